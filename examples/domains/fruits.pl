@@ -1,0 +1,97 @@
+/*  Experiment 2 of da Silva & Romero (2012), section 5.2: a robotic head, a caregiver and
+    three fruits (apple, lemon, orange). The robot learns to follow the caregiver's gaze to
+    the fruit and then to name it (declarative pointing).
+
+    Load it with relrl (relrl check examples/domains/fruits.pl) or in plain SWI-Prolog:
+        swipl prolog/relrl.pl examples/domains/fruits.pl
+
+    Places the head can look at: centre (the caregiver), left, left_down, down, right_down,
+    right. Percepts come from perception: see(face), pose(face, Pose), see(object),
+    colour(object, Colour), at(object, Place), at(Place) (where the head looks),
+    hear(attention), hear(Word).
+*/
+
+% ---- Stimuli -----------------------------------------------------------------------------
+
+stimulus(face).
+stimulus(object).
+stimulus(attention).
+stimulus(environment).
+
+stimulus_property(attention, reinforcer).
+
+% ---- Facts -------------------------------------------------------------------------------
+
+% Red, orange and green objects are fruits.
+fact(red_fruit(object)).
+fact(orange_fruit(object)).
+fact(green_fruit(object)).
+
+% The caregiver's head pose: frontal, two left profiles, two right profiles, down.
+fact(frontal(face)).
+fact(left_profile_1(face)).
+fact(left_profile_2(face)).
+fact(right_profile_1(face)).
+fact(right_profile_2(face)).
+fact(down_profile(face)).
+
+% What the robot is focusing: the caregiver, or a fruit.
+fact(looking_frontal(face)).
+fact(looking_fruit(object)).
+
+red_fruit(object)    :- see(object), percept(colour(object, red)).
+orange_fruit(object) :- see(object), percept(colour(object, orange)).
+green_fruit(object)  :- see(object), percept(colour(object, green)).
+
+frontal(face)         :- percept(pose(face, frontal)).
+left_profile_1(face)  :- percept(pose(face, left_1)).
+left_profile_2(face)  :- percept(pose(face, left_2)).
+right_profile_1(face) :- percept(pose(face, right_1)).
+right_profile_2(face) :- percept(pose(face, right_2)).
+down_profile(face)    :- percept(pose(face, down)).
+
+looking_frontal(face) :- at(centre), see(face).
+looking_fruit(object) :-
+    see(object),
+    (   red_fruit(object)
+    ;   orange_fruit(object)
+    ;   green_fruit(object)
+    ),
+    !.
+
+% ---- Responses ---------------------------------------------------------------------------
+
+% Look at the caregiver or search one of the five regions; name the object in view.
+response(look(centre)).
+response(look(left)).
+response(look(left_down)).
+response(look(down)).
+response(look(right_down)).
+response(look(right)).
+response(name_object).
+
+% ---- Constraint rules --------------------------------------------------------------------
+
+% Nothing to name when no object is in view.
+forbidden(name_object) :- \+ see(object).
+
+% ---- Necessities -------------------------------------------------------------------------
+
+% socialize, with the parameters of section 5.2. The paper's input weights are positive
+% magnitudes; declared as satisfiers they enter Eq. 1 negated, so contact lowers the need
+% (see docs/motivation.md for the sign convention).
+necessity(socialize).
+unit(socialize, bias, 1.00).
+unit(socialize, recurrent_weight, 1.00).
+unit(socialize, delta, 0.20).
+unit(socialize, threshold, 0.50).
+
+satisfier(socialize, hear(attention), 1.50).
+satisfier(socialize, see(frontal(face)), 0.95).
+satisfier(socialize, see(looking_frontal(face)), 0.50).
+satisfier(socialize, see(looking_fruit(object)), 1.50).
+
+% ---- Behaviour rules ---------------------------------------------------------------------
+
+% An innate preference: when the caregiver's face is in view, look at it.
+behaviour(see(face), look(centre), socialize, 2.0).

@@ -1,0 +1,79 @@
+:- module(relrl_perception,
+          [ perceived/3,          % +KB, +Sense, ?What
+            perceived_at/3,       % +KB, ?Stimulus, ?Place
+            stimulus_present/2,   % +KB, ?Stimulus
+            sense/1               % ?Sense
+          ]).
+:- use_module(library(error)).
+:- use_module(memory).
+:- use_module(declarations).
+
+/** <module> Perception predicates over working memory
+
+The perception predicates of section 3.1, see/1, hear/1, at/1 and smell/1 (and the positional
+at/2), answer from the current working memory of a knowledge base. Percepts are stored as
+memory elements of the same shape: see(face), hear(attention), at(object, left_down).
+
+A perception predicate takes either a stimulus or a fact applied to a stimulus:
+`see(face)` holds when see(face) is in memory; `see(frontal(face))` holds when see(face) is
+in memory and the domain's fact frontal(face) holds (for example because pose(face, frontal)
+is in memory). This is how the paper's necessity inputs such as see(frontal(face)) read.
+*/
+
+%!  sense(?Sense) is nondet.
+%
+%   The senses of the architecture.
+
+sense(see).
+sense(hear).
+sense(smell).
+sense(at).
+
+%!  perceived(+KB, +Sense, ?What) is nondet.
+%
+%   What is perceived through Sense in KB's working memory. What is a stimulus, or a fact
+%   F(S) about a stimulus S that is perceived through Sense.
+%
+%   @error domain_error(sense, Sense) if Sense is not see, hear, smell or at.
+
+perceived(KB, Sense, What) :-
+    must_be(atom, Sense),
+    (   sense(Sense)
+    ->  true
+    ;   domain_error(sense, Sense)
+    ),
+    (   var(What)
+    ->  Percept =.. [Sense, What],
+        wm_element(KB, Percept, _)
+    ;   atomic(What)
+    ->  Percept =.. [Sense, What],
+        once(wm_element(KB, Percept, _))
+    ;   What =.. [_, Stimulus],
+        atomic(Stimulus)
+    ->  Percept =.. [Sense, Stimulus],
+        once(wm_element(KB, Percept, _)),
+        once(KB:What)
+    ;   Percept =.. [Sense, What],
+        once(wm_element(KB, Percept, _))
+    ).
+
+%!  perceived_at(+KB, ?Stimulus, ?Place) is nondet.
+%
+%   Stimulus is perceived at Place (the at/2 percept).
+
+perceived_at(KB, Stimulus, Place) :-
+    wm_element(KB, at(Stimulus, Place), _).
+
+%!  stimulus_present(+KB, ?Stimulus) is nondet.
+%
+%   The declared Stimulus is perceived now through some sense (or located with at/2).
+
+stimulus_present(KB, Stimulus) :-
+    kb_stimulus(KB, Stimulus),
+    (   sense(Sense),
+        Percept =.. [Sense, Stimulus],
+        wm_element(KB, Percept, _)
+    ->  true
+    ;   wm_element(KB, at(Stimulus, _), _)
+    ->  true
+    ).

@@ -1,0 +1,110 @@
+:- module(relrl_state,
+          [ state_features/2,     % +KB, -Features
+            feature_code/3,       % +KB, ?Term, ?X
+            feature_active/2,     % +KB, +Feature
+            state_terms/2,        % +KB, -Terms
+            state_code/2,         % +KB, -Code
+            state_decode/3,       % +KB, +Code, -Terms
+            state_encode/3        % +KB, +Terms, -Code
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(declarations).
+:- use_module(perception).
+
+/** <module> The state code
+
+Section 3.1: every declared stimulus and fact is associated with a number x in 0..n-1, and
+the state of the environment is the sum of 2^x over the stimuli and facts that hold now.
+x follows declaration order, stimuli first and then facts, so a domain file always gives
+the same codes. A code decodes back to its terms without loss.
+
+A stimulus holds when it is perceived through any sense (perception.pl); a fact holds when
+its goal succeeds in the knowledge base.
+*/
+
+%!  state_features(+KB, -Features:list) is det.
+%
+%   Features is the list of stimulus(S) and fact(F) terms of KB in code order: the element
+%   at position x (0-based) has code 2^x.
+
+state_features(KB, Features) :-
+    must_be(atom, KB),
+    findall(stimulus(S), kb_stimulus(KB, S), Stimuli),
+    findall(fact(F), kb_fact(KB, F), Facts),
+    append(Stimuli, Facts, Features).
+
+%!  feature_code(+KB, ?Term, ?X) is nondet.
+%
+%   Term, a stimulus(S) or fact(F), has index X (its code is 2^X).
+
+feature_code(KB, Term, X) :-
+    state_features(KB, Features),
+    nth0(X, Features, Term).
+
+%!  feature_active(+KB, +Feature) is semidet.
+%
+%   Feature (stimulus(S) or fact(F)) holds now in KB.
+
+feature_active(KB, stimulus(S)) :-
+    stimulus_present(KB, S).
+feature_active(KB, fact(F)) :-
+    once(KB:F).
+
+%!  state_terms(+KB, -Terms:list) is det.
+%
+%   Terms are the features of KB that hold now, in code order.
+
+state_terms(KB, Terms) :-
+    state_features(KB, Features),
+    include(feature_active(KB), Features, Terms).
+
+%!  state_code(+KB, -Code:integer) is det.
+%
+%   Code is the sum of 2^x over the features of KB that hold now.
+
+state_code(KB, Code) :-
+    state_features(KB, Features),
+    foldl(add_active(KB), Features, 0-0, Code-_).
+
+add_active(KB, Feature, Code0-X, Code-X1) :-
+    X1 is X + 1,
+    (   feature_active(KB, Feature)
+    ->  Code is Code0 \/ (1 << X)
+    ;   Code = Code0
+    ).
+
+%!  state_decode(+KB, +Code, -Terms:list) is det.
+%
+%   Terms are the features whose bits are set in Code.
+%
+%   @error type_error(nonneg, Code) if Code is not a non-negative integer.
+%   @error domain_error(state_code, Code) if Code has a bit no feature of KB owns.
+
+state_decode(KB, Code, Terms) :-
+    must_be(nonneg, Code),
+    state_features(KB, Features),
+    length(Features, N),
+    (   Code >> N =:= 0
+    ->  true
+    ;   domain_error(state_code, Code)
+    ),
+    findall(T, ( nth0(X, Features, T), Code /\ (1 << X) =\= 0 ), Terms).
+
+%!  state_encode(+KB, +Terms:list, -Code) is det.
+%
+%   Code is the state code of the features in Terms.
+%
+%   @error existence_error(feature, T) if a term is not a declared feature.
+
+state_encode(KB, Terms, Code) :-
+    must_be(list, Terms),
+    state_features(KB, Features),
+    foldl(encode_term(Features), Terms, 0, Code).
+
+encode_term(Features, T, Code0, Code) :-
+    (   nth0(X, Features, T)
+    ->  Code is Code0 \/ (1 << X)
+    ;   existence_error(feature, T)
+    ).

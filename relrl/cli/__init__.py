@@ -1,0 +1,83 @@
+"""The ``relrl`` command: one entry point, one module per subcommand.
+
+Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EXAMPLE``,
+``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
+pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
+
+Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from relrl.errors import UserError
+
+__all__ = ["main", "SUBCOMMANDS"]
+
+#: subcommand name -> module (looked up by name, no if-chains).
+SUBCOMMANDS: dict[str, str] = {
+    "check": "relrl.cli.check",
+    "shell": "relrl.cli.shell",
+    "bench": "relrl.cli.bench",
+    "experiment": "relrl.cli.experiment",
+    "run": "relrl.cli.run",
+    "perceive": "relrl.cli.perceive",
+    "head": "relrl.cli.head",
+    "demo": "relrl.cli.demo",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Build the full parser with every subcommand that is installed."""
+    from relrl import __version__
+
+    parser = _Parser(prog="relrl", description="Relational reinforcement learning for social "
+                     "robots: shared attention with knowledge in SWI-Prolog.")
+    parser.add_argument("--version", action="version", version=f"relrl {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name, modname in SUBCOMMANDS.items():
+        try:
+            mod = importlib.import_module(modname)
+        except ModuleNotFoundError as exc:
+            if exc.name == modname:
+                continue  # subcommand not built yet
+            raise
+        example = getattr(mod, "EXAMPLE", "")
+        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP,
+                           epilog=f"example:\n  {example}" if example else None,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
+        mod.add_arguments(p)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``relrl`` command line; returns the exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "_run", None):
+        parser.print_help()
+        return 2
+    try:
+        return int(args._run(args) or 0)
+    except UserError as exc:
+        print(f"relrl {args.command}: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"relrl {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

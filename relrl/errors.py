@@ -1,0 +1,76 @@
+"""Errors raised by relrl.
+
+Every error a user can cause (a bad Prolog file, a bad episode script, a bad flag, a missing
+device) is a :class:`UserError`. The command line prints such an error as one line and exits
+with status 2; anything else is a bug and keeps its traceback.
+
+Other packages of the project (``perception``, ``head``) subclass these so one ``except`` in
+the command line catches them all.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+__all__ = [
+    "RelrlError",
+    "UserError",
+    "PrologError",
+    "PrologLoadError",
+    "QueryTimeout",
+    "DomainError",
+    "ConfigError",
+]
+
+
+class RelrlError(Exception):
+    """Base class of every error relrl raises on purpose."""
+
+
+class UserError(RelrlError):
+    """An error the user can fix: printed as one line, exit status 2."""
+
+
+class PrologError(RelrlError):
+    """A Prolog exception raised while running a goal.
+
+    Attributes:
+        term: the Prolog error term as plain Python values (see :mod:`relrl.terms`).
+        message: Prolog's own rendering of the error, one line.
+    """
+
+    def __init__(self, message: str, term: Any = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.term = term
+
+
+class PrologLoadError(UserError):
+    """A Prolog file could not be loaded cleanly.
+
+    Attributes:
+        path: the file that failed.
+        line: the first line with a problem (``None`` when unknown).
+        problems: every ``(path, line, text)`` reported while loading.
+    """
+
+    def __init__(self, path: str, line: int | None, text: str,
+                 problems: list[tuple[str, int | None, str]] | None = None) -> None:
+        where = f"{path}:{line}" if line else str(path)
+        super().__init__(f"{where}: {text}")
+        self.path = path
+        self.line = line
+        self.text = text
+        self.problems = problems or [(path, line, text)]
+
+
+class QueryTimeout(UserError):
+    """A Prolog goal ran longer than its time bound (a runaway rule)."""
+
+
+class DomainError(UserError):
+    """A domain file loaded but does not validate (see ``relrl check``)."""
+
+
+class ConfigError(UserError):
+    """A bad option value: a flag, a parameter, a configuration file entry."""

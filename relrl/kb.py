@@ -1,0 +1,519 @@
+"""The one gateway to Prolog.
+
+This is the only module of relrl that imports pyswip. It
+
+* starts SWI-Prolog lazily, on the first knowledge base, and loads relrl's knowledge layer
+  (``prolog/``);
+* gives each :class:`KnowledgeBase` a Prolog module of its own, so two knowledge bases in one
+  process never see each other's clauses or working memory;
+* consults domain files and raises :class:`~relrl.errors.PrologLoadError` naming file and line
+  (pyswip itself prints consult errors and carries on);
+* passes values as terms built through the foreign interface — text from outside is data,
+  never pasted into a goal string;
+* runs every goal once under a time limit (a runaway rule raises
+  :class:`~relrl.errors.QueryTimeout` instead of freezing the robot's loop), always closing
+  the query and discarding its frame;
+* returns plain Python values with structure kept (see :mod:`relrl.terms`).
+
+pyswip gives one Prolog engine per process and it is not safe across threads: a gateway
+call from a thread other than the one that started Prolog raises. Parallel experiments use
+processes.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import re
+import threading
+import time
+from collections.abc import Iterable, Sequence
+from ctypes import POINTER, byref, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from relrl.errors import PrologError, PrologLoadError, QueryTimeout, RelrlError
+from relrl.terms import Term, Var
+
+__all__ = ["KnowledgeBase", "Problem", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
+
+#: Where the knowledge layer's .pl files live (override with RELRL_PROLOG_DIR).
+PROLOG_DIR = Path(os.environ.get("RELRL_PROLOG_DIR",
+                                 Path(__file__).resolve().parent.parent / "prolog"))
+
+#: Seconds a single gateway call may run before it raises QueryTimeout.
+DEFAULT_TIMEOUT = 10.0
+
+# SWI-Prolog 9 foreign-interface constants.
+_PL_VARIABLE, _PL_ATOM, _PL_INTEGER, _PL_RATIONAL, _PL_FLOAT = 1, 2, 3, 4, 5
+_PL_STRING, _PL_TERM, _PL_NIL, _PL_BLOB, _PL_LIST_PAIR = 6, 7, 8, 9, 10
+_REP_UTF8 = 0x00100000
+_CVT_ATOM, _CVT_STRING, _CVT_INTEGER, _CVT_VARIABLE = 0x1, 0x2, 0x8, 0x40
+_CVT_WRITEQ = 0xC0
+_BUF_STACK = 0x10000
+_PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
+
+_KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One error or warning printed while loading a file."""
+
+    kind: str          # "error" or "warning"
+    path: str
+    line: int | None
+    message: str
+
+    def __str__(self) -> str:
+        where = f"{self.path}:{self.line}" if self.line else self.path
+        return f"{where}: {self.kind}: {self.message}"
+
+
+class _Engine:
+    """The process's one Prolog engine and the foreign-interface calls relrl uses."""
+
+    def __init__(self) -> None:
+        import pyswip.prolog  # noqa: F401  (starts Prolog; must come before core use)
+        from pyswip import core
+
+        self.thread = threading.get_ident()
+        lib = core._lib
+        self.lib = lib
+        T = c_size_t  # term_t, atom_t, functor_t, fid_t are uintptr_t
+
+        def fn(name: str, restype: Any, *argtypes: Any) -> Any:
+            f = getattr(lib, name)
+            f.restype = restype
+            f.argtypes = list(argtypes)
+            return f
+
+        self.new_term_refs = fn("PL_new_term_refs", T, c_size_t)
+        self.new_term_ref = fn("PL_new_term_ref", T)
+        self.put_chars = fn("PL_put_chars", c_int, T, c_int, c_size_t, c_char_p)
+        self.put_int64 = fn("PL_put_int64", c_int, T, c_int64)
+        self.put_float = fn("PL_put_float", c_int, T, c_double)
+        self.put_nil = fn("PL_put_nil", c_int, T)
+        self.put_variable = fn("PL_put_variable", c_int, T)
+        self.put_term = fn("PL_put_term", c_int, T, T)
+        self.cons_list = fn("PL_cons_list", c_int, T, T, T)
+        self.cons_functor_v = fn("PL_cons_functor_v", c_int, T, T, T)
+        self.new_atom = fn("PL_new_atom_mbchars", T, c_int, c_size_t, c_char_p)
+        self.new_functor = fn("PL_new_functor_sz", T, T, c_size_t)
+        self.unregister_atom = fn("PL_unregister_atom", None, T)
+        self.chars_to_term = fn("PL_chars_to_term", c_int, c_char_p, T)
+        self.term_type = fn("PL_term_type", c_int, T)
+        self.get_nchars = fn("PL_get_nchars", c_int, T, POINTER(c_size_t),
+                             POINTER(c_char_p), c_uint)
+        self.get_int64 = fn("PL_get_int64", c_int, T, POINTER(c_int64))
+        self.get_float = fn("PL_get_float", c_int, T, POINTER(c_double))
+        self.get_name_arity = fn("PL_get_name_arity_sz", c_int, T, POINTER(T), POINTER(c_size_t))
+        self.atom_nchars = fn("PL_atom_mbchars", c_int, T, POINTER(c_size_t),
+                              POINTER(c_char_p), c_uint)
+        self.get_arg = fn("PL_get_arg_sz", c_int, c_size_t, T, T)
+        self.get_list = fn("PL_get_list", c_int, T, T, T)
+        self.predicate = fn("PL_predicate", c_void_p, c_char_p, c_int, c_char_p)
+        self.open_frame = fn("PL_open_foreign_frame", T)
+        self.discard_frame = fn("PL_discard_foreign_frame", None, T)
+        self.call_predicate = fn("PL_call_predicate", c_int, c_void_p, c_int, c_void_p, T)
+        self.exception = fn("PL_exception", T, T)
+        self.clear_exception = fn("PL_clear_exception", None)
+
+        self._functors: dict[tuple[str, int], int] = {}
+        self._names: dict[int, str] = {}
+        self._gw_run = self.predicate(b"gw_run", 3, b"relrl_gateway")
+        self.calls = 0
+        self._bootstrap()
+
+    # -- Python -> Prolog ------------------------------------------------------------------
+
+    def functor_t(self, name: str, arity: int) -> int:
+        key = (name, arity)
+        f = self._functors.get(key)
+        if f is None:
+            data = name.encode("utf-8")
+            atom = self.new_atom(_REP_UTF8, len(data), data)
+            f = self.new_functor(atom, arity)
+            self._functors[key] = f  # the functor keeps the atom alive
+        return f
+
+    def put(self, t: int, value: Term, variables: dict[int, int]) -> None:
+        """Write ``value`` into term reference ``t``."""
+        if isinstance(value, str):
+            data = value.encode("utf-8")
+            if not self.put_chars(t, _PL_ATOM | _REP_UTF8, len(data), data):
+                raise RelrlError(f"cannot make an atom of {value!r}")
+        elif isinstance(value, bool):
+            self.put_chars(t, _PL_ATOM, 4 if value else 5, b"true" if value else b"false")
+        elif isinstance(value, int):
+            if -(2**63) <= value < 2**63:
+                self.put_int64(t, value)
+            else:
+                self.chars_to_term(str(value).encode(), t)
+        elif isinstance(value, float):
+            self.put_float(t, value)
+        elif isinstance(value, tuple):
+            if not value or not isinstance(value[0], str):
+                raise TypeError(f"a compound term is (name, args...), not {value!r}")
+            if len(value) == 1:
+                self.put(t, value[0], variables)
+                return
+            n = len(value) - 1
+            a0 = self.new_term_refs(n)
+            for i, arg in enumerate(value[1:]):
+                self.put(a0 + i, arg, variables)
+            self.cons_functor_v(t, self.functor_t(value[0], n), a0)
+        elif isinstance(value, list):
+            self.put_nil(t)
+            if value:
+                head = self.new_term_ref()
+                for item in reversed(value):
+                    self.put(head, item, variables)
+                    self.cons_list(t, head, t)
+        elif isinstance(value, Var):
+            known = variables.get(id(value))
+            if known is None:
+                self.put_variable(t)
+                variables[id(value)] = t
+            else:
+                self.put_term(t, known)
+        elif hasattr(value, "item") and callable(value.item):  # numpy scalar
+            self.put(t, value.item(), variables)
+        else:
+            raise TypeError(f"cannot pass {type(value).__name__} {value!r} to Prolog")
+
+    # -- Prolog -> Python ------------------------------------------------------------------
+
+    def _text(self, t: int, flags: int) -> str:
+        n = c_size_t()
+        s = c_char_p()
+        if not self.get_nchars(t, byref(n), byref(s), flags | _BUF_STACK | _REP_UTF8):
+            raise RelrlError("cannot read text from a Prolog term")
+        return ctypes.string_at(s, n.value).decode("utf-8")
+
+    def _atom_name(self, atom: int) -> str:
+        name = self._names.get(atom)
+        if name is None:
+            n = c_size_t()
+            s = c_char_p()
+            self.atom_nchars(atom, byref(n), byref(s), _REP_UTF8)
+            name = ctypes.string_at(s, n.value).decode("utf-8")
+        return name
+
+    def get(self, t: int) -> Term:
+        """Read the term at reference ``t`` as a Python value."""
+        kind = self.term_type(t)
+        if kind == _PL_ATOM:
+            return self._text(t, _CVT_ATOM)
+        if kind == _PL_INTEGER:
+            v = c_int64()
+            if self.get_int64(t, byref(v)):
+                return v.value
+            return int(self._text(t, _CVT_INTEGER))
+        if kind == _PL_FLOAT:
+            d = c_double()
+            self.get_float(t, byref(d))
+            return d.value
+        if kind == _PL_STRING:
+            return self._text(t, _CVT_STRING)
+        if kind == _PL_NIL:
+            return []
+        if kind == _PL_LIST_PAIR:
+            items = []
+            head = self.new_term_ref()
+            rest = self.new_term_ref()
+            self.put_term(rest, t)
+            while self.get_list(rest, head, rest):
+                items.append(self.get(head))
+            if self.term_type(rest) != _PL_NIL:  # partial list: keep the tail
+                items.append(self.get(rest))
+            return items
+        if kind == _PL_TERM:
+            name = c_size_t()
+            arity = c_size_t()
+            self.get_name_arity(t, byref(name), byref(arity))
+            arg = self.new_term_ref()
+            values = [self._atom_name(name.value)]
+            for i in range(1, arity.value + 1):
+                self.get_arg(i, t, arg)
+                values.append(self.get(arg))
+            return tuple(values)
+        if kind == _PL_VARIABLE:
+            return Var(self._text(t, _CVT_VARIABLE))
+        if kind == _PL_RATIONAL:
+            from fractions import Fraction
+
+            return Fraction(self._text(t, _CVT_WRITEQ))
+        return self._text(t, _CVT_WRITEQ)
+
+    # -- running goals ---------------------------------------------------------------------
+
+    def run(self, goal: Term, timeout: float, outputs: Sequence[int] = ()) -> list | None:
+        """Run ``goal`` once; return the values of the argument positions in ``outputs``.
+
+        Returns None when the goal fails. Raises QueryTimeout or PrologError.
+        """
+        if threading.get_ident() != self.thread:
+            raise RelrlError("the Prolog engine belongs to the thread that started it; "
+                             "use processes, not threads, for parallel runs")
+        fid = self.open_frame()
+        try:
+            self.calls += 1
+            a0 = self.new_term_refs(3)
+            variables: dict[int, int] = {}
+            self.put(a0, goal, variables)
+            self.put_float(a0 + 1, float(timeout or 0))
+            self.put_variable(a0 + 2)
+            ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
+                                     self._gw_run, a0)
+            if not ok:
+                ex = self.exception(0)
+                detail = self.get(ex) if ex else "no exception"
+                self.clear_exception()
+                raise PrologError(f"gateway call failed: {detail!r}", detail)
+            result = self.get(a0 + 2)
+            if result == "false":
+                return None
+            if result != "true":
+                _raise_result(result, timeout)
+            if not outputs:
+                return []
+            # goal is Module:Goal or Goal; read the requested arguments of Goal.
+            inner = self.new_term_ref()
+            self.put_term(inner, a0)
+            if isinstance(goal, tuple) and goal[0] == ":" and len(goal) == 3:
+                self.get_arg(2, a0, inner)
+            arg = self.new_term_ref()
+            values = []
+            for i in outputs:
+                self.get_arg(i + 1, inner, arg)
+                values.append(self.get(arg))
+            return values
+        finally:
+            self.discard_frame(fid)
+
+    def _bootstrap(self) -> None:
+        gateway = PROLOG_DIR / "gateway.pl"
+        if not gateway.exists():
+            raise RelrlError(f"relrl's Prolog files are missing: {gateway} "
+                             "(set RELRL_PROLOG_DIR to the prolog/ folder)")
+        fid = self.open_frame()
+        try:
+            t = self.new_term_ref()
+            self.put(t, ("use_module", str(gateway)), {})
+            pred = self.predicate(b"call", 1, b"user")
+            if not self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION, pred, t):
+                raise RelrlError(f"cannot load {gateway}")
+        finally:
+            self.discard_frame(fid)
+        self._gw_run = self.predicate(b"gw_run", 3, b"relrl_gateway")
+
+
+def _raise_result(result: Term, timeout: float) -> None:
+    """Turn an error(E, Message) result of gw_run/3 into a Python exception."""
+    if isinstance(result, tuple) and result[0] == "error":
+        error, message = result[1], result[2]
+        message = _KB_MODULE.sub("", str(message))
+        if error == "time_limit_exceeded":
+            raise QueryTimeout(f"query ran longer than {timeout:g} s (a rule that never ends?)")
+        raise PrologError(message, error)
+    raise PrologError(f"unexpected gateway result {result!r}", result)
+
+
+_engine: _Engine | None = None
+_engine_lock = threading.Lock()
+
+
+def _get_engine() -> _Engine:
+    global _engine
+    if _engine is None:
+        with _engine_lock:
+            if _engine is None:
+                _engine = _Engine()
+    return _engine
+
+
+def gateway_calls() -> int:
+    """Number of calls into Prolog made through the gateway so far in this process."""
+    return _engine.calls if _engine is not None else 0
+
+
+class KnowledgeBase:
+    """A knowledge base: one Prolog module holding a domain and its working memory.
+
+    Example:
+        >>> kb = KnowledgeBase("examples/domains/fruits.pl")
+        >>> kb.insert([("see", "face"), ("pose", "face", "frontal")])
+        >>> kb.holds(("see", ("frontal", "face")))
+        True
+
+    Args:
+        *domains: domain files to load, in order.
+        timeout: seconds any one call may run before raising QueryTimeout.
+        strict: treat load warnings (singleton variables, discontiguous clauses) as errors.
+    """
+
+    def __init__(self, *domains: str | os.PathLike, timeout: float = DEFAULT_TIMEOUT,
+                 strict: bool = True) -> None:
+        self._engine = _get_engine()
+        self.timeout = timeout
+        self.files: list[Path] = []
+        self.warnings: list[Problem] = []
+        out = self._engine.run((":", "relrl_gateway", ("gw_new_kb", Var())), timeout, (0,))
+        self.module: str = out[0]  # type: ignore[index]
+        self._closed = False
+        for path in domains:
+            self.load(path, strict=strict)
+
+    # -- loading ---------------------------------------------------------------------------
+
+    def load(self, path: str | os.PathLike, *, strict: bool = True) -> list[Problem]:
+        """Consult a domain (or policy) file into this knowledge base.
+
+        Returns the warnings when ``strict`` is False.
+
+        Raises:
+            PrologLoadError: the file is missing, has a syntax error or another load error,
+                or (when ``strict``) a warning; the message names file and line.
+        """
+        p = Path(path)
+        out = self._engine.run((":", "relrl_gateway", ("gw_load", str(p), self.module, Var())),
+                               0, (2,))
+        problems = [Problem(kind, str(f) if f else str(p), line or None, msg)
+                    for (_, kind, f, line, msg) in out[0]]  # type: ignore[index]
+        problems = [Problem(pr.kind, _display_path(pr.path), pr.line, pr.message)
+                    for pr in problems]
+        errors = [pr for pr in problems if pr.kind == "error" or strict]
+        if errors:
+            first = errors[0]
+            raise PrologLoadError(first.path, first.line, first.message,
+                                  [(e.path, e.line, f"{e.kind}: {e.message}") for e in errors])
+        self.files.append(p)
+        self.warnings.extend(problems)
+        return problems
+
+    # -- running goals ---------------------------------------------------------------------
+
+    def call(self, predicate: str, *arguments: Term, timeout: float | None = None) -> list | None:
+        """Call ``module:name(arguments...)`` once; return the values of its :class:`Var`
+        arguments in order, or None when it fails.
+
+        ``predicate`` is ``"module:name"`` or ``"name"`` (run in this knowledge base).
+        """
+        module, _, name = predicate.rpartition(":")
+        goal: Term = (name, *arguments) if arguments else name
+        goal = (":", module or self.module, goal)
+        outputs = [i for i, a in enumerate(arguments) if isinstance(a, Var)]
+        return self._engine.run(goal, self.timeout if timeout is None else timeout, outputs)
+
+    def holds(self, goal: Term, *, timeout: float | None = None) -> bool:
+        """True when ``goal`` (a term) succeeds in this knowledge base."""
+        out = self._engine.run((":", self.module, goal),
+                               self.timeout if timeout is None else timeout)
+        return out is not None
+
+    def query(self, text: str, *, max_solutions: int = 100,
+              timeout: float | None = None) -> tuple[list[list[tuple[str, Term, str]]], bool]:
+        """Run a query typed by a user (Prolog syntax, without the final full stop).
+
+        Returns ``(solutions, more)``: each solution is a list of
+        ``(variable name, value, value printed as Prolog)``; ``more`` is True when there
+        were more than ``max_solutions``.
+
+        Raises:
+            PrologError: syntax error or exception in the query.
+            QueryTimeout: the query ran longer than the time limit.
+        """
+        limit = self.timeout if timeout is None else timeout
+        text = text.strip()
+        if text.endswith("."):
+            text = text[:-1]
+        out = self._engine.run((":", "relrl_gateway",
+                                ("gw_query", self.module, text, float(limit), max_solutions,
+                                 Var())), 0, (4,))
+        result = out[0]  # type: ignore[index]
+        if result[0] == "error":
+            _raise_result(result, limit)
+        _, solutions, more = result
+        return ([[(name, value, printed) for (_, (_, name, value), printed) in sol]
+                 for sol in solutions], more == "true")
+
+    # -- the knowledge layer ---------------------------------------------------------------
+
+    def insert(self, elements: Iterable[Term]) -> None:
+        """One insertion of ``elements`` into working memory (they get age 0)."""
+        self.call("relrl_memory:wm_insert", self.module, list(elements))
+
+    def memory(self) -> list[tuple[int, Term]]:
+        """Working memory as ``(age, element)`` pairs, youngest first."""
+        out = self.call("relrl_memory:wm_elements", self.module, Var())
+        return [(age, element) for (_, age, element) in out[0]]  # type: ignore[index]
+
+    def clear_memory(self) -> None:
+        """Forget every element of working memory."""
+        self.call("relrl_memory:wm_clear", self.module)
+
+    def state_code(self) -> int:
+        """The current state code: sum of 2^x over the stimuli and facts that hold now."""
+        return self.call("relrl_state:state_code", self.module, Var())[0]  # type: ignore[index]
+
+    def state_terms(self) -> list[Term]:
+        """The stimuli and facts that hold now, as ``("stimulus", S)`` / ``("fact", F)``."""
+        return self.call("relrl_state:state_terms", self.module, Var())[0]  # type: ignore
+
+    def decode_state(self, code: int) -> list[Term]:
+        """The stimuli and facts whose bits are set in ``code``."""
+        return self.call("relrl_state:state_decode", self.module, code, Var())[0]  # type: ignore
+
+    def features(self) -> list[Term]:
+        """Every stimulus and fact in code order (position x has code 2^x)."""
+        return self.call("relrl_state:state_features", self.module, Var())[0]  # type: ignore
+
+    def allowed_responses(self) -> list[Term]:
+        """The responses the constraint rules allow now, in declaration order."""
+        return self.call("relrl_responses:allowed_responses", self.module, Var())[0]  # type: ignore
+
+    def declarations(self, kind: str) -> list[Term]:
+        """All ``kind`` declarations (``stimulus``, ``fact``, ``response``, ``necessity``)."""
+        out = self.call("relrl_gateway:gw_findall", self.module, (kind, Var("X")), Var())
+        return [t[1] for t in out[0]]  # type: ignore[index]
+
+    # -- life cycle ------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Forget this knowledge base's clauses and memory. Safe to call twice."""
+        if not self._closed:
+            self._closed = True
+            self._engine.run((":", "relrl_gateway", ("gw_drop_kb", self.module)), self.timeout)
+
+    def __enter__(self) -> KnowledgeBase:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        files = ", ".join(str(f) for f in self.files)
+        return f"KnowledgeBase({self.module}: {files})"
+
+
+def _display_path(path: str) -> str:
+    """Show a path relative to the working directory when it is below it."""
+    try:
+        return str(Path(path).resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return path
+
+
+def measure_call_cost(n: int = 2000) -> float:
+    """Seconds per gateway call with one binding (``relrl_state:state_code``-sized work)."""
+    kb = KnowledgeBase()
+    try:
+        kb.call("relrl_memory:wm_clock", kb.module, Var())
+        t0 = time.perf_counter()
+        for _ in range(n):
+            kb.call("relrl_memory:wm_clock", kb.module, Var())
+        return (time.perf_counter() - t0) / n
+    finally:
+        kb.close()
