@@ -17,19 +17,27 @@ from __future__ import annotations
 from pathlib import Path
 
 from head.base import Head
-from head.calibration import (DIRECTIONS, Calibration, Servo, load_calibration,
-                              save_calibration)
+from head.calibration import DIRECTIONS, Calibration, Servo, load_calibration, save_calibration
 from head.errors import HeadError
 from head.protocols import PROTOCOLS, get_protocol
 from head.sim import HeadEvent, SimHead
 
 __all__ = [
-    # opening a head
-    "open_head", "Head", "SimHead", "HeadEvent",
-    # calibration as data
-    "Calibration", "Servo", "DIRECTIONS", "load_calibration", "save_calibration",
+    "DIRECTIONS",
     # protocols and errors
-    "PROTOCOLS", "get_protocol", "HeadError",
+    "PROTOCOLS",
+    # calibration as data
+    "Calibration",
+    "Head",
+    "HeadError",
+    "HeadEvent",
+    "Servo",
+    "SimHead",
+    "get_protocol",
+    "load_calibration",
+    # opening a head
+    "open_head",
+    "save_calibration",
 ]
 
 #: the ``port`` value that means the simulated head.

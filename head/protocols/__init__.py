@@ -17,11 +17,12 @@ import importlib
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import ClassVar, Protocol as _Interface
+from typing import ClassVar
+from typing import Protocol as _Interface
 
 from head.errors import HeadError, UnknownProtocol
 
-__all__ = ["PROTOCOLS", "Command", "Link", "Protocol", "get_protocol", "check_command"]
+__all__ = ["PROTOCOLS", "Command", "Link", "Protocol", "check_command", "get_protocol"]
 
 #: protocol name -> ``"module:Class"`` (imported on first use).
 PROTOCOLS: dict[str, str] = {
