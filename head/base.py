@@ -232,8 +232,11 @@ class Head(ABC):
         """Whether the head is closed."""
         return self._closed
 
-    def close(self) -> None:
+    def close(self, centre: bool = True) -> None:
         """Return to centre, wait for it, then release the device. Safe to call twice.
+
+        Args:
+            centre: return to centre first (``False`` leaves the head where it is).
 
         Raises:
             HeadError: returning to centre failed (the device is released anyway).
@@ -241,8 +244,9 @@ class Head(ABC):
         if self._closed:
             return
         try:
-            self.move_to(self.calibration.centre_pose())
-            self.wait()
+            if centre:
+                self.move_to(self.calibration.centre_pose())
+                self.wait()
         finally:
             self._closed = True
             self._release()
