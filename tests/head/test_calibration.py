@@ -7,8 +7,13 @@ from pathlib import Path
 
 import pytest
 
-from head.calibration import (DEFAULT_CALIBRATION, DIRECTIONS, dump_calibration,
-                              load_calibration, save_calibration)
+from head.calibration import (
+    DEFAULT_CALIBRATION,
+    DIRECTIONS,
+    dump_calibration,
+    load_calibration,
+    save_calibration,
+)
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
 from relrl.errors import UserError
 

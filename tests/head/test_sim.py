@@ -127,7 +127,7 @@ def test_close_returns_to_centre_is_safe_twice_and_reopen_works(fast_cal):
 def test_context_manager_keeps_the_original_exception(fast_cal):
     with pytest.raises(ZeroDivisionError), SimHead(fast_cal) as head:
         head.look("down")
-        1 / 0
+        raise ZeroDivisionError("inside the with block")
     assert head.closed
 
 
