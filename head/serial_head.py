@@ -139,6 +139,7 @@ class SerialHead(Head):
         self._factory = serial_factory
         self._model = MotionModel({n: float(v) for n, v in self.targets.items()})
         self.link: SerialLink | None = None
+        self._bytes_before = 0
         self._open()
         self._closed = False
 
@@ -157,8 +158,14 @@ class SerialHead(Head):
 
     def _release(self) -> None:
         if self.link is not None:
+            self._bytes_before += self.link.bytes_written
             self.link.close()
             self.link = None
+
+    @property
+    def bytes_written(self) -> int:
+        """Every byte written since this head was created (over reopens too)."""
+        return self._bytes_before + (self.link.bytes_written if self.link else 0)
 
     def _live_link(self) -> SerialLink:
         if self.link is None:
@@ -197,7 +204,7 @@ class SerialHead(Head):
         """As :meth:`Head.status`, plus the port, protocol and bytes written."""
         out = super().status()
         out.update(port=self.port, protocol=self.protocol.name, feedback=self.feedback,
-                   bytes_written=self._live_link().bytes_written)
+                   bytes_written=self.bytes_written)
         return out
 
     def _now(self) -> float:
