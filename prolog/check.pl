@@ -1,5 +1,6 @@
 :- module(relrl_check,
-          [ check_domain/2        % +KB, -Problems
+          [ check_domain/2,       % +KB, -Problems
+            rule_listing/2        % +KB, -Rules
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -208,3 +209,17 @@ empty_declaration(KB, problem('', 0, Msg)) :-
     Head =.. [Kind, _],
     \+ declared(KB, Head),
     format(string(Msg), "the domain declares no ~w (add ~w(Name).)", [What, Kind]).
+
+%!  rule_listing(+KB, -Rules:list) is det.
+%
+%   Rules holds the behaviour rules and constraint rules of KB, each written as Prolog
+%   source text (a string), in file order.
+
+rule_listing(KB, Rules) :-
+    findall(S,
+            (   member(Head, [behaviour(_, _, _, _), forbidden(_)]),
+                domain_clause(KB, Head, Body, _),
+                with_output_to(string(S0), portray_clause((Head :- Body))),
+                split_string(S0, "", "\n", [S])
+            ),
+            Rules).

@@ -4,7 +4,8 @@
             gw_query/5,           % +Module, +Text, +TimeLimit, +MaxSolutions, -Result
             gw_new_kb/1,          % -Module
             gw_drop_kb/1,         % +Module
-            gw_findall/3          % +Module, +Template, -List
+            gw_findall/3,         % +Module, +Template, -List
+            gw_parse/3            % +Module, +Text, -Terms
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -223,3 +224,12 @@ solution_triples(Named-Printed, Triples) :-
 
 gw_findall(Module, Template, List) :-
     findall(Template, declared(Module, Template), List).
+
+%!  gw_parse(+Module, +Text, -Terms:list) is det.
+%
+%   Terms are the comma-separated terms of Text, read with Module's operators. Reading
+%   only: nothing in Text is run. A syntax error raises.
+
+gw_parse(Module, Text, Terms) :-
+    term_string(Term, Text, [module(Module)]),
+    comma_list(Term, Terms).

@@ -388,7 +388,8 @@ class KnowledgeBase:
         if errors:
             first = errors[0]
             raise PrologLoadError(first.path, first.line, first.message,
-                                  [(e.path, e.line, f"{e.kind}: {e.message}") for e in errors])
+                                  [(e.path, e.line, f"{e.kind}: {e.message}")
+                                   for e in problems])
         self.files.append(p)
         self.warnings.extend(problems)
         return problems

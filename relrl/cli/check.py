@@ -1,0 +1,55 @@
+"""``relrl check DOMAIN.pl``: load a domain, validate it and list its declarations."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+HELP = "load and validate a domain file; list its stimuli and facts with their codes"
+EXAMPLE = "relrl check examples/domains/fruits.pl"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``relrl check``."""
+    parser.add_argument("domain", nargs="+", metavar="DOMAIN.pl",
+                        help="domain file(s) to load, in order")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="print only problems, not the declarations")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check the domain; exit status 0 when valid, 2 when it has problems."""
+    from relrl.errors import PrologLoadError
+    from relrl.kb import KnowledgeBase
+    from relrl.validate import describe, validate
+
+    kb = KnowledgeBase()
+    problems: list[str] = []
+    try:
+        for path in args.domain:
+            try:
+                for w in kb.load(path, strict=False):
+                    problems.append(str(w))
+            except PrologLoadError as exc:
+                for path_, line, text in exc.problems:
+                    where = f"{path_}:{line}" if line else path_
+                    problems.append(f"{where}: {text}")
+                _print_problems(problems)
+                return 2
+        problems.extend(validate(kb))
+        if not args.quiet:
+            print(describe(kb))
+        if problems:
+            _print_problems(problems)
+            return 2
+        if not args.quiet:
+            print(f"ok: {', '.join(args.domain)} is valid")
+        return 0
+    finally:
+        kb.close()
+
+
+def _print_problems(problems: list[str]) -> None:
+    for p in problems:
+        print(p, file=sys.stderr)
+    print(f"{len(problems)} problem{'s' if len(problems) != 1 else ''}", file=sys.stderr)

@@ -1,0 +1,41 @@
+"""``relrl shell``: query the knowledge base interactively."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+HELP = "interactive prompt over the live knowledge base (also reads piped queries)"
+EXAMPLE = 'echo "response(R)." | relrl shell examples/domains/fruits.pl'
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``relrl shell``."""
+    parser.add_argument("domain", nargs="*", metavar="DOMAIN.pl", help="domain files to load")
+    parser.add_argument("--policy", metavar="FILE",
+                        help="a learned policy (ETG tree, behaviour rules) saved by relrl")
+    parser.add_argument("--timeout", type=float, default=10.0, metavar="S",
+                        help="seconds a query may run (default 10)")
+    parser.add_argument("--max", type=int, default=100, metavar="N",
+                        help="solutions printed per query (default 100)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the shell; exit status 2 if a piped query failed with an error."""
+    from relrl.kb import KnowledgeBase
+    from relrl.shell import Shell
+
+    kb = KnowledgeBase(*args.domain)
+    try:
+        shell = Shell(kb, max_solutions=args.max, timeout=args.timeout)
+        if args.policy:
+            from relrl.policy import load_policy
+
+            load_policy(shell, args.policy)
+        if sys.stdin.isatty():
+            shell.interact()
+            return 0
+        shell.run_lines(sys.stdin)
+        return 2 if shell.errors else 0
+    finally:
+        kb.close()

@@ -1,0 +1,49 @@
+"""Validating a loaded domain and describing its declarations (``relrl check``)."""
+
+from __future__ import annotations
+
+from relrl.kb import KnowledgeBase, _display_path
+from relrl.terms import Var, format_term
+
+__all__ = ["validate", "describe"]
+
+
+def validate(kb: KnowledgeBase) -> list[str]:
+    """Return one line per problem in the domain of ``kb`` (empty when valid).
+
+    Covers undefined predicates in rule bodies, responses used but not declared, duplicate
+    declarations and bad necessity unit parameters (prolog/check.pl). Load warnings such as
+    singleton variables come from :meth:`KnowledgeBase.load` with ``strict=False``.
+    """
+    out = kb.call("relrl_check:check_domain", kb.module, Var())
+    lines = []
+    for _, path, line, message in out[0]:  # type: ignore[index]
+        where = f"{_display_path(path)}:{line}" if path else "domain"
+        lines.append(f"{where}: {message}")
+    return lines
+
+
+def describe(kb: KnowledgeBase) -> str:
+    """A human-readable listing of the declarations of ``kb``."""
+    lines = ["stimuli and facts (x, 2^x):"]
+    for x, feature in enumerate(kb.features()):
+        lines.append(f"  {x:3d} {1 << x:>12d}  {format_term(feature)}")
+    reinforcers = kb.call("relrl_gateway:gw_findall", kb.module,
+                          ("stimulus_property", Var("S"), "reinforcer"), Var())[0]  # type: ignore
+    if reinforcers:
+        lines.append("reinforcers: " + ", ".join(format_term(r[1]) for r in reinforcers))
+    lines.append("responses:")
+    lines += [f"  {format_term(r)}" for r in kb.declarations("response")]
+    lines.append("necessities:")
+    for n in kb.declarations("necessity"):
+        params = kb.call("relrl_gateway:gw_findall", kb.module,
+                         ("unit", n, Var("P"), Var("V")), Var())[0]  # type: ignore[index]
+        text = ", ".join(f"{p[2]}={format_term(p[3])}" for p in params)
+        lines.append(f"  {format_term(n)}: {text}")
+        inputs = kb.call("relrl_declarations:necessity_inputs", kb.module, n, Var())[0]  # type: ignore
+        for _, goal, weight in inputs:
+            lines.append(f"      input {format_term(goal)}  weight {weight:+g}")
+    rules = kb.call("relrl_check:rule_listing", kb.module, Var())[0]  # type: ignore[index]
+    lines.append("rules:")
+    lines += [f"  {r}" for r in rules] or ["  (none)"]
+    return "\n".join(lines)

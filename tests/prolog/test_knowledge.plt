@@ -1,0 +1,119 @@
+/*  plunit tests of the knowledge layer. Run from pytest (tests/prolog/test_plunit.py) or:
+        swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_knowledge.plt
+*/
+:- use_module(library(plunit)).
+:- use_module('../../prolog/relrl').
+:- use_module('../../prolog/gateway').
+
+fresh_kb(KB, File) :-
+    relrl_gateway:gw_new_kb(KB),
+    source_file_property(_, module(relrl)),     % loaded
+    module_property(relrl, file(RelrlFile)),
+    file_directory_name(RelrlFile, Dir),
+    atomic_list_concat([Dir, '/../examples/domains/', File], Path),
+    relrl_gateway:gw_load(Path, KB, Problems),
+    assertion(Problems == []).
+
+:- begin_tests(memory).
+
+test(new_element_age_zero, [Age == 0]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 5),
+    relrl_memory:wm_insert(KB, [see(face)]),
+    relrl_memory:wm_element(KB, see(face), Age).
+
+test(later_insertion_ages, [Ages == [0-see(toy), 1-see(face)]]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 5),
+    relrl_memory:wm_insert(KB, [see(face)]),
+    relrl_memory:wm_insert(KB, [see(toy)]),
+    relrl_memory:wm_elements(KB, Ages).
+
+test(expires_after_span, [Es == [0-c, 1-b]]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 1),
+    relrl_memory:wm_insert(KB, [a]),
+    relrl_memory:wm_insert(KB, [b]),
+    relrl_memory:wm_insert(KB, [c]),
+    relrl_memory:wm_elements(KB, Es).
+
+test(reinsert_renews, [Es == [0-a, 1-b]]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 3),
+    relrl_memory:wm_insert(KB, [a]),
+    relrl_memory:wm_insert(KB, [b]),
+    relrl_memory:wm_insert(KB, [a]),
+    relrl_memory:wm_elements(KB, Es).
+
+test(nonground_rejected, [error(instantiation_error)]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_insert(KB, [see(_)]).
+
+test(bad_span, [error(type_error(nonneg, -1))]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, -1).
+
+test(isolated) :-
+    relrl_gateway:gw_new_kb(A),
+    relrl_gateway:gw_new_kb(B),
+    relrl_memory:wm_insert(A, [see(face)]),
+    \+ relrl_memory:wm_element(B, _, _).
+
+:- end_tests(memory).
+
+:- begin_tests(state).
+
+test(codes_follow_declaration_order, [Fs = [stimulus(face), stimulus(object)|_]]) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_state:state_features(KB, Fs).
+
+test(state_code_sum_of_powers, [Code == 8321]) :-   % 2^0 + 2^7 + 2^13
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_memory:wm_insert(KB, [see(face), pose(face, frontal), at(centre)]),
+    relrl_state:state_code(KB, Code).
+
+test(decode_encode_roundtrip, [Terms == Expected]) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_memory:wm_insert(KB, [see(object), colour(object, red), hear(attention)]),
+    relrl_state:state_code(KB, Code),
+    relrl_state:state_decode(KB, Code, Terms),
+    relrl_state:state_terms(KB, Expected),
+    relrl_state:state_encode(KB, Terms, Code2),
+    assertion(Code2 == Code).
+
+test(decode_rejects_unknown_bits, [error(domain_error(state_code, _))]) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_state:state_decode(KB, 1048576, _).
+
+test(fact_applied_to_stimulus) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_memory:wm_insert(KB, [see(face), pose(face, frontal)]),
+    relrl_perception:perceived(KB, see, frontal(face)),
+    \+ relrl_perception:perceived(KB, see, left_profile_1(face)).
+
+:- end_tests(state).
+
+:- begin_tests(responses).
+
+test(constraint_forbids, [Rs == [look(centre), look(left), look(left_down), look(down),
+                                 look(right_down), look(right)]]) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_memory:wm_insert(KB, [see(face)]),
+    relrl_responses:allowed_responses(KB, Rs).
+
+test(constraint_allows) :-
+    fresh_kb(KB, 'fruits.pl'),
+    relrl_memory:wm_insert(KB, [see(object), colour(object, red)]),
+    relrl_responses:allowed_response(KB, name_object).
+
+:- end_tests(responses).
+
+:- begin_tests(check).
+
+test(example_domains_valid, [P1-P2 == []-[]]) :-
+    fresh_kb(A, 'fruits.pl'),
+    fresh_kb(B, 'sis.pl'),
+    relrl_check:check_domain(A, P1),
+    relrl_check:check_domain(B, P2).
+
+:- end_tests(check).

@@ -1,0 +1,77 @@
+"""``relrl check``: valid domains list their codes; every bad input is one line, exit 2."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from relrl.cli import main
+from tests.conftest import FRUITS, ROOT, SIS
+
+
+def test_check_fruits_lists_codes(capsys) -> None:
+    assert main(["check", str(FRUITS)]) == 0
+    out = capsys.readouterr().out
+    assert "    0            1  stimulus(face)" in out
+    assert "   14        16384  fact(looking_fruit(object))" in out
+    assert "socialize: bias=1.0, recurrent_weight=1.0, delta=0.2, threshold=0.5" in out
+    assert "input hear(attention)  weight -1.5" in out
+    assert "forbidden(name_object)" in out
+    assert "is valid" in out
+
+
+def test_check_sis_is_valid(capsys) -> None:
+    assert main(["check", str(SIS)]) == 0
+
+
+BAD = {
+    "syntax": ("stimulus(face).\nresponse(look(left).\n", ":2: error: Syntax error"),
+    "undefined": ("stimulus(face).\nresponse(r).\nfact(f(face)).\nf(face) :- nothere(face).\n",
+                  ":4: f/1 calls undefined predicate nothere/1"),
+    "undeclared_response": ("stimulus(face).\nresponse(r).\nforbidden(jump) :- see(face).\n",
+                            ":3: response jump is used but not declared"),
+    "duplicate": ("stimulus(face).\nstimulus(face).\nresponse(r).\n",
+                  ":2: stimulus face is declared twice"),
+    "non_numeric": ("stimulus(face).\nresponse(r).\nnecessity(n).\nunit(n, bias, high).\n"
+                    "unit(n, recurrent_weight, 1).\nunit(n, delta, 0).\nunit(n, threshold, 0.5).\n",
+                    ":4: unit parameter bias of necessity n must be a number, not high"),
+    "unknown_param": ("stimulus(face).\nresponse(r).\nnecessity(n).\nunit(n, bias, 1).\n"
+                      "unit(n, recurrent_weight, 1).\nunit(n, delta, 0).\nunit(n, threshold, 0.5).\n"
+                      "unit(n, gain, 2).\n", ":8: unknown unit parameter gain of necessity n"),
+    "missing_param": ("stimulus(face).\nresponse(r).\nnecessity(n).\nunit(n, bias, 1).\n",
+                      ":3: necessity n has no recurrent_weight parameter"),
+    "singleton": ("stimulus(face).\nresponse(r).\nfact(f(face)).\nf(X) :- see(face).\n",
+                  ":4: warning: Singleton variables: [X]"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_domain_one_line_exit_2(case: str, write_domain, capsys) -> None:
+    text, expected = BAD[case]
+    path = write_domain(text)
+    assert main(["check", "--quiet", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}{expected}" in err, err
+    assert "Traceback" not in err
+
+
+def test_missing_file_exit_2(capsys) -> None:
+    assert main(["check", "nowhere/none.pl"]) == 2
+    assert "nowhere/none.pl: error: no such file" in capsys.readouterr().err
+
+
+def test_cli_process_has_no_traceback(write_domain) -> None:
+    path = write_domain("stimulus(face).\nresponse(look(left).\n")
+    proc = subprocess.run([sys.executable, "-m", "relrl.cli", "check", str(path)],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr
+    assert f"{path}:2:" in proc.stderr
+
+
+def test_bad_flag_exit_2(capsys) -> None:
+    with pytest.raises(SystemExit) as exc:
+        main(["check", "--no-such-flag", str(FRUITS)])
+    assert exc.value.code == 2

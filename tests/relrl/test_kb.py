@@ -1,0 +1,147 @@
+"""The gateway: loading, isolation, conversion both ways, errors, time limits."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from relrl.errors import PrologError, PrologLoadError, QueryTimeout, RelrlError
+from relrl.kb import KnowledgeBase, gateway_calls
+from relrl.terms import Var, format_term
+from tests.conftest import FRUITS, SIS
+
+
+@pytest.fixture
+def fruits():
+    with KnowledgeBase(FRUITS) as kb:
+        yield kb
+
+
+def test_declarations_enumerate(fruits: KnowledgeBase) -> None:
+    assert fruits.declarations("stimulus") == ["face", "object", "attention", "environment"]
+    assert len(fruits.declarations("response")) == 7
+    assert fruits.declarations("necessity") == ["socialize"]
+    assert len(fruits.declarations("fact")) == 11
+
+
+def test_compound_terms_keep_structure(fruits: KnowledgeBase) -> None:
+    (value,) = fruits.call("=", Var(), ("f", "a", [1, 2.5, "b"], ("g", -3)))
+    assert value == ("f", "a", [1, 2.5, "b"], ("g", -3))
+
+
+def test_values_round_trip_unicode_and_big_ints(fruits: KnowledgeBase) -> None:
+    for v in ["maçã", "it's", "Apple", 2**70, -(2**63), 1e-300, [], [[]]]:
+        assert fruits.call("=", Var(), v) == [v]
+
+
+def test_user_text_is_data_not_code(fruits: KnowledgeBase) -> None:
+    # A percept carrying hostile text is stored as an atom; nothing is run.
+    evil = "x), halt, (true"
+    fruits.insert([("hear", evil)])
+    assert fruits.memory() == [(0, ("hear", evil))]
+    assert format_term(("hear", evil)) == "hear('x), halt, (true')"
+
+
+def test_state_code_and_decode(fruits: KnowledgeBase) -> None:
+    fruits.insert([("see", "face"), ("pose", "face", "frontal"), ("at", "centre")])
+    code = fruits.state_code()
+    assert code == 2**0 + 2**7 + 2**13
+    assert fruits.decode_state(code) == fruits.state_terms()
+    assert ("fact", ("frontal", "face")) in fruits.decode_state(code)
+
+
+def test_two_knowledge_bases_are_isolated() -> None:
+    with KnowledgeBase(FRUITS) as a, KnowledgeBase(FRUITS) as b:
+        a.insert([("see", "face")])
+        assert b.memory() == []
+        assert a.module != b.module
+
+
+def test_different_domains_side_by_side() -> None:
+    with KnowledgeBase(FRUITS) as a, KnowledgeBase(SIS) as b:
+        assert "object" in a.declarations("stimulus")
+        assert "toy" in b.declarations("stimulus")
+        assert "toy" not in a.declarations("stimulus")
+
+
+def test_missing_file() -> None:
+    with pytest.raises(PrologLoadError, match="no such file"):
+        KnowledgeBase("does/not/exist.pl")
+
+
+def test_syntax_error_names_file_and_line(write_domain) -> None:
+    path = write_domain("stimulus(face).\nresponse(look(left).\n")
+    with pytest.raises(PrologLoadError) as err:
+        KnowledgeBase(path)
+    assert err.value.line == 2
+    assert str(err.value).startswith(f"{path}:2: ")
+    assert "Syntax error" in str(err.value)
+
+
+def test_singletons_are_errors_when_strict(write_domain) -> None:
+    path = write_domain("stimulus(face).\nfact(f(face)).\nf(X) :- see(Y).\n")
+    with pytest.raises(PrologLoadError, match="Singleton"):
+        KnowledgeBase(path)
+    kb = KnowledgeBase()
+    warnings = kb.load(path, strict=False)
+    assert [w.line for w in warnings] == [3]
+    kb.close()
+
+
+def test_runaway_query_times_out(write_domain) -> None:
+    path = write_domain("stimulus(face).\nloop :- loop_more.\nloop_more :- loop.\n")
+    with KnowledgeBase(path, timeout=0.2) as kb:
+        with pytest.raises(QueryTimeout):
+            kb.holds("loop")
+        # the engine is usable afterwards
+        assert kb.holds(("stimulus", "face"))
+
+
+def test_prolog_exception_becomes_prolog_error(fruits: KnowledgeBase) -> None:
+    with pytest.raises(PrologError, match="Unknown procedure: no_such_predicate/0"):
+        fruits.holds("no_such_predicate")
+    with pytest.raises(PrologError) as err:
+        fruits.call("atom_length", 1, "a")
+    assert err.value.term[0] == "error"
+    assert err.value.term[1] == ("type_error", "integer", "a")
+
+
+def test_query_returns_every_solution(fruits: KnowledgeBase) -> None:
+    solutions, more = fruits.query("response(look(P))")
+    assert [s[0][1] for s in solutions] == ["centre", "left", "left_down", "down",
+                                            "right_down", "right"]
+    assert not more
+    solutions, more = fruits.query("between(1, 1000, X)", max_solutions=5)
+    assert len(solutions) == 5 and more
+
+
+def test_query_syntax_error_is_prolog_error(fruits: KnowledgeBase) -> None:
+    with pytest.raises(PrologError, match="Syntax error"):
+        fruits.query("foo(")
+
+
+def test_one_call_per_request(fruits: KnowledgeBase) -> None:
+    before = gateway_calls()
+    fruits.state_code()
+    assert gateway_calls() - before == 1
+
+
+def test_other_threads_are_refused(fruits: KnowledgeBase) -> None:
+    errors: list[Exception] = []
+
+    def worker() -> None:
+        try:
+            fruits.state_code()
+        except RelrlError as exc:
+            errors.append(exc)
+
+    t = threading.Thread(target=worker)
+    t.start()
+    t.join()
+    assert errors and "thread" in str(errors[0])
+
+
+def test_close_twice(fruits: KnowledgeBase) -> None:
+    fruits.close()
+    fruits.close()
