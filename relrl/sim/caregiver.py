@@ -1,0 +1,405 @@
+"""Caregiver models of the Social Interactive Simulator, in a registry looked up by name.
+
+A caregiver is a small state machine advanced once per time unit by the simulator
+(:class:`relrl.sim.sis.SharedAttentionEnv`). It decides where it looks, which toys are where
+and when it gives attention (the robot's reinforcer, ``hear(attention)``).
+
+The paper's protocol (:class:`ProtocolCaregiver`; da Silva & Romero 2012, section 5.1) is a
+cycle of three phases:
+
+``engage``
+    The caregiver looks at the robot (its face is ``frontal`` to the robot) and waits for eye
+    contact: the robot's focus on the caregiver's face for ``contact_hold`` (3) consecutive
+    time units. Each entry into this phase is one *eye-contact opportunity*. When eye contact
+    is established the caregiver gives attention (if ``attention_on_contact``). If it is not
+    established within ``contact_timeout`` time units the opportunity is missed and a new one
+    starts (the caregiver keeps looking at the robot; toys only come after eye contact).
+``present``
+    The time unit after eye contact the toys appear (``n_toys`` of them, at empty places drawn
+    with ``placement`` weights; the first is the target). The caregiver keeps looking at the
+    robot for ``latency`` time units (0: it turns in the same time unit).
+``attend``
+    The caregiver looks at the target (with probability ``reliability``; otherwise at one of
+    the other four toy places, uniformly) and waits ``timeout`` time units after turning. In
+    the time unit the robot's focus is on the target, the caregiver gives attention; both look
+    at the toy in that time unit. In the next time unit the toys are gone and the caregiver
+    looks at the robot again (a new ``engage``). On timeout, or with ``single_look`` after the
+    robot's first look away from the face, it also goes back to ``engage`` without attention.
+
+Register other models with :func:`register_caregiver`; build one with
+:func:`make_caregiver`.
+"""
+
+from __future__ import annotations
+
+import abc
+import dataclasses
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from relrl.sim.errors import CaregiverConfigError, UnknownCaregiver, did_you_mean
+from relrl.sim.places import CENTRE, PLACES, TOY_PLACES, place_index
+
+__all__ = [
+    "ATTEND",
+    "ENGAGE",
+    "EVALUATION_SEQUENCE",
+    "PRESENT",
+    "Caregiver",
+    "CaregiverParams",
+    "ProtocolCaregiver",
+    "caregiver_names",
+    "make_caregiver",
+    "register_caregiver",
+]
+
+#: phase names (the values of :attr:`Caregiver.phase`).
+ENGAGE, PRESENT, ATTEND = "engage", "present", "attend"
+
+#: a fixed, balanced sequence of target places for evaluation runs: each toy place four
+#: times, never twice in a row (the paper's "pre-established sequence"; its own is unknown).
+EVALUATION_SEQUENCE: tuple[str, ...] = (
+    "left", "down", "right_down", "left_down", "right",
+    "down", "left_down", "right", "left", "right_down",
+    "right", "left", "left_down", "down", "right_down",
+    "left_down", "right_down", "down", "right", "left",
+)
+
+
+def _uniform() -> dict[str, float]:
+    return {p: 1.0 for p in TOY_PLACES}
+
+
+@dataclass(frozen=True)
+class CaregiverParams:
+    """What a researcher varies about the caregiver. Every time is in time units (steps).
+
+    Attributes:
+        n_toys: toys put out per trial (1 to 5); the first is the target, the others are
+            distractors.
+        placement: weight of each toy place for placing a toy (missing places weigh 0); the
+            target is drawn with these weights, then each distractor among the places still
+            empty (uniformly among them if those all weigh 0).
+        toy_colours: colours given to the toys of a trial in a random order (cycled if there
+            are more toys than colours); the robot perceives ``colour(toy, C)``. Empty: toys
+            have no colour and no colour percept.
+        reliability: probability that the caregiver looks at the target; otherwise it looks
+            at one of the other four toy places, uniformly (0.2 makes its gaze uninformative).
+        latency: time units the caregiver keeps looking at the robot after placing the toys
+            before it turns to the target (0: places and turns in the same time unit).
+        timeout: time units the caregiver waits, after turning, for the robot to look at the
+            target before it removes the toys and looks back at the robot.
+        contact_hold: consecutive time units of the robot looking at the caregiver's face
+            that make eye contact (the paper: 3).
+        contact_timeout: time units an eye-contact opportunity lasts before it is missed and
+            a new one starts; ``None`` waits for ever.
+        attention_on_contact: give attention in the time unit eye contact is established.
+        single_look: end a trial (no attention) at the robot's first look, after the turn, at
+            anything but the face or the target — one try per trial, as the paper's
+            evaluation reads.
+        target_sequence: evaluation mode: the target's place in trial k is
+            ``target_sequence[k % len]`` (from the start of each episode); distractors are
+            still drawn with ``placement``. ``None``: the target is drawn too.
+    """
+
+    n_toys: int = 2
+    placement: Mapping[str, float] = field(default_factory=_uniform)
+    toy_colours: tuple[str, ...] = ("red", "green")
+    reliability: float = 1.0
+    latency: int = 0
+    timeout: int = 5
+    contact_hold: int = 3
+    contact_timeout: int | None = 10
+    attention_on_contact: bool = True
+    single_look: bool = False
+    target_sequence: tuple[str, ...] | None = None
+
+    def __post_init__(self) -> None:
+        def bad(name: str, why: str) -> CaregiverConfigError:
+            value = getattr(self, name)
+            return CaregiverConfigError(f"caregiver parameter {name}={value!r}: {why}")
+
+        if not isinstance(self.n_toys, int) or not 1 <= self.n_toys <= len(TOY_PLACES):
+            raise bad("n_toys", f"use a whole number from 1 to {len(TOY_PLACES)}")
+        if not isinstance(self.placement, Mapping):
+            raise bad("placement", "use a mapping place -> weight, e.g. {'left': 2.0}")
+        weights = {}
+        for place, weight in self.placement.items():
+            if place not in TOY_PLACES:
+                raise bad("placement", f"unknown place {place!r}{did_you_mean(place, TOY_PLACES)}"
+                          f" (places: {', '.join(TOY_PLACES)})")
+            if not isinstance(weight, int | float) or weight < 0 or math.isnan(weight):
+                raise bad("placement", f"the weight of {place!r} must be a number >= 0")
+            weights[place] = float(weight)
+        if sum(w > 0 for w in weights.values()) < 1:
+            raise bad("placement", "give at least one place a positive weight")
+        object.__setattr__(self, "placement", {p: weights.get(p, 0.0) for p in TOY_PLACES})
+        object.__setattr__(self, "toy_colours", tuple(self.toy_colours))
+        if not all(isinstance(c, str) and c for c in self.toy_colours):
+            raise bad("toy_colours", "use non-empty colour names, e.g. ('red', 'green')")
+        if not isinstance(self.reliability, int | float) or not 0.0 <= self.reliability <= 1.0:
+            raise bad("reliability", "use a probability from 0 to 1")
+        for name, low in (("latency", 0), ("timeout", 1), ("contact_hold", 1)):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < low:
+                raise bad(name, f"use a whole number >= {low}")
+        if self.contact_timeout is not None and (
+                not isinstance(self.contact_timeout, int)
+                or self.contact_timeout < self.contact_hold):
+            raise bad("contact_timeout", f"use None or a whole number >= contact_hold "
+                                         f"({self.contact_hold})")
+        if self.target_sequence is not None:
+            seq = tuple(self.target_sequence)
+            if not seq:
+                raise bad("target_sequence", "use None or a non-empty sequence of places")
+            for place in seq:
+                if place not in TOY_PLACES:
+                    raise bad("target_sequence", f"unknown place {place!r}"
+                              f"{did_you_mean(str(place), TOY_PLACES)}")
+            object.__setattr__(self, "target_sequence", seq)
+
+    def replace(self, **overrides: Any) -> CaregiverParams:
+        """Return a copy with some parameters changed (names are checked)."""
+        names = {f.name for f in dataclasses.fields(self)}
+        for key in overrides:
+            if key not in names:
+                raise CaregiverConfigError(
+                    f"unknown caregiver parameter {key!r}{did_you_mean(key, names)} "
+                    f"(parameters: {', '.join(sorted(names))})")
+        return dataclasses.replace(self, **overrides)
+
+    def for_evaluation(self, sequence: tuple[str, ...] = EVALUATION_SEQUENCE
+                       ) -> CaregiverParams:
+        """Return a copy in evaluation mode: targets from ``sequence``."""
+        return self.replace(target_sequence=tuple(sequence))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The parameters as plain JSON-ready values."""
+        out = dataclasses.asdict(self)
+        out["placement"] = dict(self.placement)
+        out["toy_colours"] = list(self.toy_colours)
+        if self.target_sequence is not None:
+            out["target_sequence"] = list(self.target_sequence)
+        return out
+
+
+class Caregiver(abc.ABC):
+    """A caregiver model: the simulator reads these attributes after each update.
+
+    Attributes:
+        params: the parameters it was built with.
+        phase: the current phase name (``engage``, ``present``, ``attend`` for the protocol).
+        gaze: index in :data:`~relrl.sim.places.PLACES` of where it looks; ``CENTRE`` (0)
+            means at the robot (the robot then sees a ``frontal`` face).
+        toy_at: for each place index, the colour of the toy there (``""`` for a toy without
+            colour), or ``None`` when the place is empty.
+        toys: the toys out now as ``(place, colour)`` pairs, target first.
+        target: place index of the target toy, or -1 when there is none.
+        opportunity: index of the current eye-contact opportunity (from 0).
+        trial: index of the current (or last) toy trial (-1 before the first).
+        contact: eye contact was established in this time unit.
+        attention: attention is given in this time unit.
+    """
+
+    def __init__(self, params: CaregiverParams) -> None:
+        self.params = params
+        self.phase = ENGAGE
+        self.gaze = CENTRE
+        self.toy_at: list[str | None] = [None] * len(PLACES)
+        self.toys: tuple[tuple[str, str], ...] = ()
+        self.target = -1
+        self.opportunity = 0
+        self.trial = -1
+        self.contact = False
+        self.attention = False
+
+    @abc.abstractmethod
+    def reset(self, rng: np.random.Generator, focus: int) -> None:
+        """Start an interaction; ``focus`` is the robot's first focus (a place index)."""
+
+    @abc.abstractmethod
+    def update(self, focus: int) -> None:
+        """Advance one time unit; ``focus`` is where the robot looks in it."""
+
+
+class ProtocolCaregiver(Caregiver):
+    """The paper's protocol (see the module documentation)."""
+
+    def reset(self, rng: np.random.Generator, focus: int) -> None:
+        """Start with opportunity 0 and judge the robot's first focus."""
+        self._rng = rng
+        self._next: Callable[[], None] | None = None
+        self._age = 0
+        self._streak = 0
+        self.opportunity = -1
+        self.trial = -1
+        self._enter_engage()
+        self._judge(focus)
+
+    def update(self, focus: int) -> None:
+        """Enter the phase decided last time unit (if any), then judge the robot's focus."""
+        enter = self._next
+        if enter is None:
+            self._age += 1
+        else:
+            self._next = None
+            enter()
+        self._judge(focus)
+
+    # ---- phases ----------------------------------------------------------------------------
+
+    def _enter_engage(self) -> None:
+        if self.toys:
+            for place, _ in self.toys:
+                self.toy_at[place_index(place)] = None
+            self.toys = ()
+        self.target = -1
+        self.gaze = CENTRE
+        self.phase = ENGAGE
+        self.opportunity += 1
+        self._streak = 0
+        self._age = 0
+
+    def _enter_present(self) -> None:
+        self._place_toys()
+        self.phase = PRESENT
+        self._age = 0
+        if self.params.latency == 0:
+            self._enter_attend()
+
+    def _enter_attend(self) -> None:
+        p = self.params
+        self.phase = ATTEND
+        self._age = 0
+        # One draw per trial whatever the reliability, so runs that differ only in
+        # reliability see the same toys (common random numbers).
+        u, v = self._rng.random(), self._rng.random()
+        if u < p.reliability:
+            self.gaze = self.target
+        else:
+            others = [i for i in range(1, len(PLACES)) if i != self.target]
+            self.gaze = others[min(int(v * len(others)), len(others) - 1)]
+
+    def _judge(self, focus: int) -> None:
+        p = self.params
+        self.contact = False
+        self.attention = False
+        phase = self.phase
+        if phase == ENGAGE:
+            self._streak = self._streak + 1 if focus == CENTRE else 0
+            if self._streak >= p.contact_hold:
+                self.contact = True
+                self.attention = p.attention_on_contact
+                self._next = self._enter_present
+            elif p.contact_timeout is not None and self._age + 1 >= p.contact_timeout:
+                self._next = self._enter_engage  # missed: a new opportunity starts
+        elif phase == PRESENT:
+            if self._age + 1 >= p.latency:
+                self._next = self._enter_attend
+        elif phase == ATTEND:
+            if focus == self.target:
+                self.attention = True
+                self._next = self._enter_engage
+            elif (p.single_look and self._age > 0 and focus != CENTRE) or self._age >= p.timeout:
+                self._next = self._enter_engage
+
+    # ---- toys ------------------------------------------------------------------------------
+
+    def _draw(self, free: list[int]) -> int:
+        """Draw a place index from ``free`` with the placement weights."""
+        weights = [self.params.placement[PLACES[i]] for i in free]
+        total = sum(weights)
+        if total <= 0:
+            weights, total = [1.0] * len(free), float(len(free))
+        x = self._rng.random() * total
+        for place, w in zip(free, weights, strict=True):
+            x -= w
+            if x < 0:
+                return place
+        return max(pl for pl, w in zip(free, weights, strict=True) if w > 0)  # rounding
+
+    def _place_toys(self) -> None:
+        p = self.params
+        self.trial += 1
+        free = list(range(1, len(PLACES)))
+        if p.target_sequence is not None:
+            target = place_index(p.target_sequence[self.trial % len(p.target_sequence)])
+            self._rng.random()  # keep the random stream aligned with the drawing mode
+        else:
+            target = self._draw(free)
+        free.remove(target)
+        chosen = [target]
+        for _ in range(p.n_toys - 1):
+            place = self._draw(free)
+            free.remove(place)
+            chosen.append(place)
+        colours = p.toy_colours
+        if colours:
+            order = self._rng.permutation(len(colours))
+            names = [colours[order[k % len(colours)]] for k in range(len(chosen))]
+        else:
+            names = [""] * len(chosen)
+        for place, colour in zip(chosen, names, strict=True):
+            self.toy_at[place] = colour
+        self.toys = tuple((PLACES[pl], c) for pl, c in zip(chosen, names, strict=True))
+        self.target = target
+        self.gaze = CENTRE
+
+
+# ---- registry ------------------------------------------------------------------------------
+
+_REGISTRY: dict[str, tuple[Callable[[CaregiverParams], Caregiver], CaregiverParams, str]] = {}
+
+
+def register_caregiver(name: str, factory: Callable[[CaregiverParams], Caregiver],
+                       params: CaregiverParams | None = None, doc: str = "") -> None:
+    """Register a caregiver model under ``name``.
+
+    Args:
+        name: the name :func:`make_caregiver` and the simulator look it up by.
+        factory: builds the caregiver from its parameters (e.g. a :class:`Caregiver` class).
+        params: the preset's default parameters.
+        doc: one line describing the model.
+    """
+    _REGISTRY[name] = (factory, params or CaregiverParams(), doc)
+
+
+def caregiver_names() -> dict[str, str]:
+    """Return registered name -> one-line description."""
+    return {name: doc for name, (_, _, doc) in _REGISTRY.items()}
+
+
+def make_caregiver(name: str = "paper", params: CaregiverParams | Mapping[str, Any] | None = None
+                   ) -> Caregiver:
+    """Build a registered caregiver model.
+
+    Args:
+        name: a registered name (see :func:`caregiver_names`).
+        params: full parameters, or a mapping of overrides of the preset's parameters.
+
+    Raises:
+        UnknownCaregiver: no model has this name (the message suggests the closest).
+        CaregiverConfigError: a parameter is unknown or has a bad value.
+    """
+    try:
+        factory, preset, _ = _REGISTRY[name]
+    except KeyError:
+        raise UnknownCaregiver(f"unknown caregiver model {name!r}{did_you_mean(name, _REGISTRY)}"
+                               f" (models: {', '.join(_REGISTRY)})") from None
+    if isinstance(params, CaregiverParams):
+        return factory(params)
+    return factory(preset.replace(**dict(params or {})))
+
+
+register_caregiver("paper", ProtocolCaregiver, CaregiverParams(),
+                   "the paper's protocol: two toys, always looks at the target")
+register_caregiver("unreliable", ProtocolCaregiver, CaregiverParams(reliability=0.5),
+                   "the paper's protocol, looking at the target only half the time")
+register_caregiver("random", ProtocolCaregiver, CaregiverParams(reliability=0.2),
+                   "the paper's protocol with an uninformative gaze (any toy place alike)")
+register_caregiver("one_toy", ProtocolCaregiver, CaregiverParams(n_toys=1),
+                   "the paper's protocol with one toy, as in the head experiment")
