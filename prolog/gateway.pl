@@ -5,7 +5,8 @@
             gw_new_kb/1,          % -Module
             gw_drop_kb/1,         % +Module
             gw_findall/3,         % +Module, +Template, -List
-            gw_parse/3            % +Module, +Text, -Terms
+            gw_parse/3,           % +Module, +Text, -Terms
+            gw_policy_learner/2   % +File, -Learner
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -44,14 +45,29 @@ gw_run(Goal, Limit, Result) :-
 
 limited(Goal, Limit, Result) :-
     (   Limit > 0
-    ->  (   call_with_time_limit(Limit, Goal)
-        ->  Result = true
-        ;   Result = false
-        )
+    ->  watchdog(Alarm),
+        setup_call_cleanup(
+            install_alarm(Alarm, Limit),
+            (   call(Goal)
+            ->  Result = true
+            ;   Result = false
+            ),
+            uninstall_alarm(Alarm))
     ;   (   call(Goal)
         ->  Result = true
         ;   Result = false
         )
+    ).
+
+%   One alarm, made once and re-armed for every call: much cheaper than creating and
+%   removing an alarm per call (call_with_time_limit/2) when the robot steps thousands of
+%   times a second.
+watchdog(Alarm) :-
+    (   nb_current(relrl_watchdog, Alarm0)
+    ->  Alarm = Alarm0
+    ;   alarm(3600, throw(time_limit_exceeded), Alarm,
+              [remove(false), install(false)]),
+        nb_setval(relrl_watchdog, Alarm)
     ).
 
 error_result(E0, error(E, Message)) :-
@@ -233,3 +249,23 @@ gw_findall(Module, Template, List) :-
 gw_parse(Module, Text, Terms) :-
     term_string(Term, Text, [module(Module)]),
     comma_list(Term, Terms).
+
+%!  gw_policy_learner(+File, -Learner) is det.
+%
+%   Learner is the learner named by the relrl_policy/2 fact of a saved policy file (read
+%   only, nothing is run). Fails if the file has none.
+
+gw_policy_learner(File, Learner) :-
+    setup_call_cleanup(
+        open(File, read, S),
+        policy_header(S, Learner),
+        close(S)).
+
+policy_header(S, Learner) :-
+    read_term(S, T, []),
+    (   T == end_of_file
+    ->  fail
+    ;   T = relrl_policy(Learner, _)
+    ->  true
+    ;   policy_header(S, Learner)
+    ).

@@ -2,6 +2,7 @@
           [ perceived/3,          % +KB, +Sense, ?What
             perceived_at/3,       % +KB, ?Stimulus, ?Place
             stimulus_present/2,   % +KB, ?Stimulus
+            stimulus_perceived/2, % +KB, +Stimulus
             sense/1               % ?Sense
           ]).
 :- use_module(library(error)).
@@ -70,6 +71,14 @@ perceived_at(KB, Stimulus, Place) :-
 
 stimulus_present(KB, Stimulus) :-
     kb_stimulus(KB, Stimulus),
+    stimulus_perceived(KB, Stimulus).
+
+%!  stimulus_perceived(+KB, +Stimulus) is semidet.
+%
+%   Stimulus is perceived now through some sense (or located with at/2); no check that it
+%   is declared.
+
+stimulus_perceived(KB, Stimulus) :-
     (   sense(Sense),
         Percept =.. [Sense, Stimulus],
         wm_element(KB, Percept, _)

@@ -24,6 +24,7 @@
 :- use_module(state).
 :- use_module(responses).
 :- use_module(check).
+:- use_module(engine).
 
 /** <module> relrl: the knowledge layer
 

@@ -4,6 +4,7 @@
             feature_active/2,     % +KB, +Feature
             state_terms/2,        % +KB, -Terms
             state_code/2,         % +KB, -Code
+            features_code/3,      % +KB, +Features, -Code
             state_decode/3,       % +KB, +Code, -Terms
             state_encode/3        % +KB, +Terms, -Code
           ]).
@@ -48,7 +49,7 @@ feature_code(KB, Term, X) :-
 %   Feature (stimulus(S) or fact(F)) holds now in KB.
 
 feature_active(KB, stimulus(S)) :-
-    stimulus_present(KB, S).
+    stimulus_perceived(KB, S).
 feature_active(KB, fact(F)) :-
     once(KB:F).
 
@@ -66,6 +67,15 @@ state_terms(KB, Terms) :-
 
 state_code(KB, Code) :-
     state_features(KB, Features),
+    features_code(KB, Features, Code).
+
+%!  features_code(+KB, +Features:list, -Code:integer) is det.
+%
+%   Code is the sum of 2^x over the elements of Features that hold now, x being the
+%   position in Features. Features is a list from state_features/2 kept by the caller
+%   (the engine computes it once per run).
+
+features_code(KB, Features, Code) :-
     foldl(add_active(KB), Features, 0-0, Code-_).
 
 add_active(KB, Feature, Code0-X, Code-X1) :-

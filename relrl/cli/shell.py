@@ -14,6 +14,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("domain", nargs="*", metavar="DOMAIN.pl", help="domain files to load")
     parser.add_argument("--policy", metavar="FILE",
                         help="a learned policy (ETG tree, behaviour rules) saved by relrl")
+    parser.add_argument("--learner", metavar="NAME",
+                        help="start a fresh learner (etg, contingency, qlearning) for :step")
     parser.add_argument("--timeout", type=float, default=10.0, metavar="S",
                         help="seconds a query may run (default 10)")
     parser.add_argument("--max", type=int, default=100, metavar="N",
@@ -28,10 +30,12 @@ def run(args: argparse.Namespace) -> int:
     kb = KnowledgeBase(*args.domain)
     try:
         shell = Shell(kb, max_solutions=args.max, timeout=args.timeout)
-        if args.policy:
-            from relrl.policy import load_policy
+        from relrl import policy
 
-            load_policy(shell, args.policy)
+        if args.policy:
+            policy.load_policy(shell, args.policy)
+        elif args.learner:
+            policy.attach_learner(shell, args.learner)
         if sys.stdin.isatty():
             shell.interact()
             return 0

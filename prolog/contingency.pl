@@ -1,0 +1,189 @@
+:- module(relrl_contingency,
+          [ contingency_init/1,     % +KB
+            contingency_choose/6,   % +KB, +Code, +N, +Allowed, +Params, -Action
+            contingency_update/6,   % +KB, +Code0, +A0, +N0, +Reinforced, +Params
+            contingency_rules/2,    % +KB, -Rules
+            contingency_restore/2,  % +KB, +Rules
+            contingency_explain/4,  % +KB, +Code, +N, -Explanation
+            contingency_size/2      % +KB, -Size
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(random)).
+:- use_module(library(pairs)).
+:- use_module(declarations).
+
+/** <module> Contingency learning
+
+Section 4.1 of da Silva & Romero (2012). Behaviour rules are three-term contingencies:
+an antecedent (the state), a response, and a consequence (the necessity the response
+satisfies), with a fitness. A response is chosen by roulette-wheel selection over the
+responses allowed now: a response's slice is the summed fitness of the rules that match the
+state and the active necessity, or the default fitness when no rule matches.
+
+After the response, its rules learn from the consequence: when the reinforcer came and the
+rule's necessity is the active one (the rule satisfied the active necessity) its fitness
+rises by the influence rate; otherwise (it satisfied no necessity, or one that was not
+active) it falls by the influence rate. Fitness stays within [min_fitness, max_fitness].
+If no rule matched the emitted response, a new rule (state(Code), Response, Necessity) is
+stored with the default fitness moved by the same rule.
+
+Authored rules come from the domain (behaviour/4, with any goal as antecedent) and are
+copied here when the learner starts, so their fitness can learn too. Learned rules have the
+antecedent state(Code), true when the current state code is Code.
+
+Params: default_fitness, influence, min_fitness, max_fitness.
+*/
+
+:- dynamic
+    learned_/5,      % KB, Code, Necessity, Response, Fitness
+    authored_/5,     % KB, Id, Antecedent, Response, Necessity-Fitness
+    matched_/2.      % KB, Matches: rule references used by the last choice
+
+param(Params, Name, Value) :-
+    memberchk(Name=Value, Params).
+
+%!  contingency_init(+KB) is det.
+%
+%   Forget learned rules; copy the domain's authored behaviour rules.
+
+contingency_init(KB) :-
+    must_be(atom, KB),
+    retractall(learned_(KB, _, _, _, _)),
+    retractall(authored_(KB, _, _, _, _)),
+    retractall(matched_(KB, _)),
+    findall(rule(A, R, N, F), behaviour_rule(KB, A, R, N, F), Rules),
+    forall(nth1(Id, Rules, rule(A, R, N, F)),
+           assertz(authored_(KB, Id, A, R, N-F))).
+
+%!  contingency_choose(+KB, +Code, +N, +Allowed, +Params, -Action) is det.
+%
+%   Roulette-wheel selection over Allowed in the state Code under necessity N.
+
+contingency_choose(KB, Code, N, Allowed, Params, Action) :-
+    Allowed \== [],
+    param(Params, default_fitness, Default),
+    maplist(slice(KB, Code, N, Default), Allowed, Slices),
+    sum_list_of(Slices, Total),
+    random(X0),
+    X is X0 * Total,
+    pick(Slices, X, slice(Action, _, Matches)),
+    retractall(matched_(KB, _)),
+    assertz(matched_(KB, Matches)).
+
+slice(KB, Code, N, Default, R, slice(R, F, Matches)) :-
+    findall(M-Fm, matching_rule(KB, Code, N, R, M, Fm), Pairs),
+    (   Pairs == []
+    ->  F = Default, Matches = []
+    ;   pairs_keys_values(Pairs, Matches, Fs),
+        sum_list(Fs, F)
+    ).
+
+matching_rule(KB, Code, N, R, learned(Code, N, R), F) :-
+    learned_(KB, Code, N, R, F).
+matching_rule(KB, _, N, R, authored(Id), F) :-
+    authored_(KB, Id, Antecedent, R, N1-F),
+    N1 == N,
+    catch(once(KB:Antecedent), _, fail).
+
+sum_list_of(Slices, Total) :-
+    foldl(add_slice, Slices, 0, Total).
+
+add_slice(slice(_, F, _), T0, T) :-
+    T is T0 + F.
+
+pick([S], _, S) :- !.
+pick([S|Ss], X, Pick) :-
+    S = slice(_, F, _),
+    (   X < F
+    ->  Pick = S
+    ;   X1 is X - F,
+        pick(Ss, X1, Pick)
+    ).
+
+%!  contingency_update(+KB, +Code0, +A0, +N0, +Reinforced, +Params) is det.
+%
+%   Learn from the consequence of emitting A0 in state Code0 under necessity N0.
+%   Reinforced is true when a reinforcer was perceived after the response.
+
+contingency_update(KB, Code0, A0, N0, Reinforced, Params) :-
+    param(Params, influence, Rate),
+    param(Params, default_fitness, Default),
+    (   Reinforced == true
+    ->  Delta = Rate
+    ;   Delta is -Rate
+    ),
+    (   retract(matched_(KB, Matches)), Matches \== []
+    ->  forall(member(M, Matches), adjust(KB, M, N0, Delta, Rate, Params))
+    ;   clamp(Params, Default + Delta, F),
+        assertz(learned_(KB, Code0, N0, A0, F))
+    ).
+
+adjust(KB, learned(Code, N, R), _, Delta, _, Params) :-
+    (   retract(learned_(KB, Code, N, R, F0))
+    ->  clamp(Params, F0 + Delta, F),
+        assertz(learned_(KB, Code, N, R, F))
+    ;   true
+    ).
+adjust(KB, authored(Id), Active, Delta, Rate, Params) :-
+    (   retract(authored_(KB, Id, A, R, N-F0))
+    ->  (   N == Active
+        ->  D = Delta
+        ;   D is -Rate
+        ),
+        clamp(Params, F0 + D, F),
+        assertz(authored_(KB, Id, A, R, N-F))
+    ;   true
+    ).
+
+clamp(Params, Expr, F) :-
+    param(Params, min_fitness, Min),
+    param(Params, max_fitness, Max),
+    F is min(Max, max(Min, Expr)).
+
+%!  contingency_rules(+KB, -Rules:list) is det.
+%
+%   Rules are behaviour(Antecedent, Response, Necessity, Fitness) terms, authored first.
+
+contingency_rules(KB, Rules) :-
+    findall(behaviour(A, R, N, F), authored_(KB, _, A, R, N-F), Authored),
+    findall(behaviour(state(C), R, N, F), learned_(KB, C, N, R, F), Learned),
+    append(Authored, Learned, Rules).
+
+%!  contingency_restore(+KB, +Rules:list) is det.
+%
+%   Replace KB's rules by Rules, behaviour(Antecedent, Response, Necessity, Fitness) terms
+%   as listed by contingency_rules/2.
+
+contingency_restore(KB, Rules) :-
+    must_be(list, Rules),
+    retractall(learned_(KB, _, _, _, _)),
+    retractall(authored_(KB, _, _, _, _)),
+    retractall(matched_(KB, _)),
+    forall(nth1(Id, Rules, behaviour(A, R, N, F)),
+           (   A = state(Code), integer(Code)
+           ->  assertz(learned_(KB, Code, N, R, F))
+           ;   assertz(authored_(KB, Id, A, R, N-F))
+           )).
+
+%!  contingency_explain(+KB, +Code, +N, -Explanation) is det.
+%
+%   Explanation lists, for each response with a matching rule in state Code under N,
+%   Response-Fitness, highest first.
+
+contingency_explain(KB, Code, N, Ranked) :-
+    findall(F-R, ( kb_response(KB, R),
+                   findall(Fm, matching_rule(KB, Code, N, R, _, Fm), Fs), Fs \== [],
+                   sum_list(Fs, F) ), Pairs),
+    sort(1, @>=, Pairs, Sorted),
+    findall(R-F, member(F-R, Sorted), Ranked).
+
+%!  contingency_size(+KB, -Size) is det.
+%
+%   Size is size(Rules, Positions): the number of stored rules; each takes one position.
+
+contingency_size(KB, size(Rules, Rules)) :-
+    aggregate_all(count, learned_(KB, _, _, _, _), L),
+    aggregate_all(count, authored_(KB, _, _, _, _), A),
+    Rules is L + A.

@@ -1,0 +1,152 @@
+:- module(relrl_etg,
+          [ etg_init/2,           % +KB, +Tests
+            etg_choose/7,         % +KB, +D, +N, +Allowed, +Params, -Action, -Q
+            etg_update/9,         % +KB, +D0, +A0, +N0, +R, +D1, +N1, +Allowed1, +Params
+            etg_explain/4,        % +KB, +D, +N, -Explanation
+            etg_size/2            % +KB, -Size
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(random)).
+:- use_module(qtree).
+
+/** <module> Economic TG (ETG)
+
+Section 4.2.1 and Algorithms 2 and 3 of da Silva & Romero (2012). The Q-function is a
+relational regression tree (qtree.pl) whose internal nodes are first-order tests over the
+state; leaves hold (action, Q, necessity) entries in decreasing Q. Only entries whose
+necessity is the active one are candidates.
+
+Each step gives one example x = (s, a, Q-hat, n), inserted at once (no look-up table of
+examples, unlike TG):
+
+    Q-hat = Q(s, a) + alpha * (r + gamma * max_a' Q(s', a') - Q(s, a))      (Eq. 4)
+
+Algorithm 3 (insertion): sort s down the tree; at a leaf, update the action's Q (or insert
+the action with its necessity); at an empty branch (null), generate a leaf there.
+
+The paper does not say when a leaf is split, and with a single initial leaf and no split
+nothing could ever be told apart. relrl's rule, which keeps the tree economic: a leaf
+represents every state that sorts to it and remembers the first (its representative). When
+an example from a different state disagrees with the leaf — its temporal-difference error
+|r + gamma max Q(s') - Q(s, a)| exceeds `split_threshold` — the leaf is split on the first
+test that tells the two states apart, and the example goes on to generate a new leaf on the
+empty branch. States whose values agree keep sharing a leaf.
+
+Params is a list of Name=Value with alpha, gamma, epsilon, q_init and split_threshold.
+*/
+
+param(Params, Name, Value) :-
+    memberchk(Name=Value, Params).
+
+%!  etg_init(+KB, +Tests:list) is det.
+%
+%   Start KB's tree as a single empty leaf over the candidate Tests.
+
+etg_init(KB, Tests) :-
+    qtree_new(KB, Tests).
+
+%!  etg_choose(+KB, +D, +N, +Allowed, +Params, -Action, -Q) is det.
+%
+%   Choose among the Allowed responses for the state described by D under the active
+%   necessity N: with probability epsilon a random one, otherwise one with the largest Q
+%   (ties broken at random). Actions with no entry for N have Q = q_init.
+
+etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
+    Allowed \== [],
+    leaf_entries(KB, D, Entries),
+    param(Params, q_init, Q0),
+    param(Params, epsilon, Epsilon),
+    findall(Qa-A, ( member(A, Allowed), qtree_entry_q(Entries, A, N, Q0, Qa) ), Scored),
+    (   random_float < Epsilon
+    ->  random_member(Q-Action, Scored)
+    ;   max_member(Best-_, Scored),
+        include(scored(Best), Scored, Ties),
+        random_member(Q-Action, Ties)
+    ).
+
+scored(Best, Q-_) :-
+    Q =:= Best.
+
+leaf_entries(KB, D, Entries) :-
+    qtree_sort(KB, D, Where),
+    (   Where = leaf(Id)
+    ->  qtree_leaf(KB, Id, _, Entries)
+    ;   Entries = []
+    ).
+
+%!  etg_update(+KB, +D0, +A0, +N0, +R, +D1, +N1, +Allowed1, +Params) is det.
+%
+%   Learn from the transition (D0, A0, N0) -> reward R -> (D1, N1), Eq. 4 and Algorithm 3.
+%   The max in Eq. 4 runs over the responses Allowed1 in the next state (all entries of
+%   the leaf when Allowed1 is []).
+
+etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params) :-
+    param(Params, alpha, Alpha),
+    param(Params, gamma, Gamma),
+    param(Params, q_init, Qinit),
+    param(Params, split_threshold, Threshold),
+    leaf_entries(KB, D1, Next),
+    max_q(Next, N1, Allowed1, Qinit, MaxNext),
+    Target is R + Gamma * MaxNext,
+    insert_example(KB, D0, A0, N0, Target, Alpha, Qinit, Threshold).
+
+max_q(Entries, N, Allowed, Qinit, Max) :-
+    findall(Q, ( member(e(A, Q, N1), Entries), N1 == N, allowed_or_any(Allowed, A) ),
+            Qs0),
+    (   Qs0 == []
+    ->  Max = Qinit
+    ;   max_list(Qs0, Max1),
+        (   Allowed \== [], length(Qs0, K), length(Allowed, L), K < L
+        ->  Max is max(Max1, Qinit)     % some allowed action is still untried
+        ;   Max = Max1
+        )
+    ).
+
+allowed_or_any([], _) :- !.
+allowed_or_any(Allowed, A) :- memberchk(A, Allowed).
+
+insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
+    qtree_sort(KB, D, Where),
+    (   Where = null(Parent, Branch)
+    ->  Q is Qinit + Alpha * (Target - Qinit),
+        qtree_grow(KB, Parent, Branch, D, [e(A, Q, N)], _)
+    ;   Where = leaf(Id),
+        qtree_leaf(KB, Id, Rep0, Entries0),
+        qtree_entry_q(Entries0, A, N, Qinit, Old),
+        Error is Target - Old,
+        (   Rep0 \== none,
+            Rep0 =\= D,
+            abs(Error) > Threshold,
+            first_difference(Rep0, D, I)
+        ->  qtree_split(KB, Id, I),
+            insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold)
+        ;   ( Rep0 == none -> Rep = D ; Rep = Rep0 ),
+            Q is Old + Alpha * Error,
+            qtree_put_entry(Entries0, e(A, Q, N), Entries),
+            qtree_set_leaf(KB, Id, Rep, Entries)
+        )
+    ).
+
+%!  etg_explain(+KB, +D, +N, -Explanation) is det.
+%
+%   Explanation is explain(Path, Ranked): the tests from the root to the state's leaf with
+%   their outcomes, and the leaf's entries for necessity N in decreasing Q.
+
+etg_explain(KB, D, N, explain(Path, Ranked)) :-
+    qtree_path(KB, D, Path),
+    leaf_entries(KB, D, Entries),
+    include(entry_for(N), Entries, Ranked).
+
+entry_for(N, e(_, _, N1)) :-
+    N1 == N.
+
+%!  etg_size(+KB, -Size) is det.
+%
+%   Size is size(Nodes, Leaves, Entries, Positions) with Positions = Nodes + Entries, the
+%   paper's memory measure.
+
+etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
+    qtree_size(KB, Nodes, Leaves, Entries),
+    Positions is Nodes + Entries.

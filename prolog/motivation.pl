@@ -1,0 +1,148 @@
+:- module(relrl_motivation,
+          [ motivation_reset/1,     % +KB
+            motivation_step/3,      % +KB, -Outputs, -Active
+            motivation_units/2,     % +KB, -Units
+            motivation_step/4,      % +KB, +Units, -Outputs, -Active
+            motivation_peek/4,      % +KB, +Units, -Outputs, -Active
+            motivation_outputs/2,   % +KB, -Outputs
+            unit_activation/5,      % +Inputs, +Wr, +Ir, +Bias, -U
+            unit_output/3           % +U, +Delta, -Y
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(declarations).
+
+/** <module> Consequence control: necessity units and the mediator
+
+Section 3.2 of da Silva & Romero (2012). Each necessity unit is a perceptron with a
+recurrent connection:
+
+    u = sum_j w_j * i_j + w_r * i_r + b          (Eq. 1)
+    y = 1 / (1 + exp(-(u + delta)))               (Eq. 2)
+
+i_j is 1 when the j-th input goal holds in working memory and 0 otherwise; i_r is the unit's
+own output at the previous step. The mediator picks the unit with the largest output and
+makes it the active necessity when its output exceeds the unit's threshold; otherwise the
+active necessity is `none`.
+
+Sign convention. The paper gives the inputs of `socialize` positive weights, but if every
+input adds to u the unit can never fall below its threshold once contact is made. In a domain
+file, unit_input(N, Goal, W) adds W to u when Goal holds, and satisfier(N, Goal, W) subtracts
+W: a satisfying stimulus (the caregiver's attention, a frontal face) lowers the need. The
+paper's weights are declared as satisfiers with their printed magnitudes.
+*/
+
+:- dynamic output_/3.     % KB, Necessity, Y
+
+%!  unit_output(+U, +Delta, -Y) is det.
+%
+%   Eq. 2.
+
+unit_output(U, Delta, Y) :-
+    Y is 1 / (1 + exp(-(U + Delta))).
+
+%!  unit_activation(+Inputs, +Wr, +Ir, +Bias, -U) is det.
+%
+%   Eq. 1 for Inputs, a list of Weight-Input pairs with Input 0 or 1.
+
+unit_activation(Inputs, Wr, Ir, Bias, U) :-
+    foldl(weighted, Inputs, 0, Sum),
+    U is Sum + Wr*Ir + Bias.
+
+weighted(W-I, S0, S) :-
+    S is S0 + W*I.
+
+%!  motivation_reset(+KB) is det.
+%
+%   Set every unit's output to its `initial` parameter (default 0).
+
+motivation_reset(KB) :-
+    must_be(atom, KB),
+    retractall(output_(KB, _, _)),
+    forall(kb_necessity(KB, N),
+           ( unit_parameters(KB, N, Params),
+             memberchk(initial=Y0, Params),
+             assertz(output_(KB, N, Y0)) )).
+
+%!  motivation_outputs(+KB, -Outputs:list) is det.
+%
+%   Outputs is the list of Necessity-Y pairs of the last step.
+
+motivation_outputs(KB, Outputs) :-
+    findall(N-Y, output_(KB, N, Y), Outputs).
+
+%!  motivation_step(+KB, -Outputs:list, -Active) is det.
+%
+%   Compute every unit's output from working memory (Eq. 1, 2), remember it for the
+%   recurrent connection, and let the mediator choose Active, a necessity or `none`.
+
+motivation_step(KB, Outputs, Active) :-
+    motivation_units(KB, Units),
+    motivation_step(KB, Units, Outputs, Active).
+
+%!  motivation_units(+KB, -Units:list) is det.
+%
+%   Units describes every necessity unit of KB as
+%   unit(N, Bias, Wr, Delta, Threshold, Initial, Inputs), Inputs a list of Goal-Weight.
+%   The engine computes it once per run and passes it to motivation_step/4.
+
+motivation_units(KB, Units) :-
+    findall(unit(N, B, Wr, Delta, T, Y0, Goals),
+            ( kb_necessity(KB, N),
+              unit_parameters(KB, N, Params),
+              memberchk(bias=B, Params),
+              memberchk(recurrent_weight=Wr, Params),
+              memberchk(delta=Delta, Params),
+              memberchk(threshold=T, Params),
+              memberchk(initial=Y0, Params),
+              necessity_inputs(KB, N, Goals) ),
+            Units).
+
+%!  motivation_step(+KB, +Units, -Outputs:list, -Active) is det.
+%
+%   As motivation_step/3 with the units from motivation_units/2.
+
+motivation_step(KB, Units, Outputs, Active) :-
+    maplist(unit_step(KB), Units, Outputs),
+    mediate(Units, Outputs, Active).
+
+%!  motivation_peek(+KB, +Units, -Outputs, -Active) is det.
+%
+%   What motivation_step/4 would give now, without moving the units' state.
+
+motivation_peek(KB, Units, Outputs, Active) :-
+    maplist(unit_value(KB), Units, Outputs),
+    mediate(Units, Outputs, Active).
+
+unit_step(KB, Unit, N-Y) :-
+    unit_value(KB, Unit, N-Y),
+    retractall(output_(KB, N, _)),
+    assertz(output_(KB, N, Y)).
+
+unit_value(KB, unit(N, B, Wr, Delta, _, Y0, Goals), N-Y) :-
+    (   output_(KB, N, Ir)
+    ->  true
+    ;   Ir = Y0
+    ),
+    maplist(input_signal(KB), Goals, Inputs),
+    unit_activation(Inputs, Wr, Ir, B, U),
+    unit_output(U, Delta, Y).
+
+input_signal(KB, Goal-W, W-I) :-
+    (   once(KB:Goal)
+    ->  I = 1
+    ;   I = 0
+    ).
+
+mediate(_, [], none) :- !.
+mediate(Units, Outputs, Active) :-
+    foldl(stronger, Outputs, none-(-1.0), Best-Y),
+    memberchk(unit(Best, _, _, _, T, _, _), Units),
+    (   Y > T
+    ->  Active = Best
+    ;   Active = none
+    ).
+
+stronger(N-Y, _-Y0, N-Y) :- Y > Y0, !.
+stronger(_, Best, Best).

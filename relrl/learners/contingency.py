@@ -1,0 +1,48 @@
+"""Contingency learning (section 4.1): behaviour rules with fitness, held in Prolog."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from relrl.learners.base import Learner, register
+from relrl.terms import Term, Var, format_term
+
+__all__ = ["ContingencyLearner"]
+
+
+@register
+class ContingencyLearner(Learner):
+    """Roulette-wheel selection over behaviour rules (prolog/contingency.pl).
+
+    Parameters: default_fitness (slice of a response with no matching rule), influence
+    (how much a consequence moves a rule's fitness), min_fitness and max_fitness.
+    """
+
+    name = "contingency"
+    engine = "contingency"
+    defaults = {"default_fitness": 1.0, "influence": 0.5, "min_fitness": 0.05,
+                "max_fitness": 10.0}
+
+    def _check_params(self) -> None:
+        super()._check_params()
+        from relrl.errors import ConfigError
+
+        p = self.params
+        if not 0 < p["min_fitness"] <= p["default_fitness"] <= p["max_fitness"]:
+            raise ConfigError("need 0 < min_fitness <= default_fitness <= max_fitness, got "
+                              f"{p['min_fitness']}, {p['default_fitness']}, {p['max_fitness']}")
+
+    def _size_from(self, size: Term) -> dict[str, int]:
+        _, rules, positions = size
+        return {"rules": rules, "positions": positions}
+
+    def _explain_from(self, exp: Term) -> dict[str, Any]:
+        _, code, necessity, ranked = exp
+        return {"learner": "contingency", "state": code, "necessity": necessity,
+                "ranked": [{"response": format_term(r), "fitness": f} for (_, r, f) in ranked]}
+
+    def rules(self) -> list[tuple[Term, Term, Term, float]]:
+        """Every behaviour rule: (antecedent, response, necessity, fitness)."""
+        assert self.kb is not None
+        (rules,) = self.kb.call("relrl_contingency:contingency_rules", self.kb.module, Var())
+        return [tuple(r[1:]) for r in rules]  # type: ignore[misc]

@@ -1,0 +1,45 @@
+"""ETG: the Economic TG learner (Algorithms 2 and 3, Eq. 4), held in Prolog (prolog/etg.pl)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from relrl.learners.base import Learner, register
+from relrl.terms import Term, format_term
+
+__all__ = ["ETGLearner"]
+
+
+@register
+class ETGLearner(Learner):
+    """A relational Q-tree grown one example per step; choices and updates run in Prolog.
+
+    Parameters: alpha, gamma, epsilon (Eq. 4 and epsilon-greedy choice), q_init (Q of an
+    action a leaf has no entry for), split_threshold (temporal-difference error above which
+    a leaf is split between two states it cannot tell apart; see prolog/etg.pl).
+    """
+
+    name = "etg"
+    engine = "etg"
+    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 0.0,
+                "split_threshold": 1.0}
+
+    def _size_from(self, size: Term) -> dict[str, int]:
+        _, nodes, leaves, entries, positions = size
+        return {"nodes": nodes, "leaves": leaves, "entries": entries, "positions": positions}
+
+    def _explain_from(self, exp: Term) -> dict[str, Any]:
+        _, description, necessity, path, ranked = exp
+        tests = []
+        for step in path:
+            if isinstance(step, tuple) and step[0] == "-":
+                tests.append({"test": format_term(step[1]), "holds": step[2] == "true"})
+        end = path[-1]
+        return {
+            "learner": "etg",
+            "state": description,
+            "necessity": necessity,
+            "path": tests,
+            "leaf": end[1] if isinstance(end, tuple) else None,
+            "ranked": [{"response": format_term(a), "q": q} for (_, a, q, _) in ranked],
+        }

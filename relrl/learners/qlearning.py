@@ -1,0 +1,132 @@
+"""Q-learning with necessity (Algorithm 1, Eq. 3) over a numpy table."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from relrl.errors import ConfigError
+from relrl.learners.base import Learner, StepOut, register
+from relrl.terms import Term, format_term
+
+__all__ = ["QLearner"]
+
+
+@register
+class QLearner(Learner):
+    """Tabular Q-learning whose rows are (state code, active necessity) pairs.
+
+    Rows are added the first time a (state, necessity) pair is met (Algorithm 1: "if not
+    have n_i defined then insert n_i on Q-table"); columns are the domain's responses in
+    declaration order. Choice is epsilon-greedy over the allowed responses, ties broken at
+    random; learning off means greedy.
+
+    Parameters: alpha, gamma, epsilon, q_init.
+    """
+
+    name = "qlearning"
+    engine = "external"
+    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 0.0}
+
+    def attach(self, kb, seed):  # type: ignore[override]
+        super().attach(kb, seed)
+        self._index = {format_term(r): i for i, r in enumerate(self.responses)}
+        self._rows: dict[tuple[int, str], int] = {}
+        self._q = np.full((64, len(self.responses)), self.params["q_init"])
+        self._prev: tuple[int, int] | None = None
+
+    def _row(self, code: int, necessity: str) -> int:
+        key = (code, necessity)
+        row = self._rows.get(key)
+        if row is None:
+            row = len(self._rows)
+            if row == len(self._q):
+                grown = np.full((2 * len(self._q), self._q.shape[1]), self.params["q_init"])
+                grown[:row] = self._q
+                self._q = grown
+            self._rows[key] = row
+        return row
+
+    def act(self, out: StepOut, learning: bool) -> Term:
+        """Update Q for the previous step (Eq. 3), then choose epsilon-greedily."""
+        row = self._row(out.code, out.necessity)
+        allowed = [self._index[format_term(r)] for r in out.allowed]
+        q = self._q
+        if learning and self._prev is not None and allowed:
+            prev_row, prev_action = self._prev
+            target = out.reward + self.params["gamma"] * q[row, allowed].max()
+            q[prev_row, prev_action] += self.params["alpha"] * (target - q[prev_row, prev_action])
+        if not allowed:
+            self._prev = None
+            return "none"
+        epsilon = self.params["epsilon"] if learning else 0.0
+        if epsilon > 0 and self.rng.random() < epsilon:
+            choice = allowed[int(self.rng.integers(len(allowed)))]
+        else:
+            values = q[row, allowed]
+            best = np.flatnonzero(values == values.max())
+            choice = allowed[int(best[self.rng.integers(len(best))])] if len(best) > 1 \
+                else allowed[int(best[0])]
+        self._prev = (row, choice)
+        return self.responses[choice]
+
+    def end_episode(self) -> None:
+        """No update links the next step to the last one."""
+        self._prev = None
+
+    def size(self) -> dict[str, int]:
+        """rows x actions positions, and the distinct states met."""
+        rows = len(self._rows)
+        return {"rows": rows, "actions": len(self.responses),
+                "states": len({code for code, _ in self._rows}),
+                "positions": rows * len(self.responses)}
+
+    def _explain_from(self, exp: Term) -> dict[str, Any]:
+        """The Q row of the state the engine reports (external(Code, Necessity))."""
+        _, code, necessity = exp
+        row = self._rows.get((code, necessity))
+        if row is None:
+            return {"learner": "qlearning", "state": code, "necessity": necessity,
+                    "ranked": [], "note": "state never met: every Q is q_init"}
+        values = self._q[row]
+        order = np.argsort(-values, kind="stable")
+        return {"learner": "qlearning", "state": code, "necessity": necessity,
+                "ranked": [{"response": format_term(self.responses[i]), "q": float(values[i])}
+                           for i in order]}
+
+    def save(self, path: str | Path, header: str = "") -> Path:
+        """Write the table as .npz (atomic: temp file + rename)."""
+        path = Path(path)
+        keys = sorted(self._rows, key=self._rows.get)  # type: ignore[arg-type]
+        rows = [self._rows[k] for k in keys]
+        fd, tmp = tempfile.mkstemp(dir=path.parent or ".", suffix=".npz.tmp")
+        os.close(fd)
+        with open(tmp, "wb") as fh:
+            np.savez(fh, q=self._q[rows], codes=np.array([str(k[0]) for k in keys]),
+                     necessities=np.array([k[1] for k in keys]),
+                     responses=np.array([format_term(r) for r in self.responses]),
+                     header=np.array(header or "relrl policy: qlearning"))
+        os.replace(tmp, path)
+        return path
+
+    def load(self, path: str | Path) -> None:
+        """Load a table saved by :meth:`save` (its responses must match the domain's)."""
+        try:
+            data = np.load(path, allow_pickle=False)
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"{path}: not a Q-table (.npz): {exc}") from None
+        responses = [str(r) for r in data["responses"]]
+        mine = [format_term(r) for r in self.responses]
+        if responses != mine:
+            raise ConfigError(f"{path}: the table's responses {responses} are not the "
+                              f"domain's {mine}")
+        self._rows = {(int(c), str(n)): i for i, (c, n) in
+                      enumerate(zip(data["codes"], data["necessities"], strict=True))}
+        self._q = np.array(data["q"], dtype=float)
+        if len(self._q) == 0:
+            self._q = np.full((64, len(self.responses)), self.params["q_init"])
+        self._prev = None

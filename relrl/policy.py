@@ -1,0 +1,103 @@
+"""Learned policies as files, and the shell commands that inspect them.
+
+An ETG tree or a set of behaviour rules saves as a readable Prolog file (consult it in plain
+swipl, or load it with ``relrl shell DOMAIN.pl --policy FILE``); a Q-table saves as ``.npz``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from relrl.errors import UserError
+from relrl.kb import KnowledgeBase
+from relrl.learners import make_learner
+from relrl.loop import Agent
+from relrl.shell import Shell, command
+from relrl.terms import Var, format_term
+
+__all__ = ["policy_learner", "load_policy", "attach_learner"]
+
+
+def policy_learner(path: str | Path, kb: KnowledgeBase) -> str:
+    """The name of the learner that saved the policy file at ``path``."""
+    path = Path(path)
+    if not path.exists():
+        raise UserError(f"{path}: no such policy file")
+    if path.suffix == ".npz":
+        return "qlearning"
+    out = kb.call("relrl_gateway:gw_policy_learner", str(path), Var())
+    if out is None:
+        raise UserError(f"{path}: not a relrl policy (no relrl_policy/2 fact)")
+    return out[0]
+
+
+def attach_learner(shell: Shell, name: str) -> Agent:
+    """Give the shell an agent with a fresh learner called ``name``."""
+    agent = Agent(shell.kb, make_learner(name), seed=0)
+    shell.policy = agent
+    return agent
+
+
+def load_policy(shell: Shell, path: str | Path) -> Agent:
+    """Load a saved policy into the shell's knowledge base (``relrl shell --policy``)."""
+    name = policy_learner(path, shell.kb)
+    agent = attach_learner(shell, name)
+    agent.learner.load(path)
+    shell.print(f"loaded {name} policy {path}")
+    return agent
+
+
+def _agent(shell: Shell) -> Agent:
+    if shell.policy is None:
+        raise UserError("no learner: start the shell with --policy FILE or --learner NAME, "
+                        "or use :learner NAME")
+    return shell.policy
+
+
+@command("learner", ":learner NAME", "start a fresh learner (etg, contingency, qlearning)")
+def _learner(shell: Shell, text: str) -> None:
+    attach_learner(shell, text.strip() or "etg")
+    shell.print(f"learner {text.strip() or 'etg'} ready")
+
+
+@command("tree", ":tree", "draw the ETG tree")
+def _tree(shell: Shell, _: str) -> None:
+    text = _agent(shell).learner.tree()
+    shell.print(text.rstrip() if text else "(this learner has no tree)")
+
+
+@command("explain", ":explain", "why the learner would choose what it chooses now")
+def _explain(shell: Shell, _: str) -> None:
+    exp = _agent(shell).learner.explain(now=True)
+    shell.print(f"state {exp.get('state')}  necessity {exp.get('necessity')}")
+    for step in exp.get("path", []):
+        shell.print(f"  {step['test']} -> {'yes' if step['holds'] else 'no'}")
+    if "leaf" in exp:
+        shell.print(f"  leaf {exp['leaf']}" if exp["leaf"] is not None else "  (null branch)")
+    ranked = exp.get("ranked", [])
+    if not ranked:
+        shell.print("  no stored choices for this state and necessity: every response "
+                    "starts equal")
+    for item in ranked:
+        value = {k: v for k, v in item.items() if k != "response"}
+        shell.print(f"  {item['response']:<20} {json.dumps(value)}")
+
+
+@command("step", ":step TERM, ...", "one control step with these percepts (no learning)")
+def _step(shell: Shell, text: str) -> None:
+    agent = _agent(shell)
+    percepts = shell.parse_terms(text) if text else []
+    out = agent.step(percepts, learning=False)
+    ys = ", ".join(f"{n}={y:.3f}" for n, y in out.outputs.items())
+    shell.print(f"state {out.code}  necessity {out.necessity} ({ys})  reward {out.reward:g}")
+    shell.print(f"allowed: {', '.join(format_term(r) for r in out.allowed)}")
+    shell.print(f"response: {format_term(out.action)}")
+
+
+@command("save", ":save FILE", "save the learner's policy")
+def _save(shell: Shell, text: str) -> None:
+    if not text:
+        raise UserError("usage: :save FILE")
+    path = _agent(shell).learner.save(text)
+    shell.print(f"saved {path}")
