@@ -1,1 +1,55 @@
-"""Camera frames to perception facts: saliency, colour, faces and head pose, ART2."""
+"""Camera frames to perception facts: saliency, colour, faces and head pose, ART2.
+
+The public surface::
+
+    perceive(frame, *, state=None, looking_at=None) -> list[Fact]   # one call per frame
+    Perceiver                      # keeps the face tracker between frames; .analyse() for all
+    format_fact(fact) -> str       # ("see", "face") -> "see(face)."
+    SceneView, render              # the synthetic camera's scene and renderer
+    open_camera(src) -> Camera     # 0, cam://0, video file, folder, synthetic://
+    ART2, FruitNamer               # colour categories named by a caregiver (Table 1)
+    PLACES, POSES, COLOURS         # the shared vocabulary
+    bench(...) -> dict             # speed and face-detection figures
+
+Heavy imports (OpenCV) happen on first use, so importing this package is cheap.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+__all__ = [
+    # colour naming
+    "ART2",
+    "COLOURS",
+    # vocabulary
+    "PLACES",
+    "POSES",
+    "FruitNamer",
+    "Perceiver",
+    # the synthetic camera and camera sources
+    "SceneView",
+    # benchmark
+    "bench",
+    "format_fact",
+    "open_camera",
+    # one call per frame
+    "perceive",
+    "render",
+]
+
+_WHERE = {
+    "perceive": "perception.pipeline", "Perceiver": "perception.pipeline",
+    "format_fact": "perception.facts", "SceneView": "perception.render",
+    "render": "perception.render", "open_camera": "perception.camera",
+    "ART2": "perception.art2", "FruitNamer": "perception.art2",
+    "PLACES": "perception.vocab", "POSES": "perception.vocab", "COLOURS": "perception.vocab",
+    "bench": "perception.bench",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        return getattr(import_module(_WHERE[name]), name)
+    raise AttributeError(f"module 'perception' has no attribute {name!r}")

@@ -1,0 +1,118 @@
+"""Benchmark of the perception pipeline (``relrl bench`` calls :func:`bench`).
+
+* **Speed**: frames per second of the whole pipeline (faces with tracking, saliency, colour,
+  facts) on one core (``cv2.setNumThreads(1)``) at 320x240 and 640x480, over a rendered
+  interaction: the caregiver's face in changing poses for runs of frames, then the head turning
+  to toys and fruits (and empty places). Frames are rendered before timing. ``*_cold`` figures
+  reset the tracker before every frame: a full search each time (the worst case).
+* **Faces**: recall on the 100 faces of scikit-image's ``lfw_subset()`` and false detections on
+  its 100 non-faces, with the same detector (full search, all three cascades). The 25x25 crops
+  are enlarged to 64x64 and padded by 16 pixels of replicated border, so that the 20x20
+  cascades have the bit of context around the face they were trained with.
+
+Run ``python -m perception.bench``. scikit-image is needed for the face figures only.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+
+import numpy as np
+
+from perception.vocab import GAZE_POSE, PLACES
+
+__all__ = ["bench", "interaction_views", "lfw_figures"]
+
+
+def interaction_views(n: int = 240, seed: int = 0):
+    """A rendered-interaction script: runs of face frames and of object frames."""
+    from perception.render import SceneView
+
+    rng = np.random.default_rng(seed)
+    kinds = ("apple", "lemon", "orange", "red", "green", "blue")
+    views = []
+    while len(views) < n:
+        place = PLACES[int(rng.integers(len(PLACES)))]
+        run = int(rng.integers(10, 30))
+        if place == "centre":
+            pose = GAZE_POSE[PLACES[int(rng.integers(len(PLACES)))]]
+            views += [SceneView("centre", pose, {}, 1.0, len(views) + k) for k in range(run)]
+        else:
+            objects = {place: kinds[int(rng.integers(len(kinds)))]} if rng.random() < 0.8 else {}
+            views += [SceneView(place, None, objects, 1.0, len(views) + k) for k in range(run)]
+    return views[:n]
+
+
+def _fps(frames: list[np.ndarray], cold: bool) -> float:
+    from perception.pipeline import Perceiver
+
+    perceiver = Perceiver()
+    perceiver.analyse(frames[0])  # warm up (cascades load)
+    perceiver.reset()
+    start = time.perf_counter()
+    for frame in frames:
+        if cold:
+            perceiver.reset()
+        perceiver.analyse(frame)
+    return len(frames) / (time.perf_counter() - start)
+
+
+def lfw_figures() -> dict[str, int]:
+    """Face recall and false detections on ``skimage.data.lfw_subset()``."""
+    import cv2
+
+    try:
+        from skimage import data
+    except ImportError:  # pragma: no cover - depends on the environment
+        raise RuntimeError("the face figures need scikit-image (pip install scikit-image); "
+                           "it is a test/benchmark dependency only") from None
+    from perception.faces import detect_face
+
+    crops = (data.lfw_subset() * 255).round().astype(np.uint8)
+    found = []
+    for crop in crops:
+        img = cv2.resize(crop, (64, 64), interpolation=cv2.INTER_LINEAR)
+        img = cv2.copyMakeBorder(img, 16, 16, 16, 16, cv2.BORDER_REPLICATE)
+        found.append(detect_face(img) is not None)
+    return {"faces": 100, "faces_found": int(sum(found[:100])), "non_faces": 100,
+            "false_detections": int(sum(found[100:]))}
+
+
+def bench(frames: int = 240, seed: int = 0, faces: bool = True) -> dict[str, float | int]:
+    """Measure speed and face detection.
+
+    Args:
+        frames: frames of the rendered interaction per size.
+        seed: seed of the interaction script.
+        faces: also compute the lfw figures (needs scikit-image).
+
+    Returns:
+        ``fps_320x240``, ``fps_640x480`` (tracking), ``fps_320x240_cold``, ``fps_640x480_cold``
+        (full search every frame), ``face_recall`` (fraction), ``faces_found``,
+        ``false_detections`` and the counts behind them.
+    """
+    import cv2
+
+    from perception.render import render
+
+    old = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        views = interaction_views(frames, seed)
+        out: dict[str, float | int] = {"frames": frames}
+        for w, h in ((320, 240), (640, 480)):
+            rendered = [render(v, (w, h)) for v in views]
+            out[f"fps_{w}x{h}"] = round(_fps(rendered, cold=False), 1)
+            out[f"fps_{w}x{h}_cold"] = round(_fps(rendered, cold=True), 1)
+        if faces:
+            figures = lfw_figures()
+            out.update(figures)
+            out["face_recall"] = figures["faces_found"] / figures["faces"]
+        return out
+    finally:
+        cv2.setNumThreads(old)
+
+
+if __name__ == "__main__":
+    print(json.dumps(bench(), indent=2))

@@ -1,0 +1,224 @@
+"""Camera sources behind one interface, chosen by URL or name (a registry, no if-chains).
+
+=========================  ==========================================================
+source                     meaning
+=========================  ==========================================================
+``0``, ``cam://0``         webcam by index (OpenCV ``VideoCapture``)
+``video.mp4``              a video file (``file://video.mp4`` also works)
+``frames/``                a folder of images, read in name order (``dir://frames``)
+``photo.png``              one image, read once (``image://photo.png``)
+``synthetic://``           :func:`perception.render.render` of a :class:`SceneView`
+=========================  ==========================================================
+
+``synthetic://`` takes query options for its first view, e.g.
+``synthetic://?looking_at=left_down&objects=left_down:apple,right:lemon&pose=frontal&lighting=0.8
+&seed=3&size=640x480``; the simulator then sets each step's view with
+:meth:`SyntheticCamera.set_view`.
+
+Every source is a context manager; ``read()`` returns the next BGR frame or ``None`` at the end;
+``close()`` is safe to call twice.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Self
+from urllib.parse import parse_qs, urlsplit
+
+import numpy as np
+
+from perception.errors import CameraError, ImageError
+from perception.render import SceneView, render
+
+__all__ = ["SOURCES", "Camera", "SyntheticCamera", "open_camera", "read_image"]
+
+_IMAGE_EXT = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp"}
+
+
+def read_image(path: str | Path) -> np.ndarray:
+    """Read an image file as BGR; raises :class:`ImageError` when missing or unreadable."""
+    import cv2
+
+    p = Path(path)
+    if not p.is_file():
+        raise ImageError(f"no such image file: {str(path)!r}")
+    img = cv2.imread(str(p), cv2.IMREAD_COLOR)
+    if img is None:
+        raise ImageError(f"cannot decode {str(path)!r} as an image (is it a PNG or JPEG?)")
+    return img
+
+
+class Camera:
+    """Base class of camera sources: override :meth:`read` and, if needed, :meth:`_release`."""
+
+    name = "camera"
+
+    def __init__(self) -> None:
+        self._closed = False
+
+    def read(self) -> np.ndarray | None:  # pragma: no cover - abstract
+        """The next BGR frame, or ``None`` when the source has no more."""
+        raise NotImplementedError
+
+    def _release(self) -> None:
+        """Free the device (called once by :meth:`close`)."""
+
+    def close(self) -> None:
+        """Release the source; safe to call twice."""
+        if not self._closed:
+            self._closed = True
+            self._release()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __iter__(self) -> Iterator[np.ndarray]:
+        while (frame := self.read()) is not None:
+            yield frame
+
+
+class _Capture(Camera):
+    """A webcam or a video file through ``cv2.VideoCapture``."""
+
+    def __init__(self, target: int | str, what: str) -> None:
+        import cv2
+
+        super().__init__()
+        self.name = what
+        self._cap = cv2.VideoCapture(target)
+        if not self._cap.isOpened():
+            self._cap.release()
+            self._closed = True
+            raise CameraError(f"cannot open {what}; check the device or path, or use "
+                              "synthetic:// for the simulated camera")
+
+    def read(self) -> np.ndarray | None:
+        if self._closed:
+            return None
+        ok, frame = self._cap.read()
+        return frame if ok else None
+
+    def _release(self) -> None:
+        self._cap.release()
+
+
+class _Folder(Camera):
+    """The images of a folder, in name order."""
+
+    def __init__(self, path: str) -> None:
+        super().__init__()
+        folder = Path(path)
+        if not folder.is_dir():
+            raise CameraError(f"no such folder of images: {path!r}")
+        self.name = f"folder {path}"
+        self._files = sorted(p for p in folder.iterdir() if p.suffix.lower() in _IMAGE_EXT)
+        if not self._files:
+            raise CameraError(f"folder {path!r} holds no images ({', '.join(sorted(_IMAGE_EXT))})")
+        self._next = 0
+
+    def read(self) -> np.ndarray | None:
+        if self._closed or self._next >= len(self._files):
+            return None
+        self._next += 1
+        return read_image(self._files[self._next - 1])
+
+
+class _Image(_Folder):
+    """One image file, read once."""
+
+    def __init__(self, path: str) -> None:
+        Camera.__init__(self)
+        read_image(path)  # fail early with a clear message
+        self.name = f"image {path}"
+        self._files = [Path(path)]
+        self._next = 0
+
+
+class SyntheticCamera(Camera):
+    """Renders the simulator's scene (see :mod:`perception.render`).
+
+    Args:
+        view: the first view.
+        size: ``(width, height)`` of the frames.
+    """
+
+    name = "synthetic"
+
+    def __init__(self, view: SceneView | None = None, size: tuple[int, int] = (320, 240)) -> None:
+        super().__init__()
+        self.view = view or SceneView("centre")
+        self.size = size
+
+    def set_view(self, view: SceneView) -> None:
+        """Set what the next frames show."""
+        self.view = view
+
+    def read(self) -> np.ndarray | None:
+        return None if self._closed else render(self.view, self.size)
+
+
+def _synthetic(url: str) -> Camera:
+    query = {k: v[-1] for k, v in parse_qs(urlsplit(url).query).items()}
+    known = {"looking_at", "pose", "objects", "lighting", "seed", "size"}
+    if set(query) - known:
+        raise CameraError(f"unknown synthetic:// option(s) {sorted(set(query) - known)}; "
+                          f"use {sorted(known)}")
+    try:
+        objects = dict(item.split(":", 1) for item in query.get("objects", "").split(",") if item)
+        w, h = (int(v) for v in query.get("size", "320x240").lower().split("x"))
+        pose = query.get("pose", "frontal")
+        view = SceneView(query.get("looking_at", "centre"), None if pose == "none" else pose,
+                         objects, float(query.get("lighting", 1.0)), int(query.get("seed", 0)))
+    except ValueError as exc:
+        raise CameraError(f"bad synthetic:// URL {url!r}: {exc}") from None
+    return SyntheticCamera(view, (w, h))
+
+
+def _webcam(rest: str) -> Camera:
+    if not rest.isdigit():
+        raise CameraError(f"bad webcam index {rest!r}; use a number such as cam://0")
+    return _Capture(int(rest), f"webcam {rest}")
+
+
+def _video(path: str) -> Camera:
+    if not Path(path).is_file():
+        raise CameraError(f"no such video file: {path!r}")
+    return _Capture(path, f"video {path}")
+
+
+#: URL scheme -> factory taking the rest of the URL.
+SOURCES: dict[str, Callable[[str], Camera]] = {
+    "cam": _webcam,
+    "file": _video,
+    "dir": _Folder,
+    "image": _Image,
+    "synthetic": lambda rest: _synthetic("synthetic://" + rest),
+}
+
+
+def open_camera(source: str | int) -> Camera:
+    """Open a camera source by URL or name (see the module table).
+
+    Raises:
+        CameraError: the source does not exist or cannot be opened.
+    """
+    src = str(source).strip()
+    if "://" in src:
+        scheme, rest = src.split("://", 1)
+    elif src.isdigit():
+        scheme, rest = "cam", src
+    elif Path(src).is_dir():
+        scheme, rest = "dir", src
+    elif Path(src).suffix.lower() in _IMAGE_EXT:
+        scheme, rest = "image", src
+    else:
+        scheme, rest = "file", src
+    factory = SOURCES.get(scheme)
+    if factory is None:
+        raise CameraError(f"unknown camera scheme {scheme + '://'!r}; use one of "
+                          f"{', '.join(s + '://' for s in SOURCES)}, a webcam index, or a path")
+    return factory(rest)

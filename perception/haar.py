@@ -1,0 +1,105 @@
+"""A small numpy evaluator of OpenCV's Haar cascades (stump-based ones).
+
+OpenCV's ``CascadeClassifier`` only says "face" or "no face" for a window. To build a synthetic
+face the real detector responds to (see :mod:`perception.texture`) we need a graded score: how
+many stages a window passes and by what margin. This module reads the cascade XML shipped in the
+wheel and evaluates windows the way OpenCV does (variance-normalised Haar features on an
+integral image, stage sums of stump leaves against stage thresholds). It is used offline, by the
+texture generator; the detector itself always uses OpenCV.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["HaarCascade"]
+
+
+@dataclass
+class _Stage:
+    threshold: float
+    features: np.ndarray  # (n, 3, 5) rects x, y, w, h, weight
+    thresholds: np.ndarray  # (n,)
+    leaves: np.ndarray  # (n, 2)
+
+
+class HaarCascade:
+    """A stump-based Haar cascade read from an OpenCV XML file.
+
+    Args:
+        path: the cascade file, e.g. ``cv2.data.haarcascades + "haarcascade_profileface.xml"``.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        root = ET.parse(str(path)).getroot()[0]
+        self.width = int(root.findtext("width"))
+        self.height = int(root.findtext("height"))
+        feats = []
+        for f in root.find("features"):
+            rects = [[float(v) for v in r.text.split()] for r in f.find("rects")]
+            rects += [[0.0, 0.0, 0.0, 0.0, 0.0]] * (3 - len(rects))
+            feats.append(rects)
+        table = np.array(feats)
+        self.stages: list[_Stage] = []
+        for s in root.find("stages"):
+            idx, ths, leaves = [], [], []
+            for weak in s.find("weakClassifiers"):
+                nodes = weak.findtext("internalNodes").split()
+                if len(nodes) != 4:
+                    raise ValueError(f"{path}: only stump cascades are supported")
+                idx.append(int(nodes[2]))
+                ths.append(float(nodes[3]))
+                leaves.append([float(v) for v in weak.findtext("leafValues").split()])
+            self.stages.append(_Stage(float(s.findtext("stageThreshold")), table[idx],
+                                      np.array(ths), np.array(leaves)))
+
+    def evaluate(self, grey: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Score windows of the cascade's size at the given top-left corners.
+
+        Args:
+            grey: a 2-D grey image (any numeric type).
+            corners: ``(n, 2)`` integer array of window corners ``x, y``.
+
+        Returns:
+            ``(passed, margin)``: the number of stages each window passes (``len(stages)`` for a
+            detection) and the stage-sum margin of the last stage it reached.
+        """
+        import cv2
+
+        img = grey.astype(np.float64)
+        ii = cv2.integral(img)
+        sq = cv2.integral(img * img)
+        x = corners[:, 0][:, None].astype(int)
+        y = corners[:, 1][:, None].astype(int)
+
+        def box(table, x0, y0, w, h):
+            return table[y0 + h, x0 + w] - table[y0, x0 + w] - table[y0 + h, x0] + table[y0, x0]
+
+        w2, h2 = self.width - 2, self.height - 2
+        area = w2 * h2
+        s1 = box(ii, x[:, 0] + 1, y[:, 0] + 1, w2, h2)
+        s2 = box(sq, x[:, 0] + 1, y[:, 0] + 1, w2, h2)
+        nf = area * s2 - s1 * s1
+        nf = np.where(nf > 0, np.sqrt(np.maximum(nf, 1e-12)), 1.0)
+        n = len(corners)
+        passed = np.zeros(n, dtype=int)
+        alive = np.ones(n, dtype=bool)
+        margin = np.zeros(n)
+        for stage in self.stages:
+            f = stage.features
+            value = np.zeros((n, len(f)))
+            for r in range(3):
+                fx, fy, fw, fh = (f[:, r, j].astype(int)[None] for j in range(4))
+                value += f[:, r, 4][None] * box(ii, x + fx, y + fy, fw, fh)
+            value /= nf[:, None]
+            total = np.where(value < stage.thresholds[None], stage.leaves[None, :, 0],
+                             stage.leaves[None, :, 1]).sum(axis=1)
+            m = total - stage.threshold
+            margin = np.where(alive, m, margin)
+            alive &= m >= 0
+            passed += alive
+        return passed, margin
