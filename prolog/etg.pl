@@ -24,7 +24,10 @@ examples, unlike TG):
     Q-hat = Q(s, a) + alpha * (r + gamma * max_a' Q(s', a') - Q(s, a))      (Eq. 4)
 
 Algorithm 3 (insertion): sort s down the tree; at a leaf, update the action's Q (or insert
-the action with its necessity); at an empty branch (null), generate a leaf there.
+the action with its necessity); at an empty branch (null), generate a leaf there. When
+choosing (and for the max of Eq. 4), a state that reaches an empty branch uses the nearest
+leaf, the one down the other branch of that test: it is the tree's best guess for a state it
+has not met.
 
 The paper does not say when a leaf is split, and with a single initial leaf and no split
 nothing could ever be told apart. relrl's rule, which keeps the tree economic: a leaf
@@ -69,12 +72,12 @@ etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
 scored(Best, Q-_) :-
     Q =:= Best.
 
+%   The entries that estimate Q for a state: its leaf's or, for a state that sorts to an
+%   empty branch (never met), those of the nearest leaf (qtree_nearest_leaf/3): the tree
+%   generalises from the states that share the tests on the way down.
 leaf_entries(KB, D, Entries) :-
-    qtree_sort(KB, D, Where),
-    (   Where = leaf(Id)
-    ->  qtree_leaf(KB, Id, _, Entries)
-    ;   Entries = []
-    ).
+    qtree_nearest_leaf(KB, D, Id),
+    qtree_leaf(KB, Id, _, Entries).
 
 %!  etg_update(+KB, +D0, +A0, +N0, +R, +D1, +N1, +Allowed1, +Params) is det.
 %

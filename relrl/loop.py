@@ -19,7 +19,7 @@ from relrl.kb import KnowledgeBase
 from relrl.learners.base import Learner, StepOut
 from relrl.terms import Term, Var
 
-__all__ = ["Agent", "StepRecord", "run"]
+__all__ = ["Agent", "Interaction", "StepRecord", "run"]
 
 
 class Agent:
@@ -90,34 +90,72 @@ class StepRecord:
     info: dict[str, Any]
 
 
-def run(env: Environment, agent: Agent, steps: int, *, learning: bool = True,
-        actuator: Actuator | None = None, seed: int | None = None,
-        on_step: Callable[[StepRecord], None] | None = None,
-        reset: bool = True) -> list[StepRecord]:
-    """Run ``steps`` time units of ``env`` with ``agent``.
+class Interaction:
+    """An agent interacting with an environment (and, optionally, a real actuator).
 
     The robot perceives, its mind steps (one gateway call), the response goes to the
-    actuator (if any) and to the environment, which advances one time unit.
+    actuator (if any) and to the environment, which advances one time unit. Learning and
+    evaluation phases can alternate on the same interaction (:meth:`run` continues where the
+    last call stopped).
+
+    Args:
+        env: the environment (simulator, scripted episode, camera).
+        agent: the robot's mind.
+        actuator: what carries the responses out besides the environment (a head).
+        on_step: called with every :class:`StepRecord` as it happens.
+    """
+
+    def __init__(self, env: Environment, agent: Agent, *, actuator: Actuator | None = None,
+                 on_step: Callable[[StepRecord], None] | None = None) -> None:
+        self.env = env
+        self.agent = agent
+        self.actuator = actuator
+        self.on_step = on_step
+        self.info: dict[str, Any] | None = None
+        self.t = 0
+
+    def reset(self, seed: int | None = None, options: dict[str, Any] | None = None
+              ) -> dict[str, Any]:
+        """Start a new interaction: the environment resets, the agent ends its episode."""
+        self.agent.end_episode()
+        _, self.info = self.env.reset(seed=seed, options=options)
+        return self.info
+
+    def run(self, steps: int, *, learning: bool = True, keep: bool = True) -> list[StepRecord]:
+        """Run ``steps`` time units; returns their records (none when ``keep`` is False)."""
+        if self.info is None:
+            self.reset()
+        assert self.info is not None
+        records: list[StepRecord] = []
+        agent, env, actuator, on_step = self.agent, self.env, self.actuator, self.on_step
+        info = self.info
+        for _ in range(steps):
+            percepts = info["percepts"]
+            out = agent.step(percepts, learning=learning)
+            if actuator is not None and out.action != "none":
+                actuator.emit(out.action)
+            _, env_reward, terminated, truncated, info = env.step(out.action)
+            self.info = info
+            if keep or on_step is not None:
+                record = StepRecord(self.t, percepts, out, env_reward, info)
+                if keep:
+                    records.append(record)
+                if on_step is not None:
+                    on_step(record)
+            self.t += 1
+            if terminated or truncated:
+                info = self.reset()
+        return records
+
+
+def run(env: Environment, agent: Agent, steps: int, *, learning: bool = True,
+        actuator: Actuator | None = None, seed: int | None = None,
+        on_step: Callable[[StepRecord], None] | None = None) -> list[StepRecord]:
+    """Reset ``env`` with ``seed`` and run ``steps`` time units of it with ``agent``.
 
     Returns:
         the records of every step (also passed to ``on_step`` as they happen).
     """
-    records: list[StepRecord] = []
-    if reset:
-        _, info = env.reset(seed=seed)
-    else:
-        info = getattr(env, "last_info", {"percepts": []})
-    for t in range(steps):
-        percepts = info["percepts"]
-        out = agent.step(percepts, learning=learning)
-        if out.action != "none" and actuator is not None:
-            actuator.emit(out.action)
-        _, env_reward, terminated, truncated, info = env.step(out.action)
-        record = StepRecord(t, percepts, out, env_reward, info)
-        records.append(record)
-        if on_step is not None:
-            on_step(record)
-        if terminated or truncated:
-            agent.end_episode()
-            _, info = env.reset()
-    return records
+    interaction = Interaction(env, agent, actuator=actuator, on_step=on_step)
+    interaction.reset(seed=seed)
+    return interaction.run(steps, learning=learning)

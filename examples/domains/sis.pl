@@ -42,6 +42,8 @@ fact(toy_at(left_down)).
 fact(toy_at(down)).
 fact(toy_at(right_down)).
 fact(toy_at(right)).
+fact(red_toy(toy)).
+fact(green_toy(toy)).
 
 gaze_frontal(face)    :- percept(pose(face, frontal)).
 gaze_left(face)       :- percept(pose(face, left)).
@@ -55,6 +57,10 @@ head_at(Place) :- memory(at(Place), 0).
 
 % Where the robot has seen a toy, now or at the previous step.
 toy_at(Place) :- at(toy, Place).
+
+% The colour of the toy in view.
+red_toy(toy)   :- see(toy), percept(colour(toy, red)).
+green_toy(toy) :- see(toy), percept(colour(toy, green)).
 
 % A percept stays in working memory for this many further steps.
 memory_span(1).

@@ -98,6 +98,9 @@ class CaregiverParams:
         contact_timeout: time units an eye-contact opportunity lasts before it is missed and
             a new one starts; ``None`` waits for ever.
         attention_on_contact: give attention in the time unit eye contact is established.
+        attention_during_gaze: also give attention in every time unit of mutual gaze while
+            waiting for eye contact (the robot on the caregiver's face, the caregiver looking
+            at the robot), as Triesch et al.'s caregiver rewards looking at its face.
         single_look: end a trial (no attention) at the robot's first look, after the turn, at
             anything but the face or the target — one try per trial, as the paper's
             evaluation reads.
@@ -115,6 +118,7 @@ class CaregiverParams:
     contact_hold: int = 3
     contact_timeout: int | None = 10
     attention_on_contact: bool = True
+    attention_during_gaze: bool = False
     single_look: bool = False
     target_sequence: tuple[str, ...] | None = None
 
@@ -291,6 +295,8 @@ class ProtocolCaregiver(Caregiver):
         phase = self.phase
         if phase == ENGAGE:
             self._streak = self._streak + 1 if focus == CENTRE else 0
+            if p.attention_during_gaze and focus == CENTRE:
+                self.attention = True
             if self._streak >= p.contact_hold:
                 self.contact = True
                 self.attention = p.attention_on_contact

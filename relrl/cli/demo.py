@@ -1,0 +1,38 @@
+"""``relrl demo``: the main job on the simulator, short (what ``make demo`` runs)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+HELP = "a short Experiment 1 on the simulator: summary table and plots (what make demo runs)"
+EXAMPLE = "relrl demo --out runs/demo"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``relrl demo``."""
+    parser.add_argument("--out", default="runs/demo", help="output folder (default runs/demo)")
+    parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the quick Experiment 1 and say where everything is."""
+    from relrl.experiments.main import run_sis
+    from relrl.experiments.report import summary_table
+    from relrl.experiments.sis import SISConfig
+
+    config = SISConfig(points=4, eval_runs=5)
+    print("relrl demo: Experiment 1 (da Silva & Romero 2012) on the Social Interactive "
+          "Simulator,\n  short version: 3 learners x 5 evaluation points x 5 runs of 500 "
+          "time units")
+    t0 = time.perf_counter()
+    results, files = run_sis(config, args.out, workers=args.workers)
+    print()
+    print(summary_table(results["summary"]))
+    print(f"\n(CGI: correct gaze index, Eq. 5; eye contacts in the first "
+          f"{config.opportunities} opportunities; memory in the paper's positions)")
+    print(f"done in {time.perf_counter() - t0:.1f} s; results, CSVs and plots in {args.out}/:")
+    for f in files:
+        print(f"  {f}")
+    print("The full experiment: relrl experiment sis --out runs/exp1")
+    return 0

@@ -1,0 +1,118 @@
+"""``relrl experiment sis``: reproduce the paper's Experiment 1 with one command."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from pathlib import Path
+
+HELP = "reproduce the paper's experiments (sis: Experiment 1, three learners in the simulator)"
+EXAMPLE = "relrl experiment sis --quick --out runs/exp1-quick"
+
+
+def _param(text: str) -> tuple[str, str, float]:
+    try:
+        key, value = text.split("=", 1)
+        learner, name = key.split(".", 1)
+        return learner, name, float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"bad --param {text!r}: use LEARNER.NAME=NUMBER, e.g. etg.alpha=0.3") from None
+
+
+def _caregiver_param(text: str) -> tuple[str, object]:
+    try:
+        key, value = text.split("=", 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"bad --caregiver-param {text!r}: use NAME=VALUE, e.g. reliability=0.7") from None
+    try:
+        return key, json.loads(value)
+    except json.JSONDecodeError:
+        return key, value
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``relrl experiment``."""
+    parser.add_argument("name", choices=["sis"], help="which experiment")
+    parser.add_argument("--learners", default="contingency,qlearning,etg",
+                        help="comma-separated learners (default: all three)")
+    parser.add_argument("--points", type=int, default=None,
+                        help="evaluation points after the first (default 20; --quick: 4)")
+    parser.add_argument("--eval-runs", type=int, default=None,
+                        help="evaluation runs per point (default 20; --quick: 5)")
+    parser.add_argument("--eval-steps", type=int, default=500, help="time units per run")
+    parser.add_argument("--block", type=int, default=500,
+                        help="learning time units between evaluations (default 500)")
+    parser.add_argument("--seeds", default="0", help="comma-separated seeds (default 0)")
+    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
+                        help="worker processes, one Prolog engine each (default: up to 2)")
+    parser.add_argument("--caregiver", default="paper", help="caregiver model (default paper)")
+    parser.add_argument("--caregiver-param", type=_caregiver_param, action="append", default=[],
+                        metavar="NAME=VALUE", help="override a caregiver parameter (repeatable)")
+    parser.add_argument("--param", type=_param, action="append", default=[],
+                        metavar="LEARNER.NAME=X", help="learner parameter (repeatable)")
+    parser.add_argument("--domain", default=None, help="domain file (default sis.pl)")
+    parser.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
+    parser.add_argument("--quick", action="store_true", help="a short run (under a minute)")
+
+
+def build_config(args: argparse.Namespace):
+    """The SISConfig the options describe."""
+    from relrl.errors import ConfigError
+    from relrl.experiments.sis import SISConfig
+    from relrl.learners import LEARNERS
+    from relrl.sim.caregiver import make_caregiver
+
+    learners = [x.strip() for x in args.learners.split(",") if x.strip()]
+    for name in learners:
+        if name not in LEARNERS:
+            raise ConfigError(f"unknown learner {name!r} in --learners "
+                              f"(known: {', '.join(sorted(LEARNERS))})")
+    try:
+        seeds = [int(s) for s in args.seeds.split(",")]
+    except ValueError:
+        raise ConfigError(f"--seeds must be comma-separated integers, not {args.seeds!r}") \
+            from None
+    config = SISConfig(learners=learners, seeds=seeds)
+    config.points = args.points if args.points is not None else (4 if args.quick else 20)
+    config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
+    config.eval_steps = args.eval_steps
+    config.block = args.block
+    for what, value in [("--points", config.points), ("--eval-runs", config.eval_runs),
+                        ("--eval-steps", config.eval_steps), ("--block", config.block)]:
+        if value < 1:
+            raise ConfigError(f"{what} must be at least 1, not {value}")
+    config.caregiver = args.caregiver
+    config.caregiver_params.update(dict(args.caregiver_param))
+    make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker
+    for learner, name, value in args.param:
+        if learner not in learners:
+            raise ConfigError(f"--param {learner}.{name}: {learner} is not among --learners")
+        config.learner_params.setdefault(learner, {})[name] = value
+    from relrl.learners import make_learner
+
+    for learner in learners:
+        make_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    if args.domain:
+        if not Path(args.domain).exists():
+            raise ConfigError(f"--domain {args.domain}: no such file")
+        config.domain = str(Path(args.domain).resolve())
+    if args.workers < 1:
+        raise ConfigError(f"--workers must be at least 1, not {args.workers}")
+    return config
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the experiment, write the outputs, print the summary."""
+    from relrl.experiments.main import run_sis
+    from relrl.experiments.report import summary_table
+
+    config = build_config(args)
+    results, files = run_sis(config, args.out, workers=args.workers)
+    print(summary_table(results["summary"]))
+    print(f"\nwrote {len(files)} files to {args.out}/:")
+    for f in files:
+        print(f"  {f}")
+    return 0

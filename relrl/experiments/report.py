@@ -1,0 +1,160 @@
+"""Aggregating, writing and plotting experiment results.
+
+``results.json`` holds every number, the full configuration, the seeds and the package
+version; it is byte-identical for the same configuration and seeds. Wall-clock figures go to
+``timing.json``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["aggregate", "write_outputs", "summary_table", "write_json_atomic"]
+
+
+def write_json_atomic(path: Path, data: Any) -> None:
+    """Write JSON to ``path`` through a temporary file and a rename."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(data, fh, indent=1, sort_keys=True)
+        fh.write("\n")
+    os.replace(tmp, path)
+
+
+def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
+    """Per learner: the CGI curve pooled over seeds, eye contacts, memory, states met."""
+    out: dict[str, Any] = {}
+    for name in learners:
+        mine = sorted((j for j in jobs if j["learner"] == name), key=lambda j: j["seed"])
+        if not mine:
+            continue
+        points = len(mine[0]["curve"])
+        curve = []
+        for p in range(points):
+            runs = [v for j in mine for v in j["curve"][p]["cgi_runs"]]
+            curve.append({"point": p, "learning_steps": mine[0]["curve"][p]["learning_steps"],
+                          "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
+                          "n_runs": len(runs)})
+        flags = np.array([j["eye_contacts"]["per_opportunity"] for j in mine], dtype=float)
+        n_opp = min(len(f) for f in flags) if len(flags) else 0
+        cumulative = np.cumsum(flags[:, :n_opp], axis=1).mean(axis=0) if n_opp else np.zeros(0)
+        established = [j["eye_contacts"]["established"] for j in mine]
+        memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
+        out[name] = {
+            "curve": curve,
+            "cgi_after_first_run": curve[1]["cgi_mean"] if points > 1 else None,
+            "cgi_final": curve[-1]["cgi_mean"],
+            "eye_contacts": {"mean": float(np.mean(established)),
+                             "std": float(np.std(established)),
+                             "opportunities": n_opp,
+                             "cumulative_mean": [float(c) for c in cumulative]},
+            "memory": memory,
+            "states_met": float(np.mean([j["states_met"]["all"] for j in mine])),
+            "states_met_learning": float(np.mean([j["states_met"]["learning"] for j in mine])),
+        }
+    return out
+
+
+def summary_table(summary: dict[str, Any]) -> str:
+    """The results as a fixed-width text table."""
+    lines = [f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'eye contacts':>13} "
+             f"{'memory':>8} {'states':>7}"]
+    for name, s in summary.items():
+        ec = s["eye_contacts"]
+        first = s["cgi_after_first_run"]
+        lines.append(f"{name:<12} {first if first is not None else float('nan'):>9.3f} "
+                     f"{s['cgi_final']:>9.3f} {ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
+                     f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+    return "\n".join(lines)
+
+
+def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
+    """Write results.json, timing.json, the figures' CSVs and (with matplotlib) their PNGs.
+
+    Returns the files written.
+    """
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written = [out_dir / "results.json", out_dir / "timing.json"]
+    write_json_atomic(written[0], results)
+    write_json_atomic(written[1], timing)
+    summary = results["summary"]
+    fig5 = out_dir / "fig5_cgi.csv"
+    with open(fig5, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "n_runs"])
+        for name, s in summary.items():
+            for c in s["curve"]:
+                w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
+                            f"{c['cgi_std']:.6f}", c["n_runs"]])
+    fig4 = out_dir / "fig4_eye_contacts.csv"
+    with open(fig4, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["learner", "opportunity", "cumulative_eye_contacts"])
+        for name, s in summary.items():
+            for i, c in enumerate(s["eye_contacts"]["cumulative_mean"], start=1):
+                w.writerow([name, i, f"{c:.4f}"])
+    memory = out_dir / "memory.csv"
+    with open(memory, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["learner", "positions", "detail", "states_met"])
+        for name, s in summary.items():
+            detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
+            w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
+    written += [fig5, fig4, memory]
+    written += plot(out_dir, summary)
+    return written
+
+
+def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
+    """Fig. 4 and Fig. 5 as PNG files; nothing (and a note) without matplotlib."""
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        note = out_dir / "PLOTS.txt"
+        note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
+                        "are in the CSV files.\nInstall the extra to get plots:  "
+                        "pip install 'relrl[plots]'\n")
+        return [note]
+    files = []
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for name, s in summary.items():
+        steps = [c["point"] for c in s["curve"]]
+        ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
+                    yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3, capsize=3,
+                    label=name)
+    ax.set_xlabel("run (evaluation point; 500 learning time units each)")
+    ax.set_ylabel("CGI (mean ± s.d.)")
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_title("Fig. 5 — learning evolution (Social Interactive Simulator)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    files.append(out_dir / "fig5_cgi.png")
+    fig.savefig(files[-1], dpi=120)
+    plt.close(fig)
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for name, s in summary.items():
+        cum = s["eye_contacts"]["cumulative_mean"]
+        ax.plot(range(1, len(cum) + 1), cum,
+                label=f"{name} ({s['eye_contacts']['mean']:.0f} ± "
+                      f"{s['eye_contacts']['std']:.0f})")
+    ax.set_xlabel("eye-contact opportunity")
+    ax.set_ylabel("eye contacts established (cumulative)")
+    ax.set_title("Fig. 4 — capacity of attention (first opportunities)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    files.append(out_dir / "fig4_eye_contacts.png")
+    fig.savefig(files[-1], dpi=120)
+    plt.close(fig)
+    return files
