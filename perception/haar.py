@@ -90,16 +90,21 @@ class HaarCascade:
         alive = np.ones(n, dtype=bool)
         margin = np.zeros(n)
         for stage in self.stages:
+            idx = np.flatnonzero(alive)  # only windows still alive are evaluated
+            if idx.size == 0:
+                break
             f = stage.features
-            value = np.zeros((n, len(f)))
+            xa, ya = x[idx], y[idx]
+            value = np.zeros((idx.size, len(f)))
             for r in range(3):
                 fx, fy, fw, fh = (f[:, r, j].astype(int)[None] for j in range(4))
-                value += f[:, r, 4][None] * box(ii, x + fx, y + fy, fw, fh)
-            value /= nf[:, None]
+                value += f[:, r, 4][None] * box(ii, xa + fx, ya + fy, fw, fh)
+            value /= nf[idx, None]
             total = np.where(value < stage.thresholds[None], stage.leaves[None, :, 0],
                              stage.leaves[None, :, 1]).sum(axis=1)
             m = total - stage.threshold
-            margin = np.where(alive, m, margin)
-            alive &= m >= 0
-            passed += alive
+            margin[idx] = m
+            ok = m >= 0
+            alive[idx] = ok
+            passed[idx] += ok
         return passed, margin

@@ -165,9 +165,20 @@ def _profile(img: np.ndarray, cx: int, cy: int, r: int, textured: bool = True) -
     _profile_geometry(flipped, w - 1 - cx, cy, r)
     img[:] = cv2.flip(flipped, 1)
     if textured:
+        _apply_texture(img, cx, cy, r, _texture())
+
+
+#: the profile texture in use (``None``: load :mod:`perception._profile_texture` on first use;
+#: :mod:`perception.texture` sets candidates here while it optimises them).
+_TEXTURE: list[np.ndarray] = []
+
+
+def _texture() -> np.ndarray:
+    if not _TEXTURE:
         from perception._profile_texture import texture
 
-        _apply_texture(img, cx, cy, r, texture())
+        _TEXTURE.append(texture())
+    return _TEXTURE[0]
 
 
 def _profile_geometry(img: np.ndarray, cx: int, cy: int, r: int) -> None:

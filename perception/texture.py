@@ -65,6 +65,42 @@ def score_patch(cascade, patch: np.ndarray) -> np.ndarray:
     return np.concatenate(out)
 
 
+def _detector_frames() -> list[tuple[object, tuple[int, int]]]:
+    """The rendered profile views the final pass scores against (poses, lights, sizes)."""
+    from perception.render import SceneView
+
+    return [(SceneView("centre", pose, lighting=light, seed=seed), size)
+            for pose in ("left_2", "right_2") for light in (0.6, 1.0, 1.25)
+            for size, seed in (((320, 240), 3), ((320, 240), 8))]
+
+
+def score_with_opencv(patch: np.ndarray, frames) -> np.ndarray:
+    """Per frame: OpenCV's raw profile hits on the rendered frame (capped at 10, over 10) plus 2
+    when the hits group into a detection with the detector's own parameters."""
+    import cv2
+
+    from perception import render as rmod
+    from perception.faces import FaceParams, _cascade
+
+    p = FaceParams()
+    rmod._TEXTURE[:] = [np.clip(np.round(patch), 0, 255).astype(np.uint8)]
+    cascade = _cascade("profile")
+    out = []
+    for view, size in frames:
+        grey = cv2.cvtColor(rmod.render(view, size), cv2.COLOR_BGR2GRAY)
+        scale = p.work_height / grey.shape[0]
+        grey = cv2.resize(grey, (round(grey.shape[1] * scale), p.work_height),
+                          interpolation=cv2.INTER_AREA)
+        if view.face_pose.startswith("right"):
+            grey = cv2.flip(grey, 1)
+        raw = cascade.detectMultiScale(grey, p.scale_factor, 0, minSize=(p.min_size,) * 2)
+        hits = [list(map(int, r)) for r in raw]
+        grouped, _ = cv2.groupRectangles(hits, p.min_neighbors, 0.2) if hits else ((), 0)
+        out.append(min(len(hits), 10) / 10.0 + 2.0 * (len(grouped) > 0))
+    rmod._TEXTURE.clear()
+    return np.array(out)
+
+
 def make_texture(iterations: int = 30000, seed: int = 0, verbose: bool = False,
                  start: np.ndarray | None = None, stage: int = 0) -> np.ndarray:
     """Hill-climb the profile texture against OpenCV's profile cascade.
@@ -75,7 +111,8 @@ def make_texture(iterations: int = 30000, seed: int = 0, verbose: bool = False,
         verbose: print progress every 2000 iterations.
         start: continue from this texture instead of the drawing.
         stage: 0 edits only inside the head outline and stays near the drawing; 1 (a second
-            pass) may edit the whole square and scores only the cascade.
+            pass) may edit the whole square and scores only the cascade; 2 (a third pass)
+            scores the rendered frames with OpenCV itself (:func:`score_with_opencv`).
 
     Returns:
         The ``PATCH x PATCH`` uint8 texture.
@@ -93,7 +130,11 @@ def make_texture(iterations: int = 30000, seed: int = 0, verbose: bool = False,
     yy, xx = np.mgrid[0:PATCH, 0:PATCH]
     inside = np.argwhere(mask)
 
+    frames = _detector_frames() if stage == 2 else None
+
     def objective(p: np.ndarray) -> float:
+        if frames is not None:
+            return float(score_with_opencv(p, frames).sum())
         s = score_patch(cascade, p)
         return float(s.mean() + 0.5 * s.min() - weight * np.abs(p - init).mean() / 255.0)
 
@@ -140,6 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     tex = make_texture(args.iterations, args.seed, verbose=True)
     tex = make_texture(args.iterations, args.seed + 1, verbose=True, start=tex, stage=1)
+    tex = make_texture(args.iterations // 10, args.seed + 2, verbose=True, start=tex, stage=2)
     rows = "\n".join(f'    "{row.tobytes().hex()}"' for row in tex)
     Path(args.out).write_text(_TEMPLATE.format(seed=args.seed, iterations=args.iterations,
                                                n=PATCH, rows=rows))
