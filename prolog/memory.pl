@@ -24,13 +24,30 @@ Inserting an element that is already present renews it (its age becomes 0 again)
 never holds two copies of one element.
 
 Each knowledge base (a Prolog module, see relrl.pl) has a memory of its own; the first
-argument of every predicate names it. This module is the only one that asserts percepts.
+argument of every predicate names it. This module is the only one that stores percepts.
 */
 
-:- dynamic
-    element_/3,     % KB, Element, Stamp
-    clock_/2,       % KB, Clock: number of insertions so far
-    span_/2.        % KB, Span
+:- use_module(library(pairs)).
+
+%   The memory of knowledge base KB is one term, wm(Clock, Span, Elements), in a global
+%   variable (b/nb_setval) named after KB: Clock counts insertions, Span is the expiry age
+%   (or `default` until the domain's memory_span/1 is read), Elements are Element-Stamp
+%   pairs, newest first. A global term instead of asserted clauses keeps the robot's
+%   control step free of assert/retract churn.
+
+key(KB, Key) :-
+    atom_concat('$relrl_wm:', KB, Key).
+
+get(KB, State) :-
+    key(KB, Key),
+    (   nb_current(Key, State0)
+    ->  State = State0
+    ;   State = wm(0, default, [])
+    ).
+
+put(KB, State) :-
+    key(KB, Key),
+    nb_setval(Key, State).
 
 %!  wm_span(+KB, -Span) is det.
 %
@@ -39,10 +56,17 @@ argument of every predicate names it. This module is the only one that asserts p
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    (   span_(KB, Span0)
-    ->  Span = Span0
-    ;   catch(KB:memory_span(Span0), error(existence_error(procedure, _), _), fail)
-    ->  Span = Span0
+    get(KB, wm(_, Span0, _)),
+    (   Span0 == default
+    ->  domain_span(KB, Span)
+    ;   Span = Span0
+    ).
+
+domain_span(KB, Span) :-
+    (   current_predicate(KB:memory_span/1),
+        KB:memory_span(Span0)
+    ->  must_be(nonneg, Span0),
+        Span = Span0
     ;   Span = 0
     ).
 
@@ -55,18 +79,15 @@ wm_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    retractall(span_(KB, _)),
-    assertz(span_(KB, Span)).
+    get(KB, wm(Clock, _, Elements)),
+    put(KB, wm(Clock, Span, Elements)).
 
 %!  wm_clock(+KB, -Clock) is det.
 %
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    (   clock_(KB, Clock0)
-    ->  Clock = Clock0
-    ;   Clock = 0
-    ).
+    get(KB, wm(Clock, _, _)).
 
 %!  wm_insert(+KB, +Elements:list) is det.
 %
@@ -75,36 +96,49 @@ wm_clock(KB, Clock) :-
 %
 %   @error instantiation_error if an element is not ground.
 
-wm_insert(KB, Elements) :-
+wm_insert(KB, New) :-
     must_be(atom, KB),
-    must_be(list, Elements),
-    maplist(must_be_ground, Elements),
-    wm_clock(KB, Clock0),
-    Clock is Clock0 + 1,
-    retractall(clock_(KB, _)),
-    assertz(clock_(KB, Clock)),
-    forall(member(E, Elements),
-           ( retractall(element_(KB, E, _)),
-             assertz(element_(KB, E, Clock))
-           )),
-    wm_span(KB, Span),
-    Oldest is Clock - Span,
-    forall(( element_(KB, E, Stamp), Stamp < Oldest ),
-           retract(element_(KB, E, Stamp))).
-
-must_be_ground(E) :-
-    (   ground(E)
+    must_be(list, New),
+    (   ground(New)
     ->  true
-    ;   instantiation_error(E)
-    ).
+    ;   member(E, New), \+ ground(E)
+    ->  instantiation_error(E)
+    ),
+    get(KB, wm(Clock0, Span0, Old)),
+    (   Span0 == default
+    ->  domain_span(KB, Span)
+    ;   Span = Span0
+    ),
+    Clock is Clock0 + 1,
+    Oldest is Clock - Span,
+    stamp(New, Clock, Fresh),
+    keep_old(Old, New, Oldest, Kept),
+    append(Fresh, Kept, Elements),
+    put(KB, wm(Clock, Span, Elements)).
+
+stamp([], _, []).
+stamp([E|Es], Clock, Out) :-
+    (   memberchk(E, Es)                   % the same element twice in one insertion
+    ->  Out = Out1
+    ;   Out = [E-Clock|Out1]
+    ),
+    stamp(Es, Clock, Out1).
+
+keep_old([], _, _, []).
+keep_old([E-S|Es], New, Oldest, Out) :-
+    (   ( S < Oldest ; memberchk(E, New) )
+    ->  Out = Out1
+    ;   Out = [E-S|Out1]
+    ),
+    keep_old(Es, New, Oldest, Out1).
 
 %!  wm_element(?KB, ?Element, ?Age) is nondet.
 %
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    element_(KB, Element, Stamp),
-    clock_(KB, Clock),
+    get(KB, wm(Clock, _, Elements)),
+    member(Element-Stamp, Elements),
     Age is Clock - Stamp.
 
 %!  wm_elements(+KB, -Pairs:list) is det.
@@ -113,9 +147,6 @@ wm_element(KB, Element, Age) :-
 
 wm_elements(KB, Pairs) :-
     findall(Age-E, wm_element(KB, E, Age), Pairs0),
-    msort_by_age(Pairs0, Pairs).
-
-msort_by_age(Pairs0, Pairs) :-
     map_list_to_pairs(pair_age, Pairs0, Keyed),
     keysort(Keyed, Sorted),
     pairs_values(Sorted, Pairs).
@@ -128,5 +159,5 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    retractall(element_(KB, _, _)),
-    retractall(clock_(KB, _)).
+    get(KB, wm(_, Span, _)),
+    put(KB, wm(0, Span, [])).

@@ -1,0 +1,74 @@
+"""Benchmarks behind ``relrl bench``: rates and ratios, measured on this machine.
+
+* the cost of one gateway call with one binding;
+* steps per second of each learner driving the Social Interactive Simulator (a fixed,
+  seeded synthetic environment), learning on, and the gateway calls per step;
+* the simulator's own step rate;
+* the perception pipeline's frames per second (perception.bench), optional.
+
+Targets (from the project's issues): ETG at most ~1.5 gateway calls per step and at least
+5,000 steps/s on one core.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+__all__ = ["bench_engine", "bench_all"]
+
+
+def bench_engine(learner: str, steps: int = 5000, seed: int = 0) -> dict[str, float]:
+    """Steps/s and gateway calls per step of ``learner`` on the SIS, learning on."""
+    from relrl.experiments.sis import DEFAULT_DOMAIN
+    from relrl.kb import KnowledgeBase, gateway_calls
+    from relrl.learners import make_learner
+    from relrl.loop import Agent, Interaction
+    from relrl.sim.caregiver import make_caregiver
+    from relrl.sim.sis import SharedAttentionEnv
+
+    with KnowledgeBase(DEFAULT_DOMAIN) as kb:
+        agent = Agent(kb, make_learner(learner), seed=seed)
+        env = SharedAttentionEnv(make_caregiver("paper", {"attention_during_gaze": True}),
+                                 max_steps=None, record_trace=False)
+        interaction = Interaction(env, agent)
+        interaction.reset(seed=seed)
+        interaction.run(500, keep=False)            # warm up: the tree and tables exist
+        calls0 = gateway_calls()
+        t0 = time.perf_counter()
+        interaction.run(steps, keep=False)
+        elapsed = time.perf_counter() - t0
+        calls = gateway_calls() - calls0
+        return {"steps_per_second": steps / elapsed, "us_per_step": 1e6 * elapsed / steps,
+                "gateway_calls_per_step": calls / steps, "steps": steps}
+
+
+def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
+              ) -> dict[str, Any]:
+    """Every benchmark; a JSON-ready dict."""
+    import os
+    import platform
+
+    from relrl import __version__
+    from relrl.kb import measure_call_cost
+    from relrl.sim.policies import bench_step_rate
+
+    out: dict[str, Any] = {"relrl_version": __version__, "python": platform.python_version(),
+                           "cpus": os.cpu_count()}
+    out["gateway_call_us"] = measure_call_cost(5000) * 1e6
+    out["learners"] = {name: bench_engine(name, steps) for name in
+                       ("etg", "contingency", "qlearning")}
+    out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
+    if perception:
+        try:
+            import perception as perception_pkg
+
+            out["perception"] = perception_pkg.bench(faces=faces)
+        except ImportError as exc:  # pragma: no cover - OpenCV missing
+            out["perception"] = {"skipped": str(exc)}
+    etg = out["learners"]["etg"]
+    out["targets"] = {
+        "etg_calls_per_step<=1.5": etg["gateway_calls_per_step"] <= 1.5,
+        "etg_steps_per_second>=5000": etg["steps_per_second"] >= 5000,
+    }
+    return out
