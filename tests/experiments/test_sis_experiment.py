@@ -1,0 +1,79 @@
+"""``relrl experiment sis``: outputs, repeatability, learning, bad options."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from relrl.cli import main
+from relrl.experiments.report import plot
+from relrl.experiments.sis import SISConfig, run_job
+
+SMALL = ["--points", "2", "--eval-runs", "2", "--eval-steps", "100", "--block", "300"]
+
+
+def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert main(["experiment", "sis", *SMALL, "--out", str(a), "--workers", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "learner" in out and "etg" in out and "qlearning" in out and "contingency" in out
+    for name in ["results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
+                 "memory.csv", "fig5_cgi.png", "fig4_eye_contacts.png"]:
+        assert (a / name).exists(), name
+    # two worker processes, same seed: the same results.json, byte for byte
+    assert main(["experiment", "sis", *SMALL, "--out", str(b), "--workers", "2"]) == 0
+    assert (a / "results.json").read_bytes() == (b / "results.json").read_bytes()
+    results = json.loads((a / "results.json").read_text())
+    assert results["config"]["points"] == 2 and results["seeds"] == [0]
+    assert results["relrl_version"]
+    for name in ["contingency", "qlearning", "etg"]:
+        s = results["summary"][name]
+        assert len(s["curve"]) == 3
+        assert s["memory"]["positions"] > 0
+        assert s["states_met"] > 0
+    lines = (a / "fig5_cgi.csv").read_text().splitlines()
+    assert lines[0] == "learner,point,learning_steps,cgi_mean,cgi_std,n_runs"
+    assert len(lines) == 1 + 3 * 3
+
+
+def test_another_seed_other_numbers(tmp_path: Path) -> None:
+    cfg = SISConfig(learners=["etg"], points=1, eval_runs=2, eval_steps=100, block=300)
+    r0, r1 = run_job(cfg, "etg", 0), run_job(cfg, "etg", 1)
+    r0.pop("timing"), r1.pop("timing")
+    assert r0 != r1
+
+
+@pytest.mark.parametrize("learner", ["etg", "qlearning", "contingency"])
+def test_learning_improves_gaze_following(learner: str) -> None:
+    cfg = SISConfig(learners=[learner], points=2, eval_runs=3, eval_steps=300, block=500)
+    result = run_job(cfg, learner, 0)
+    curve = [c["cgi_mean"] for c in result["curve"]]
+    assert curve[0] < 0.5            # no knowledge yet (chance is about 0.2)
+    assert curve[-1] > curve[0] + 0.3
+    assert result["timing"]["gateway_calls_per_step"] == pytest.approx(1.0, abs=0.01)
+
+
+def test_without_matplotlib_a_note(tmp_path: Path, monkeypatch) -> None:
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    files = plot(tmp_path, {})
+    assert files == [tmp_path / "PLOTS.txt"]
+    assert "pip install 'relrl[plots]'" in files[0].read_text()
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--learners", "sarsa"], "unknown learner 'sarsa'"),
+    (["--seeds", "one"], "--seeds must be comma-separated integers"),
+    (["--caregiver-param", "reliability=2"], "reliability"),
+    (["--caregiver", "nobody"], "unknown caregiver model 'nobody'"),
+    (["--param", "etg.alpha=3"], "alpha must be in [0, 1]"),
+    (["--points", "0"], "--points must be at least 1"),
+])
+def test_bad_options_one_line_exit_2(args: list[str], message: str, tmp_path: Path,
+                                     capsys) -> None:
+    assert main(["experiment", "sis", *args, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert len(err.strip().splitlines()) == 1

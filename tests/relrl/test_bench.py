@@ -1,0 +1,21 @@
+"""``relrl bench`` reports every figure (no speed assertions: those live in the output)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from relrl.cli import main
+
+
+def test_bench_json(tmp_path: Path, capsys) -> None:
+    path = tmp_path / "bench.json"
+    assert main(["bench", "--no-perception", "--steps", "200", "--json", str(path)]) == 0
+    figures = json.loads(path.read_text())
+    assert figures["gateway_call_us"] > 0
+    for name in ("etg", "contingency", "qlearning"):
+        learner = figures["learners"][name]
+        assert learner["steps_per_second"] > 0
+        assert 0.99 <= learner["gateway_calls_per_step"] <= 1.01
+    assert "etg_calls_per_step<=1.5" in figures["targets"]
+    assert "steps_per_second" in capsys.readouterr().out
