@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from types import TracebackType
 from typing import Any, Self
 
-from head.calibration import Calibration
+from head.calibration import MIN_SPEED, Calibration
 from head.errors import HeadClosed, HeadError, HeadTimeout
 from head.scripts import Step
 
@@ -24,6 +24,9 @@ __all__ = ["Head", "MotionModel"]
 POLL_S = 0.01
 #: slack added to a move's expected duration before :meth:`Head.wait` gives up, in seconds.
 WAIT_SLACK_S = 1.0
+#: times closer than this (seconds) count as equal, so float round-off never leaves a servo
+#: a hair short of its target.
+TIME_EPS = 1e-9
 
 
 @dataclass
@@ -44,12 +47,16 @@ class MotionModel:
         self.speed = self.speed or {name: 1.0 for name in self.start}
 
     def at(self, now: float) -> dict[str, float]:
-        """Every servo's position at time ``now``."""
+        """Every servo's position at time ``now`` (exactly the target once it has arrived)."""
         out = {}
         for name, p0 in self.start.items():
-            goal = self.target[name]
-            step = self.speed[name] * max(0.0, now - self.t0)
-            out[name] = goal if abs(goal - p0) <= step else p0 + (step if goal > p0 else -step)
+            goal, speed = self.target[name], self.speed[name]
+            elapsed = now - self.t0
+            if elapsed + TIME_EPS >= abs(goal - p0) / speed:
+                out[name] = goal
+            else:
+                step = speed * max(0.0, elapsed)
+                out[name] = p0 + (step if goal > p0 else -step)
         return out
 
     def end_time(self) -> float:
@@ -59,7 +66,7 @@ class MotionModel:
 
     def moving(self, now: float) -> bool:
         """Whether any servo is still on its way at ``now``."""
-        return now < self.end_time()
+        return now + TIME_EPS < self.end_time()
 
     def command(self, now: float, pose: Mapping[str, int], speeds: Mapping[str, float]) -> float:
         """Start a move from where the servos are at ``now``; returns its duration in s."""
@@ -113,6 +120,10 @@ class Head(ABC):
     def _sleep(self, seconds: float) -> None:
         """Let ``seconds`` pass on the head's clock."""
 
+    def _quantise_speed(self, speed: float) -> float:
+        """The speed the device will really use for a requested one (never faster)."""
+        return speed
+
     def _errors(self) -> list[str]:
         """Errors the device reports (none by default)."""
         return []
@@ -129,7 +140,7 @@ class Head(ABC):
         Args:
             pose: servo name -> pulse width in microseconds (servos left out stay put).
             speed: optional speed in microseconds per second; never faster than a servo's
-                calibrated speed.
+                calibrated speed, never slower than 25 us/s.
 
         Returns:
             The pose actually commanded (after clamping).
@@ -143,7 +154,8 @@ class Head(ABC):
         if speed is not None and not (isinstance(speed, int | float) and speed > 0):
             raise HeadError(f"speed {speed!r} must be a positive number of microseconds/second")
         servos = self.calibration.servos
-        speeds = {n: min(float(speed), servos[n].speed) if speed else servos[n].speed
+        speeds = {n: self._quantise_speed(max(MIN_SPEED, min(float(speed), servos[n].speed)
+                                              if speed else servos[n].speed))
                   for n in clamped}
         self.clamped_count += len(over)
         if clamped:

@@ -58,6 +58,8 @@ DIRECTIONS: tuple[str, ...] = ("left", "left_down", "down", "right_down", "right
 PULSE_RANGE: tuple[int, int] = (500, 2500)
 #: the fastest a servo may be calibrated to move, in microseconds per second.
 MAX_SPEED = 20_000.0
+#: the slowest speed, microseconds per second (one unit of the Maestro's speed setting).
+MIN_SPEED = 25.0
 #: the calibration used when none is given.
 DEFAULT_CALIBRATION = Path(__file__).resolve().parent.parent / "examples/heads/wha8030.toml"
 
@@ -221,8 +223,9 @@ def _parse_servo(name: str, raw: Any, fail) -> Servo:
     speed = raw["speed"]
     if isinstance(speed, bool) or not isinstance(speed, int | float) or not math.isfinite(speed):
         fail(f"{key}.speed", f"{speed!r} must be a number of microseconds per second")
-    if not 0 < speed <= MAX_SPEED:
-        fail(f"{key}.speed", f"{speed:g} must be in (0, {MAX_SPEED:g}] microseconds per second")
+    if not MIN_SPEED <= speed <= MAX_SPEED:
+        fail(f"{key}.speed", f"{speed:g} must be in {MIN_SPEED:g}..{MAX_SPEED:g} microseconds "
+             "per second")
     accel = _int(raw.get("acceleration", 0), f"{key}.acceleration", fail, 0, 255)
     return Servo(name, channel, pmin, centre, pmax, float(speed), accel)
 

@@ -111,12 +111,15 @@ class SerialHead(Head):
             can, except on ``loop://``, which only echoes). Without feedback the head
             estimates positions from the calibrated speeds.
         serial_factory: replaces ``serial.serial_for_url`` (tests use an in-memory twin).
+        clock, sleep: the head's time source (tests pass a fake clock).
     """
 
     def __init__(self, port: str, protocol: str | Protocol | None = None,
                  calibration: Calibration | None = None, *, timeout: float = DEFAULT_TIMEOUT,
                  feedback: bool | None = None, baudrate: int | None = None,
-                 serial_factory: Callable[..., Any] | None = None) -> None:
+                 serial_factory: Callable[..., Any] | None = None,
+                 clock: Callable[[], float] = time.monotonic,
+                 sleep: Callable[[float], None] = time.sleep) -> None:
         super().__init__(calibration or load_calibration())
         cal = self.calibration
         name = protocol or cal.protocol
@@ -137,6 +140,7 @@ class SerialHead(Head):
         can = self.protocol.feedback and not str(port).startswith("loop://")
         self.feedback = can if feedback is None else (feedback and self.protocol.feedback)
         self._factory = serial_factory
+        self._clock, self._sleeper = clock, sleep
         self._model = MotionModel({n: float(v) for n, v in self.targets.items()})
         self.link: SerialLink | None = None
         self._bytes_before = 0
@@ -149,6 +153,8 @@ class SerialHead(Head):
         try:
             servos = [(s.channel, s.acceleration) for s in self.calibration.servos.values()]
             self.link.write(self.protocol.setup(servos))
+            if self.feedback:  # start the estimate from where the servos really are
+                self._model = MotionModel(self.positions())
             # A head starts looking forward, at the caregiver.
             self._closed = False
             self.move_to(self.calibration.centre_pose())
@@ -174,10 +180,14 @@ class SerialHead(Head):
 
     def _command(self, pose: dict[str, int], speeds: dict[str, float]) -> float:
         servos = self.calibration.servos
-        duration = self._model.command(time.monotonic(), pose, speeds)
-        commands = [Command(servos[n].channel, v, speeds[n]) for n, v in pose.items()]
+        duration = self._model.command(self._clock(), pose, speeds)
+        commands = [Command(servos[n].channel, v, speeds[n], servos[n].min, servos[n].max)
+                    for n, v in pose.items()]
         self._live_link().write(self.protocol.encode_move(commands, round(duration * 1000)))
         return duration
+
+    def _quantise_speed(self, speed: float) -> float:
+        return self.protocol.quantise_speed(speed)
 
     def _channels(self) -> dict[str, int]:
         return {n: s.channel for n, s in self.calibration.servos.items()}
@@ -185,7 +195,7 @@ class SerialHead(Head):
     def positions(self) -> dict[str, float]:
         """Read back from the controller when it can; otherwise the speed-based estimate."""
         if not self.feedback:
-            return self._model.at(time.monotonic())
+            return self._model.at(self._clock())
         channels = self._channels()
         raw = self.protocol.query_positions(self._live_link(), list(channels.values()))
         return {n: raw[ch] for n, ch in channels.items()}
@@ -193,7 +203,7 @@ class SerialHead(Head):
     def is_moving(self) -> bool:
         """Ask the controller when it can; otherwise the speed-based estimate."""
         if not self.feedback:
-            return self._model.moving(time.monotonic())
+            return self._model.moving(self._clock())
         targets = {self.calibration.servos[n].channel: v for n, v in self.targets.items()}
         return self.protocol.query_moving(self._live_link(), targets)
 
@@ -208,7 +218,7 @@ class SerialHead(Head):
         return out
 
     def _now(self) -> float:
-        return time.monotonic()
+        return self._clock()
 
     def _sleep(self, seconds: float) -> None:
-        time.sleep(seconds)
+        self._sleeper(seconds)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import difflib
 import importlib
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -43,11 +44,15 @@ class Command:
         channel: controller channel.
         pulse_us: pulse width in whole microseconds.
         speed: microseconds per second (positive).
+        lo, hi: the servo's calibrated range; an encoder whose units are coarser than a
+            microsecond rounds into it, never out of it.
     """
 
     channel: int
     pulse_us: int
     speed: float
+    lo: int = ABSOLUTE_RANGE[0]
+    hi: int = ABSOLUTE_RANGE[1]
 
 
 class Link(_Interface):
@@ -66,10 +71,10 @@ def check_command(cmd: Command, max_channel: int) -> None:
     """Refuse a command no servo should get (the last guard before encoding).
 
     Raises:
-        HeadError: the pulse is outside 500..2500 us, the speed is not positive, or the
+        HeadError: the pulse is outside 500..2500 us or the servo's own range, the speed is not positive, or the
             channel does not exist on the controller. Reaching this is a bug upstream.
     """
-    lo, hi = ABSOLUTE_RANGE
+    lo, hi = max(ABSOLUTE_RANGE[0], cmd.lo), min(ABSOLUTE_RANGE[1], cmd.hi)
     if not isinstance(cmd.pulse_us, int) or not lo <= cmd.pulse_us <= hi:
         raise HeadError(f"refusing to send pulse {cmd.pulse_us!r} us to channel {cmd.channel}: "
                         f"outside {lo}..{hi}")
@@ -88,12 +93,24 @@ class Protocol(ABC):
         baudrate: the default serial speed.
         max_channel: the highest channel number the controller has.
         feedback: whether the controller can report positions and motion.
+        speed_step: the unit of the speed field, microseconds per second (0: time-based).
     """
 
     name: ClassVar[str]
     baudrate: ClassVar[int]
     max_channel: ClassVar[int]
     feedback: ClassVar[bool] = True
+    speed_step: ClassVar[float] = 0.0
+
+    def quantise_speed(self, speed: float) -> float:
+        """The largest speed the controller can be told that is not above ``speed``.
+
+        ``speed_step`` is the unit of the protocol's speed field (0: any speed works, as for
+        time-based protocols). Speeds are at least 25 us/s, a multiple of every unit here.
+        """
+        if not self.speed_step:
+            return speed
+        return max(self.speed_step, math.floor(speed / self.speed_step) * self.speed_step)
 
     def setup(self, servos: Sequence[tuple[int, int]]) -> bytes:
         """Bytes to send once after opening; ``servos`` is ``(channel, acceleration)``."""

@@ -46,6 +46,7 @@ class Maestro(Protocol):
     name = "maestro"
     baudrate = 9600
     max_channel = 23
+    speed_step = SPEED_UNIT
 
     def setup(self, servos: Sequence[tuple[int, int]]) -> bytes:
         """Set the acceleration of each servo that declares one."""
@@ -72,7 +73,7 @@ class Maestro(Protocol):
     def query_moving(self, link: Link, targets: dict[int, int]) -> bool:
         """Moving while any channel's read-back position differs from its target."""
         positions = self.query_positions(link, list(targets))
-        return any(abs(positions[ch] - t) >= 1.0 for ch, t in targets.items())
+        return any(positions[ch] != t for ch, t in targets.items())  # exact, in 0.25 us
 
     def query_errors(self, link: Link) -> list[str]:
         """``0xA1``: the error bits, as names."""

@@ -17,6 +17,7 @@ calibrated speeds (:attr:`feedback` is false).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 from head.protocols import Command, Protocol, check_command
@@ -49,9 +50,13 @@ def packet(did: int, data: bytes) -> bytes:
     return STX + body + bytes((crc8_maxim(body),)) + ETX
 
 
-def pulse_to_value(pulse_us: int) -> int:
-    """Microseconds -> the PMS5005 servo command value (ms x 2250)."""
-    return round(pulse_us * 2.25)
+def pulse_to_value(pulse_us: int, lo: int = 500, hi: int = 2500) -> int:
+    """Microseconds -> the PMS5005 servo command value (ms x 2250), kept inside [lo, hi].
+
+    One unit is 0.44 us, so the nearest value can land a fraction of a microsecond past a
+    limit; it is then moved one unit back inside.
+    """
+    return min(math.floor(hi * 2.25), max(math.ceil(lo * 2.25), round(pulse_us * 2.25)))
 
 
 class PMS5005(Protocol):
@@ -69,7 +74,7 @@ class PMS5005(Protocol):
         values = [NO_CONTROL] * CHANNELS
         for cmd in commands:
             check_command(cmd, self.max_channel)
-            values[cmd.channel] = pulse_to_value(cmd.pulse_us)
+            values[cmd.channel] = pulse_to_value(cmd.pulse_us, cmd.lo, cmd.hi)
         ms = min(0xFFFF, max(0, int(duration_ms)))
         data = b"".join(v.to_bytes(2, "little") for v in values) + ms.to_bytes(2, "little")
         return packet(SERVO_ALL_TIME_DID, data)

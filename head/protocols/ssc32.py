@@ -28,6 +28,7 @@ class SSC32(Protocol):
     name = "ssc32"
     baudrate = 115200
     max_channel = 31
+    speed_step = 1.0
 
     def encode_move(self, commands: Sequence[Command], duration_ms: int) -> bytes:
         """``#0P1500S600#1P1400S400\\r`` for a group of servos moving together."""

@@ -89,8 +89,12 @@ def test_maestro_errors_appear_in_status(fast_cal):
 def test_a_silent_controller_is_a_clear_timeout(fast_cal, name):
     fake = FakeController(name, mute=True)
     with PtyController(fake) as pty:
-        head = SerialHead(pty.port, name, fast_cal, timeout=0.1)
         with pytest.raises(HeadTimeout, match=f"{name} controller on .* did not answer"):
+            SerialHead(pty.port, name, fast_cal, timeout=0.1)  # it asks for positions at once
+        fake.mute = False
+        head = SerialHead(pty.port, name, fast_cal, timeout=0.1)
+        fake.mute = True  # the controller goes quiet while in use
+        with pytest.raises(HeadTimeout, match="check power, cable, baud rate"):
             head.is_moving()
         head.close(centre=False)
 
