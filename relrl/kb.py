@@ -51,7 +51,7 @@ _PL_STRING, _PL_TERM, _PL_NIL, _PL_BLOB, _PL_LIST_PAIR = 6, 7, 8, 9, 10
 _REP_UTF8 = 0x00100000
 _CVT_ATOM, _CVT_STRING, _CVT_INTEGER, _CVT_VARIABLE = 0x1, 0x2, 0x8, 0x40
 _CVT_WRITEQ = 0xC0
-_BUF_STACK = 0x10000
+_BUF_DISCARDABLE = 0x0
 _PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
 
 _KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
@@ -119,6 +119,8 @@ class _Engine:
         self.call_predicate = fn("PL_call_predicate", c_int, c_void_p, c_int, c_void_p, T)
         self.exception = fn("PL_exception", T, T)
         self.clear_exception = fn("PL_clear_exception", None)
+        self.mark_strings = fn("PL_mark_string_buffers", None, POINTER(c_size_t))
+        self.release_strings = fn("PL_release_string_buffers_from_mark", None, c_size_t)
 
         self._functors: dict[tuple[str, int], int] = {}
         self._names: dict[int, str] = {}
@@ -188,7 +190,7 @@ class _Engine:
     def _text(self, t: int, flags: int) -> str:
         n = c_size_t()
         s = c_char_p()
-        if not self.get_nchars(t, byref(n), byref(s), flags | _BUF_STACK | _REP_UTF8):
+        if not self.get_nchars(t, byref(n), byref(s), flags | _BUF_DISCARDABLE | _REP_UTF8):
             raise RelrlError("cannot read text from a Prolog term")
         return ctypes.string_at(s, n.value).decode("utf-8")
 
@@ -257,6 +259,11 @@ class _Engine:
         if threading.get_ident() != self.thread:
             raise RelrlError("the Prolog engine belongs to the thread that started it; "
                              "use processes, not threads, for parallel runs")
+        # Text conversions push buffers on SWI-Prolog's string stack, which is only popped
+        # when a foreign predicate returns: a host calling in a million times must pop them
+        # itself, or Prolog dies with "Too many stacked strings".
+        mark = c_size_t()
+        self.mark_strings(byref(mark))
         fid = self.open_frame()
         try:
             self.calls += 1
@@ -292,6 +299,7 @@ class _Engine:
             return values
         finally:
             self.discard_frame(fid)
+            self.release_strings(mark.value)
 
     def _bootstrap(self) -> None:
         gateway = PROLOG_DIR / "gateway.pl"

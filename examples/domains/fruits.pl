@@ -79,7 +79,7 @@ forbidden(name_object) :- \+ see(object).
 
 % socialize, with the parameters of section 5.2. The paper's input weights are positive
 % magnitudes; declared as satisfiers they enter Eq. 1 negated, so contact lowers the need
-% (see docs/motivation.md for the sign convention).
+% (see docs/engine.md for the sign convention).
 necessity(socialize).
 unit(socialize, bias, 1.00).
 unit(socialize, recurrent_weight, 1.00).

@@ -145,3 +145,15 @@ def test_other_threads_are_refused(fruits: KnowledgeBase) -> None:
 def test_close_twice(fruits: KnowledgeBase) -> None:
     fruits.close()
     fruits.close()
+
+
+def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
+    """Regression: every call pushed a text buffer on Prolog's string stack, which only a
+    returning foreign predicate pops; an experiment of ~600k steps died with 'Too many
+    stacked strings' (fatal, no exception). The gateway now pops them after each call."""
+    from relrl.kb import _get_engine
+
+    engine = _get_engine()
+    for _ in range(1_300_000):
+        engine.run("true", 0, ())
+    assert engine.run(("=", Var(), "still alive"), 0, (0,)) == ["still alive"]
