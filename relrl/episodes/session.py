@@ -1,0 +1,344 @@
+"""Running an episode: the learning time line, evaluations, naming, trace, summary, plots.
+
+:func:`run_episode` builds the knowledge base, learner and agent of a script, the world
+(:class:`~relrl.episodes.world.EpisodeWorld` on the simulator, or
+:class:`~relrl.episodes.devices.DeviceWorld` on a camera and a head) and runs the phases one
+time unit at a time. With an output folder it writes, as it goes, ``trace.jsonl`` (one line
+per time unit, flushed) and at the end ``summary.json`` (atomic), ``timing.json``, the learned
+policy and plots. A stop request (Ctrl-C or SIGTERM) ends the run after the current time unit
+with everything up to it written.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import signal
+import sys
+import threading
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import numpy as np
+
+from relrl.episodes.script import Episode
+from relrl.terms import format_term
+
+__all__ = ["RunOptions", "run_episode", "StopRequest"]
+
+
+class StopRequest:
+    """A flag set by SIGINT/SIGTERM (a second SIGINT raises KeyboardInterrupt)."""
+
+    def __init__(self) -> None:
+        self.requested = False
+
+    def __call__(self) -> bool:
+        return self.requested
+
+    @contextmanager
+    def installed(self):
+        """Catch SIGINT and SIGTERM while the block runs (main thread only)."""
+        if threading.current_thread() is not threading.main_thread():
+            yield self
+            return
+
+        def handler(signum: int, frame: Any) -> None:
+            if self.requested and signum == signal.SIGINT:
+                raise KeyboardInterrupt
+            self.requested = True
+
+        old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            yield self
+        finally:
+            for s, h in old.items():
+                signal.signal(s, h)
+
+
+@dataclass
+class RunOptions:
+    """How to run an episode (the ``relrl run`` flags).
+
+    Attributes:
+        out: output folder (``None``: nothing written).
+        head: head port (``sim``, a serial device, a pyserial URL) or ``None``.
+        protocol: head protocol name.
+        camera: camera source (perception's ``open_camera``) or ``None`` for the simulator.
+        live: print what the robot perceives, wants and does; read typed words.
+        step_seconds: pause per time unit (a live session on the simulator is slowed down so
+            a person can follow and type).
+        stream: where the live view goes.
+        words: a source of typed/recognised words (``get_nowait()``), or ``None``.
+        plots: write PNG plots (needs matplotlib).
+    """
+
+    out: Path | None = None
+    head: str | None = None
+    protocol: str | None = None
+    camera: str | None = None
+    live: bool = False
+    step_seconds: float = 0.0
+    stream: TextIO = field(default_factory=lambda: sys.stdout)
+    words: Any = None
+    plots: bool = True
+
+
+def _json_num(x: float) -> float | None:
+    return None if isinstance(x, float) and math.isnan(x) else x
+
+
+class _Trace:
+    """trace.jsonl, one flushed line per time unit."""
+
+    def __init__(self, path: Path | None) -> None:
+        self.fh = open(path, "w", encoding="utf-8") if path is not None else None  # noqa: SIM115
+
+    def write(self, row: dict[str, Any]) -> None:
+        if self.fh is not None:
+            self.fh.write(json.dumps(row, sort_keys=True) + "\n")
+            self.fh.flush()
+
+    def close(self) -> None:
+        if self.fh is not None:
+            self.fh.close()
+            self.fh = None
+
+
+class _Run:
+    """The state of one episode run."""
+
+    def __init__(self, episode: Episode, opts: RunOptions) -> None:
+        from relrl.experiments.fruits import Naming
+        from relrl.kb import KnowledgeBase
+        from relrl.learners import make_learner
+        from relrl.loop import Agent
+        from relrl.sim.metrics import GazeMetrics
+        from relrl.speech import Speaker
+
+        self.episode, self.opts = episode, opts
+        self.kb = KnowledgeBase(episode.domain)
+        self.learner = make_learner(episode.learner, **episode.learner_params)
+        self.agent = Agent(self.kb, self.learner, seed=episode.seed)
+        if episode.policy_load is not None:
+            self.learner.load(episode.policy_load)
+        self.metrics = GazeMetrics(hold=episode.caregiver.get("contact_hold", 3))
+        vocab = {episode.word_for(k) for k in episode.fruits}
+        self.naming = Naming(vocab, (episode.naming or {}).get("confident_after", 3))
+        self.speaker = Speaker(episode.speech.get("voice", "en"),
+                               aloud=bool(episode.speech.get("say")),
+                               stream=opts.stream if opts.live else None)
+        self.rewards: list[float] = []
+        self.phase_stats: dict[str, dict[str, Any]] = {}
+        self.curve: list[dict[str, Any]] = []
+        self.executions: list[dict[str, Any]] = []
+        self.t = 0
+        self.in_view = None
+
+    def close(self) -> None:
+        self.kb.close()
+
+
+def _live_line(t: int, phase: str, record: Any, outcome: str | None, said: str | None) -> str:
+    out = record.out
+    wants = (f"{out.necessity} ({out.outputs.get(out.necessity, 0.0):.2f})"
+             if out.necessity != "none" else
+             "nothing (" + ", ".join(f"{k} {v:.2f}" for k, v in out.outputs.items()) + ")")
+    text = (f"t={t:<4d} [{phase}] perceives: "
+            f"{', '.join(format_term(p) for p in record.percepts)}\n"
+            f"       wants: {wants}  does: {format_term(out.action)}  reward {out.reward:+.0f}")
+    if said:
+        text += f'  says: "{said}"'
+    if outcome:
+        text += f"  naming: {outcome}"
+    return text
+
+
+def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
+    """Trace, naming and live output of one time unit."""
+    info = record.info
+    said = None
+    if record.out.action == "name_object":
+        said = run.naming.point(run.in_view)
+        run.speaker.say(said)
+    outcome = run.naming.hear(info["words"], info.get("features"))
+    run.in_view = info.get("features")
+    run.metrics.add(info["record"])
+    run.rewards.append(float(record.out.reward))
+    stats = run.phase_stats.setdefault(phase, {"steps": 0, "reward": 0.0, "attention": 0})
+    stats["steps"] += 1
+    stats["reward"] += float(record.out.reward)
+    stats["attention"] += int(info["record"].attention)
+    out = record.out
+    trace.write({
+        "t": run.t, "phase": phase,
+        "percepts": [format_term(p) for p in record.percepts],
+        "memory": len(run.kb.memory()),
+        "state": out.code, "necessity": out.necessity,
+        "activation": {k: round(v, 6) for k, v in out.outputs.items()},
+        "reward": out.reward, "response": format_term(out.action),
+        "allowed": [format_term(a) for a in out.allowed],
+        "explanation": run.learner.explain(),
+        "caregiver": info.get("scene"), "focus": info["record"].focus,
+        "heard": info["words"], "naming": outcome, "said": said,
+    })
+    if run.opts.live:
+        print(_live_line(run.t, phase, record, outcome, said), file=run.opts.stream,
+              flush=True)
+
+
+def _pull_words(run: _Run, env: Any) -> None:
+    source = run.opts.words
+    if source is None:
+        return
+    while True:
+        try:
+            word = source.get_nowait()
+        except Exception:  # queue.Empty
+            return
+        if word:
+            env.hear(word)
+
+
+def run_episode(episode: Episode, opts: RunOptions | None = None,
+                stop: StopRequest | None = None) -> dict[str, Any]:
+    """Run an episode; returns the summary (also written to ``out/summary.json``).
+
+    Raises:
+        UserError: a bad device, domain or policy.
+    """
+    from relrl.experiments import fruits
+    from relrl.loop import Interaction
+
+    opts = opts or RunOptions()
+    stop = stop or StopRequest()
+    out = opts.out
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    t0 = time.perf_counter()
+    run = _Run(episode, opts)
+    trace = _Trace(out / "trace.jsonl" if out is not None else None)
+    env = actuator = None
+    try:
+        env, actuator = _world(episode, opts)
+        phase_name = episode.phase_at(1).name
+        interaction = Interaction(env, run.agent, actuator=actuator,
+                                  on_step=lambda r: _on_step(run, trace, r, phase_name))
+        info = interaction.reset(seed=episode.seed)
+        run.in_view = info.get("features")
+        ev = episode.evaluation
+        eval_seeds = [int(s) for s in np.random.SeedSequence([episode.seed, 2])
+                      .generate_state(ev["runs"])] if ev else []
+
+        def evaluate() -> None:
+            point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
+            point["learning_steps"] = run.t
+            run.curve.append(point)
+            if opts.live:
+                print(f"evaluation after {run.t} time units: CGI {point['cgi_mean']:.3f} +- "
+                      f"{point['cgi_std']:.3f}", file=opts.stream, flush=True)
+            interaction.reset(seed=episode.seed + run.t)
+
+        for t in range(1, episode.steps + 1):
+            if stop():
+                break
+            if ev and (t - 1) % ev["every"] == 0:
+                evaluate()
+            phase = episode.phase_at(t)
+            phase_name = phase.name
+            _pull_words(run, env)
+            run.t = t
+            interaction.run(1, learning=phase.learning, keep=False)
+            if opts.step_seconds:
+                time.sleep(opts.step_seconds)
+        if ev and not stop() and episode.steps % ev["every"] == 0:
+            evaluate()
+        if episode.naming and not stop():
+            for k in range(episode.naming["executions"]):
+                if stop():
+                    break
+                res = fruits.naming_execution(run.agent, episode, episode.seed * 1000 + k,
+                                              stop=stop)
+                run.executions.append(res)
+                if opts.live:
+                    print(f"naming execution {k + 1}: {res['counts']} "
+                          f"({res['presentations']} presentations)", file=opts.stream,
+                          flush=True)
+        summary = _summary(run, stopped=stop())
+        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t}
+        if out is not None:
+            _write_outputs(run, out, summary, timing)
+        return summary
+    finally:
+        trace.close()
+        for thing in (actuator, env):
+            if thing is not None:
+                thing.close()
+        run.close()
+
+
+def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
+    from relrl.episodes.devices import DeviceWorld, HeadActuator
+
+    actuator = None
+    if opts.head is not None:
+        from head import open_head
+
+        actuator = HeadActuator(open_head(opts.head, opts.protocol))
+    if opts.camera is not None:
+        from perception import open_camera
+
+        return DeviceWorld(episode, open_camera(opts.camera), actuator), actuator
+    from relrl.episodes.world import EpisodeWorld
+
+    return EpisodeWorld(episode), actuator
+
+
+def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
+    from relrl.experiments import fruits
+
+    m = run.metrics
+    c = m.cgi()
+    e = m.eye_contacts()
+    ep = run.episode
+    summary: dict[str, Any] = {
+        "episode": ep.name, "script": str(ep.path), "seed": ep.seed,
+        "learner": {"name": ep.learner, "params": run.learner.params},
+        "steps": run.t, "planned_steps": ep.steps, "stopped_early": stopped,
+        "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
+        "eye_contacts": e.established, "opportunities": e.opportunities,
+        "mutual_gaze_events": m.mutual_gaze_events,
+        "rewards": {"total": float(sum(run.rewards)),
+                    "mean": float(np.mean(run.rewards)) if run.rewards else 0.0},
+        "phases": run.phase_stats,
+        "naming": {"outcomes": run.naming.counts(), "presentations": len(run.naming.outcomes)},
+        "memory": run.learner.size(),
+    }
+    if run.curve:
+        summary["evaluation"] = run.curve
+    if run.executions:
+        summary["table1"] = {"executions": run.executions,
+                             "rates": fruits.rates(run.executions),
+                             "paper": fruits.PAPER["table1"]}
+    return summary
+
+
+def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
+                   timing: dict[str, Any]) -> None:
+    from relrl.experiments.report import write_json_atomic
+
+    ep = run.episode
+    if ep.policy_save:
+        path = out / ep.policy_save
+        run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
+                               f"seed {ep.seed}, {run.t} time units")
+        summary["policy"] = path.name
+    write_json_atomic(out / "summary.json", summary)
+    write_json_atomic(out / "timing.json", timing)
+    if run.opts.plots:
+        from relrl.episodes.plots import plot_episode
+
+        plot_episode(out, summary, run.rewards)
