@@ -20,13 +20,20 @@ import tempfile
 import wave
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Self
 
 import numpy as np
 
 from relrl.errors import UserError
 
-__all__ = ["Recognizer", "SpeechError", "Speaker", "espeak_available", "synthesise",
-           "sentence_for"]
+__all__ = [
+    "Recognizer",
+    "Speaker",
+    "SpeechError",
+    "espeak_available",
+    "sentence_for",
+    "synthesise",
+]
 
 
 class SpeechError(UserError):
@@ -156,7 +163,7 @@ class Recognizer:
         """Remove the grammar file (safe twice)."""
         self._dir.cleanup()
 
-    def __enter__(self) -> Recognizer:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:

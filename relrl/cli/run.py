@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
         summary = run_episode(episode, opts, stop)
     print(_report(summary))
     if args.out:
-        print(f"wrote {args.out}/trace.jsonl, summary.json"
-              + (f", {summary['policy']}" if "policy" in summary else ""))
+        policy = f", {summary['policy']}" if "policy" in summary else ""
+        print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
     if summary["stopped_early"]:
         print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}; "
               "everything up to it is written", file=sys.stderr)

@@ -17,15 +17,15 @@ __all__ = [
     # scripts
     "Episode",
     "EpisodeError",
-    "Event",
-    "Phase",
-    "load_episode",
-    "parse_episode",
     # the world
     "EpisodeWorld",
+    "Event",
+    "Phase",
     "ProtocolCaregiver",
     # running
     "RunOptions",
     "StopRequest",
+    "load_episode",
+    "parse_episode",
     "run_episode",
 ]

@@ -19,8 +19,16 @@ from typing import Any
 
 from relrl.errors import UserError
 
-__all__ = ["Episode", "EpisodeError", "Event", "Phase", "load_episode", "parse_episode",
-           "PLACES", "OBJECT_PLACES"]
+__all__ = [
+    "OBJECT_PLACES",
+    "PLACES",
+    "Episode",
+    "EpisodeError",
+    "Event",
+    "Phase",
+    "load_episode",
+    "parse_episode",
+]
 
 #: where the head (and the caregiver) can look; ``centre`` is the other's face.
 PLACES: tuple[str, ...] = ("centre", "left", "left_down", "down", "right_down", "right")
@@ -259,8 +267,8 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
     try:
         make_learner(ep.learner, **ep.learner_params)
     except ConfigError as exc:
-        bad = re.search(r"'(\w+)'", str(exc))
-        where = ("learner", bad.group(1)) if bad else ("learner",)
+        bad = [k for k in params if re.search(rf"\b{re.escape(k)}\b", str(exc))]
+        where = ("learner", bad[0]) if bad else ("learner",)
         raise c.fail(where, str(exc)) from None
 
     world = data.get("world", {})

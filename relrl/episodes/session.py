@@ -27,7 +27,7 @@ import numpy as np
 from relrl.episodes.script import Episode
 from relrl.terms import format_term
 
-__all__ = ["RunOptions", "run_episode", "StopRequest"]
+__all__ = ["RunOptions", "StopRequest", "run_episode"]
 
 
 class StopRequest:
@@ -191,13 +191,15 @@ def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
 
 
 def _pull_words(run: _Run, env: Any) -> None:
+    import queue
+
     source = run.opts.words
     if source is None:
         return
     while True:
         try:
             word = source.get_nowait()
-        except Exception:  # queue.Empty
+        except queue.Empty:
             return
         if word:
             env.hear(word)

@@ -26,7 +26,7 @@ from relrl.interfaces import Environment
 from relrl.sim.metrics import StepRecord
 from relrl.terms import Term, format_term
 
-__all__ = ["EpisodeWorld", "ProtocolCaregiver", "Scene", "GAZE_POSE", "KIND_COLOUR"]
+__all__ = ["GAZE_POSE", "KIND_COLOUR", "EpisodeWorld", "ProtocolCaregiver", "Scene"]
 
 #: the head pose a caregiver shows while looking at each place (perception's vocabulary).
 GAZE_POSE: dict[str, str] = {"centre": "frontal", "left": "left_2", "left_down": "left_1",
@@ -71,8 +71,9 @@ class ProtocolCaregiver:
       it, and, with ``gaze_attention`` (default), in every time unit the robot looks at its
       face (Triesch et al.'s reward for looking at the caregiver, as in Experiment 1); a new
       opportunity starts after ``contact_timeout`` units without contact.
-    * ``present`` (only when the phase has objects): after eye contact, a fruit appears at a
-      place and the caregiver turns to it (random in learning, a fixed cycle in evaluation).
+    * ``present`` (only when the phase has objects): with ``latency`` 0 (default), in the time
+      unit of eye contact a fruit appears at a place and the caregiver turns to it (random in
+      learning, a fixed cycle in evaluation); otherwise ``latency`` units later.
     * ``attend``: when the robot looks at the fruit the caregiver looks at, the caregiver gives
       attention and says the fruit's name (``hear(Word)``); after ``timeout`` units without it
       the fruit is removed.
@@ -112,6 +113,13 @@ class ProtocolCaregiver:
         return (self.places[int(self.rng.integers(len(self.places)))],
                 self.fruits[int(self.rng.integers(len(self.fruits)))])
 
+    def _present(self) -> None:
+        s = self.scene
+        s.trial += 1
+        place, self._kind = self._next_fruit()
+        s.objects, s.look, s.target = {place: self._kind}, place, place
+        s.mode, self._timer = "attend", 0
+
     def _end_trial(self) -> None:
         s = self.scene
         s.objects, s.look, s.mode, s.target = {}, "centre", "engage", None
@@ -130,18 +138,17 @@ class ProtocolCaregiver:
             if self._streak >= p["contact_hold"]:
                 s.attention = True
                 s.contact = self._streak == p["contact_hold"]
-                if objects:
+                if objects and p["latency"] == 0:
+                    self._present()
+                elif objects:
                     s.mode, self._timer = "present", 0
             elif self._timer >= p["contact_timeout"]:
                 s.opportunity += 1
                 self._timer = 0
         elif s.mode == "present":
             self._timer += 1
-            if self._timer > p["latency"]:
-                s.trial += 1
-                place, self._kind = self._next_fruit()
-                s.objects, s.look, s.target = {place: self._kind}, place, place
-                s.mode, self._timer = "attend", 0
+            if self._timer >= p["latency"]:
+                self._present()
         elif s.mode == "attend":
             self._timer += 1
             if focus == s.target:

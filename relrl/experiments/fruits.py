@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["PAPER", "OUTCOMES", "Naming", "evaluate_cgi", "naming_execution", "rates"]
+__all__ = ["OUTCOMES", "PAPER", "Naming", "evaluate_cgi", "naming_execution", "rates"]
 
 #: Table 1 outcomes, in the paper's order of the table.
 OUTCOMES: tuple[str, ...] = ("unknown", "correct_guess", "incorrect_guess", "error", "success")
