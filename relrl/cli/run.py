@@ -86,9 +86,10 @@ def run(args: argparse.Namespace) -> int:
 
 def _report(s: dict) -> str:
     cgi = "n/a" if s["cgi"] is None else f"{s['cgi']:.3f}"
-    lines = [f"{s['episode']}: {s['steps']} time units, CGI {cgi} ({s['correct_shifts']}/"
-             f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
-             f"reward {s['rewards']['total']:+.0f}"]
+    head = (f"{s['episode']}: {s['steps']} time units, CGI {cgi} ({s['correct_shifts']}/"
+            f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
+            f"reward {s['rewards']['total']:+.0f}")
+    lines = [head]
     for p in s.get("evaluation", []):
         lines.append(f"  evaluation after {p['learning_steps']:4d} time units: CGI "
                      f"{p['cgi_mean']:.3f} +- {p['cgi_std']:.3f}")
