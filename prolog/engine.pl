@@ -113,7 +113,8 @@ engine_end_episode(KB) :-
 %
 %   One control step. Percepts are this step's perception facts; Emitted is the index
 %   (0-based, in declaration order) of the response emitted at the previous step, or -1;
-%   Learning is true to update the learner from the previous step and explore, false to
+%   Learning is `true` to update the learner from the previous step and explore,
+%   `explore` to act with the learner's exploration (epsilon) without learning, `false` to
 %   act greedily without learning.
 %
 %   Out = step(Code, Necessity, Ys, Reward, Allowed, Action): the state code, the active
@@ -208,7 +209,7 @@ learn(external, _, _, _, _, _, _, _, _, _, _).
 
 choose(_, _, _, _, [], _, _, none) :- !.
 choose(etg, KB, D, N, Allowed, Learning, Params0, Action) :-
-    (   Learning == true
+    (   Learning \== false
     ->  Params = Params0
     ;   Params = [epsilon=0|Params0]
     ),

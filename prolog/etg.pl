@@ -113,8 +113,11 @@ allowed_or_any(Allowed, A) :- memberchk(A, Allowed).
 insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
     qtree_sort(KB, D, Where),
     (   Where = null(Parent, Branch)
-    ->  Q is Qinit + Alpha * (Target - Qinit),
-        qtree_grow(KB, Parent, Branch, D, [e(A, Q, N)], _)
+    ->  leaf_entries(KB, D, Inherited),
+        qtree_entry_q(Inherited, A, N, Qinit, Old),
+        Q is Old + Alpha * (Target - Old),
+        qtree_put_entry(Inherited, e(A, Q, N), Entries),
+        qtree_grow(KB, Parent, Branch, D, Entries, _)
     ;   Where = leaf(Id),
         qtree_leaf(KB, Id, Rep0, Entries0),
         qtree_entry_q(Entries0, A, N, Qinit, Old),

@@ -45,17 +45,29 @@ class Agent:
         self.steps = 0
         self.states: set[int] = set()
 
-    def step(self, percepts: Sequence[Term], *, learning: bool = True) -> StepOut:
+    def step(self, percepts: Sequence[Term], *, learning: bool = True,
+             explore: bool | None = None) -> StepOut:
         """One control step from this time unit's percepts; returns what happened and the
-        response to emit (``out.action``)."""
+        response to emit (``out.action``).
+
+        Args:
+            percepts: this time unit's perception facts.
+            learning: update the learner from the previous step.
+            explore: keep the learner's exploration (epsilon); by default only when learning.
+                Evaluating with ``learning=False, explore=True`` measures the behaviour the
+                robot shows, without changing what it knows.
+        """
+        if explore is None:
+            explore = learning
+        mode = "true" if learning else ("explore" if explore else "false")
         (raw,) = self.kb.call("relrl_engine:engine_step", self.kb.module, list(percepts),
-                              self._emitted, "true" if learning else "false", Var())
+                              self._emitted, mode, Var())
         _, code, necessity, ys, reward, allowed, action = raw
         responses = self.responses
         out = StepOut(code, necessity, dict(zip(self.necessities, ys, strict=True)), reward,
                       [responses[i] for i in allowed], responses[action] if action >= 0 else "none")
         out.extra["allowed_index"] = allowed
-        out.action = self.learner.act(out, learning)
+        out.action = self.learner.act(out, learning, explore)
         self.emitted = out.action
         self._emitted = self._index_of(out.action)
         self.steps += 1
@@ -121,8 +133,11 @@ class Interaction:
         _, self.info = self.env.reset(seed=seed, options=options)
         return self.info
 
-    def run(self, steps: int, *, learning: bool = True, keep: bool = True) -> list[StepRecord]:
-        """Run ``steps`` time units; returns their records (none when ``keep`` is False)."""
+    def run(self, steps: int, *, learning: bool = True, explore: bool | None = None,
+            keep: bool = True) -> list[StepRecord]:
+        """Run ``steps`` time units; returns their records (none when ``keep`` is False).
+
+        ``learning`` and ``explore`` are as in :meth:`Agent.step`."""
         if self.info is None:
             self.reset()
         assert self.info is not None
@@ -131,7 +146,7 @@ class Interaction:
         info = self.info
         for _ in range(steps):
             percepts = info["percepts"]
-            out = agent.step(percepts, learning=learning)
+            out = agent.step(percepts, learning=learning, explore=explore)
             if actuator is not None and out.action != "none":
                 actuator.emit(out.action)
             _, env_reward, terminated, truncated, info = env.step(out.action)

@@ -53,6 +53,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         metavar="NAME=VALUE", help="override a caregiver parameter (repeatable)")
     parser.add_argument("--param", type=_param, action="append", default=[],
                         metavar="LEARNER.NAME=X", help="learner parameter (repeatable)")
+    parser.add_argument("--eval-policy", choices=["behaviour", "greedy"], default="behaviour",
+                        help="evaluate the robot's behaviour (exploration kept, the default) "
+                             "or the greedy policy")
     parser.add_argument("--domain", default=None, help="domain file (default sis.pl)")
     parser.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
     parser.add_argument("--quick", action="store_true", help="a short run (under a minute)")
@@ -84,6 +87,7 @@ def build_config(args: argparse.Namespace):
                         ("--eval-steps", config.eval_steps), ("--block", config.block)]:
         if value < 1:
             raise ConfigError(f"{what} must be at least 1, not {value}")
+    config.eval_policy = args.eval_policy
     config.caregiver = args.caregiver
     config.caregiver_params.update(dict(args.caregiver_param))
     make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker

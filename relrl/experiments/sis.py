@@ -56,6 +56,9 @@ class SISConfig:
         default_factory=lambda: {"attention_during_gaze": True})
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     domain: str = str(DEFAULT_DOMAIN)
+    #: "behaviour": evaluate the robot as it behaves (its exploration kept, no learning);
+    #: "greedy": the learners' greedy policy (contingency's roulette stays a roulette).
+    eval_policy: str = "behaviour"
 
     def jobs(self) -> list[tuple[str, int]]:
         """Every (learner, seed) pair, learners first."""
@@ -113,7 +116,8 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
                 metrics = GazeMetrics()
                 ev = Interaction(eval_env, agent, on_step=lambda r: metrics.add(r.info["record"]))
                 ev.reset(seed=int(run_seed))
-                ev.run(config.eval_steps, learning=False, keep=False)
+                ev.run(config.eval_steps, learning=False,
+                       explore=config.eval_policy == "behaviour", keep=False)
                 steps += config.eval_steps
                 values.append(_nan_to_zero(metrics.cgi().value))
             agent.end_episode()

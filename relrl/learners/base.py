@@ -105,7 +105,7 @@ class Learner(abc.ABC):
                 seed if seed is not None else "none")
         self.responses: list[Term] = kb.declarations("response")
 
-    def act(self, out: StepOut, learning: bool) -> Term:
+    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term:
         """Return the response to emit. Prolog learners have already chosen."""
         return out.action
 

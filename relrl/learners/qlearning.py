@@ -23,14 +23,14 @@ class QLearner(Learner):
     Rows are added the first time a (state, necessity) pair is met (Algorithm 1: "if not
     have n_i defined then insert n_i on Q-table"); columns are the domain's responses in
     declaration order. Choice is epsilon-greedy over the allowed responses, ties broken at
-    random; learning off means greedy.
+    random; without exploration (evaluation) greedy.
 
     Parameters: alpha, gamma, epsilon, q_init.
     """
 
     name = "qlearning"
     engine = "external"
-    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 0.0}
+    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0}
 
     def attach(self, kb, seed):  # type: ignore[override]
         super().attach(kb, seed)
@@ -51,7 +51,7 @@ class QLearner(Learner):
             self._rows[key] = row
         return row
 
-    def act(self, out: StepOut, learning: bool) -> Term:
+    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term:
         """Update Q for the previous step (Eq. 3), then choose epsilon-greedily."""
         row = self._row(out.code, out.necessity)
         allowed = [self._index[format_term(r)] for r in out.allowed]
@@ -63,7 +63,9 @@ class QLearner(Learner):
         if not allowed:
             self._prev = None
             return "none"
-        epsilon = self.params["epsilon"] if learning else 0.0
+        if explore is None:
+            explore = learning
+        epsilon = self.params["epsilon"] if explore else 0.0
         if epsilon > 0 and self.rng.random() < epsilon:
             choice = allowed[int(self.rng.integers(len(allowed)))]
         else:
