@@ -69,9 +69,14 @@ class MotionModel:
         return now + TIME_EPS < self.end_time()
 
     def command(self, now: float, pose: Mapping[str, int], speeds: Mapping[str, float]) -> float:
-        """Start a move from where the servos are at ``now``; returns its duration in s."""
+        """Start a move from where the servos are at ``now``; returns its duration in s.
+
+        The duration is until every servo arrives, including servos still on their way to
+        an earlier target.
+        """
         self.start = self.at(now)
-        self.target = {**self.start, **{n: float(v) for n, v in pose.items()}}
+        # servos left out of the pose keep going to their previous targets
+        self.target = {**self.target, **{n: float(v) for n, v in pose.items()}}
         self.speed = {**self.speed, **speeds}
         self.t0 = now
         return self.end_time() - now

@@ -139,3 +139,15 @@ def test_tick_refuses_negative_time():
 def test_sim_checks_the_protocol_name_anyway():
     with pytest.raises(UnknownProtocol, match="did you mean 'maestro'"):
         open_head("sim", "maestro2")
+
+
+def test_partial_move_does_not_stop_servos_still_moving(fast_cal):
+    """Bug found by the property tests: a move of one servo froze the others mid-way."""
+    head = SimHead(fast_cal)
+    head.move_to({"neck_pan": 2000, "neck_tilt": 1800}, speed=100)  # 5 s and 3 s
+    head.tick(1.0)
+    head.move_to({"eye_pan": 1600})
+    assert head.wait(timeout=10.0)
+    assert head.positions()["neck_pan"] == 2000.0
+    assert head.positions()["neck_tilt"] == 1800.0
+    assert head.time == pytest.approx(5.0)
