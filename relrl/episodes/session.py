@@ -242,7 +242,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             if opts.live:
                 print(f"evaluation after {run.t} time units: CGI {point['cgi_mean']:.3f} +- "
                       f"{point['cgi_std']:.3f}", file=opts.stream, flush=True)
-            interaction.reset(seed=episode.seed + run.t)
+            # learning resumes where it stopped: the world keeps its time line (and phase)
 
         for t in range(1, episode.steps + 1):
             if stop():

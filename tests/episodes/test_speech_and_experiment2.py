@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -40,7 +41,7 @@ def test_experiment2_small_on_rendered_frames(tmp_path: Path) -> None:
     text = (ROOT / "examples" / "episodes" / "experiment2.toml").read_text()
     text = text.replace('"../domains/fruits.pl"', f'"{ROOT / "examples/domains/fruits.pl"}"')
     for old, new in [("steps = 30", "steps = 6"), ("steps = 70", "steps = 14"),
-                     ("every = 10", "every = 20"), ("runs = 5", "runs = 1"),
+                     ("every = 10", "every = 10"), ("runs = 5", "runs = 1"),
                      ("steps = 100", "steps = 20"), ("executions = 5", "executions = 2"),
                      ("presentations = 40", "presentations = 4"),
                      ("max_steps = 1500", "max_steps = 60")]:
@@ -48,7 +49,10 @@ def test_experiment2_small_on_rendered_frames(tmp_path: Path) -> None:
         text = text.replace(old, new, 1)
     ep = parse_episode(text, tmp_path / "exp2.toml")
     s = run_episode(ep, RunOptions(out=tmp_path / "out"))
-    assert [p["learning_steps"] for p in s["evaluation"]] == [0, 20]
+    assert [p["learning_steps"] for p in s["evaluation"]] == [0, 10, 20]
+    # regression: an evaluation must not send the learning world back to its first phase
+    rows = [json.loads(x) for x in (tmp_path / "out" / "trace.jsonl").read_text().splitlines()]
+    assert any(r["caregiver"]["objects"] for r in rows if r["phase"] == "fruits")
     assert all(0.0 <= p["cgi_mean"] <= 1.0 for p in s["evaluation"])
     t1 = s["table1"]
     assert len(t1["executions"]) == 2 and t1["paper"] == PAPER["table1"]

@@ -170,3 +170,26 @@ def test_live_session_prints_and_hears_typed_words(tmp_path: Path, capsys, monke
     out = capsys.readouterr().out
     assert out.count("perceives:") == 3 and "wants:" in out and "does:" in out
     assert "hear(apple)" in out
+
+
+def test_evaluation_does_not_rewind_the_learning_phases(tmp_path: Path) -> None:
+    ep = parse_episode(script("""
+[caregiver]
+contact_hold = 1
+[[phase]]
+name = "no objects"
+steps = 5
+objects = false
+[[phase]]
+name = "fruits"
+steps = 20
+[evaluation]
+every = 5
+runs = 1
+steps = 5
+"""), tmp_path / "e.toml")
+    s = run_episode(ep, RunOptions(out=tmp_path, plots=False))
+    assert [p["learning_steps"] for p in s["evaluation"]] == [0, 5, 10, 15, 20, 25]
+    rows = [json.loads(x) for x in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    assert not any(r["caregiver"]["objects"] for r in rows if r["phase"] == "no objects")
+    assert any(r["caregiver"]["objects"] for r in rows if r["t"] > 10)
