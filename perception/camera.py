@@ -89,7 +89,12 @@ class _Capture(Camera):
 
         super().__init__()
         self.name = what
-        self._cap = cv2.VideoCapture(target)
+        level = cv2.utils.logging.getLogLevel()
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)  # one-line errors
+        try:
+            self._cap = cv2.VideoCapture(target)
+        finally:
+            cv2.utils.logging.setLogLevel(level)
         if not self._cap.isOpened():
             self._cap.release()
             self._closed = True

@@ -93,9 +93,10 @@ class Perceiver:
             out.facts += [("see", "face"), ("pose", "face", face.pose),
                           ("pan", "face", float(face.pan)), ("tilt", "face", float(face.tilt))]
             x, y, w, h = face.box
-            # the caregiver: the head (with hair) and the body below it are not objects
-            exclude.append((x - w // 3, y - h, w + 2 * (w // 3), 5 * h // 2))
-            exclude.append((x - 3 * w // 2, y + h, 4 * w, frame.shape[0]))
+            # the caregiver: the head (with hair) and the body below it (the whole width of
+            # the frame under the face) are not objects
+            exclude.append((x - w, y - h, 3 * w, 5 * h // 2))
+            exclude.append((0, y + h, frame.shape[1], frame.shape[0]))
         area = most_salient(frame, self.saliency, exclude=exclude)
         if area is not None:
             out.area = area

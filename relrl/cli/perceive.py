@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 HELP = "print the perception facts of an image (or camera frames) as Prolog terms"
-EXAMPLE = "relrl perceive photo.png --annotate out.png   |   relrl perceive --camera synthetic://"
+EXAMPLE = "relrl perceive photo.png --annotate out.png"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

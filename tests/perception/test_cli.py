@@ -28,6 +28,7 @@ def test_errors_are_one_line_exit_2(tmp_path, capsys):
     bad.write_text("x")
     for argv in (["perceive", str(tmp_path / "missing.png")], ["perceive", str(bad)],
                  ["perceive", "--camera", "cam://nope"], ["perceive"],
+                 ["perceive", "--camera", "cam://97"],
                  ["perceive", "--camera", "ftp://x"]):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err

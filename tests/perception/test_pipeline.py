@@ -16,6 +16,12 @@ def test_facts_for_the_caregiver():
     assert ("see", "object") not in facts  # the caregiver's body is not an object
 
 
+@pytest.mark.parametrize("pose", ["left_2", "right_2", "down"])
+def test_the_caregivers_head_is_not_an_object(pose):
+    facts = perceive(render(SceneView("centre", pose, seed=4)))
+    assert ("pose", "face", pose) in facts and ("see", "object") not in facts
+
+
 def test_facts_for_a_fruit_where_the_head_looks():
     frame = render(SceneView("left_down", None, {"left_down": "apple"}))
     assert perceive(frame, looking_at="left_down") == [
