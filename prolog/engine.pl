@@ -119,11 +119,12 @@ engine_end_episode(KB) :-
 %
 %   Out = step(Code, Necessity, Ys, Reward, Allowed, Action): the state code, the active
 %   necessity (or none), the necessity units' outputs (a list in declaration order), the
-%   reward for the previous response, the indices of the allowed responses, and the index
-%   of the learner's choice (-1 for learners outside Prolog or when nothing is allowed).
+%   reward for the previous response, the allowed responses as a bit mask (bit i set when
+%   response i is allowed), and the index of the learner's choice (-1 for learners outside
+%   Prolog or when nothing is allowed).
 %   Indices keep the bridge to Python cheap; engine_responses/2 maps them to terms.
 
-engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, AllowedIx,
+engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, AllowedMask,
                                                     ActionIx)) :-
     config(KB, responses, Responses),
     (   EmittedIx >= 0
@@ -147,6 +148,7 @@ engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, Al
     ;   Reinforced = false, memberchk(reward_negative=Reward, Params)
     ),
     allowed(KB, Responses, AllowedIx, Allowed),
+    foldl(set_bit, AllowedIx, 0, AllowedMask),
     config(KB, learner, Learner),
     (   Learning == true,
         Emitted \== none,
@@ -196,6 +198,9 @@ allowed(KB, Responses, AllowedIx, Allowed) :-
     ;   findall(I-R, nth0(I, Responses, R), Pairs)
     ),
     pairs_keys_values(Pairs, AllowedIx, Allowed).
+
+set_bit(I, M0, M) :-
+    M is M0 \/ (1 << I).
 
 forbidden(KB, R) :-
     catch(KB:forbidden(R), error(existence_error(procedure, _), _), fail),

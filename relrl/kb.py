@@ -36,7 +36,7 @@ from typing import Any
 from relrl.errors import PrologError, PrologLoadError, QueryTimeout, RelrlError
 from relrl.terms import Term, Var
 
-__all__ = ["KnowledgeBase", "Problem", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
+__all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
 
 #: Where the knowledge layer's .pl files live (override with RELRL_PROLOG_DIR).
 PROLOG_DIR = Path(os.environ.get("RELRL_PROLOG_DIR",
@@ -55,6 +55,31 @@ _BUF_DISCARDABLE = 0x0
 _PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
 
 _KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
+_MAX_RECORDS = 4096
+
+
+class Cached:
+    """A ground term that recurs (a percept list of the simulator): built in Prolog once,
+    then copied from Prolog's record database, one foreign call instead of one per node.
+
+    Args:
+        value: the term (ground: no :class:`~relrl.terms.Var`).
+        key: a hashable key equal for equal terms (default: ``value`` made hashable).
+    """
+
+    __slots__ = ("value", "key")
+
+    def __init__(self, value: Term, key: Any = None) -> None:
+        self.value = value
+        self.key = key if key is not None else _hashable(value)
+
+
+def _hashable(value: Term) -> Any:
+    if isinstance(value, list):
+        return ("[]", *map(_hashable, value))
+    if isinstance(value, tuple):
+        return tuple(map(_hashable, value))
+    return (type(value).__name__, value)
 
 
 @dataclass(frozen=True)
@@ -119,6 +144,10 @@ class _Engine:
         self.call_predicate = fn("PL_call_predicate", c_int, c_void_p, c_int, c_void_p, T)
         self.exception = fn("PL_exception", T, T)
         self.clear_exception = fn("PL_clear_exception", None)
+        self.record = fn("PL_record", c_void_p, T)
+        self.recorded = fn("PL_recorded", c_int, c_void_p, T)
+        self.erase = fn("PL_erase", None, c_void_p)
+        self._records: dict[Any, int] = {}
         self.mark_strings = fn("PL_mark_string_buffers", None, POINTER(c_size_t))
         self.release_strings = fn("PL_release_string_buffers_from_mark", None, c_size_t)
 
@@ -173,6 +202,18 @@ class _Engine:
                 for item in reversed(value):
                     self.put(head, item, variables)
                     self.cons_list(t, head, t)
+        elif isinstance(value, Cached):
+            rec = self._records.get(value.key)
+            if rec is None:
+                if len(self._records) >= _MAX_RECORDS:
+                    for old in self._records.values():
+                        self.erase(old)
+                    self._records.clear()
+                self.put(t, value.value, variables)
+                rec = self.record(t)
+                self._records[value.key] = rec
+            else:
+                self.recorded(rec, t)
         elif isinstance(value, Var):
             known = variables.get(id(value))
             if known is None:

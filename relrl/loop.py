@@ -15,7 +15,7 @@ from typing import Any
 
 from relrl.errors import UserError
 from relrl.interfaces import Actuator, Environment
-from relrl.kb import KnowledgeBase
+from relrl.kb import Cached, KnowledgeBase
 from relrl.learners.base import Learner, StepOut
 from relrl.terms import Term, Var
 
@@ -60,10 +60,12 @@ class Agent:
         if explore is None:
             explore = learning
         mode = "true" if learning else ("explore" if explore else "false")
-        (raw,) = self.kb.call("relrl_engine:engine_step", self.kb.module, list(percepts),
+        (raw,) = self.kb.call("relrl_engine:engine_step", self.kb.module,
+                              Cached(percepts if isinstance(percepts, list) else list(percepts)),
                               self._emitted, mode, Var())
-        _, code, necessity, ys, reward, allowed, action = raw
+        _, code, necessity, ys, reward, mask, action = raw
         responses = self.responses
+        allowed = [i for i in range(len(responses)) if mask >> i & 1]
         out = StepOut(code, necessity, dict(zip(self.necessities, ys, strict=True)), reward,
                       [responses[i] for i in allowed], responses[action] if action >= 0 else "none")
         out.extra["allowed_index"] = allowed

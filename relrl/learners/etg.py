@@ -22,7 +22,7 @@ class ETGLearner(Learner):
     name = "etg"
     engine = "etg"
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0,
-                "split_threshold": 0.5}
+                "split_threshold": 0.1}
 
     def _size_from(self, size: Term) -> dict[str, int]:
         _, nodes, leaves, entries, positions = size
