@@ -45,11 +45,12 @@ _WHERE = {
     "render": "perception.render", "open_camera": "perception.camera",
     "ART2": "perception.art2", "FruitNamer": "perception.art2",
     "PLACES": "perception.vocab", "POSES": "perception.vocab", "COLOURS": "perception.vocab",
-    "bench": "perception.bench",
 }
 
 
 def __getattr__(name: str) -> Any:
+    if name == "bench":  # the submodule, which is callable as the bench() function
+        return import_module("perception.bench")
     if name in _WHERE:
         return getattr(import_module(_WHERE[name]), name)
     raise AttributeError(f"module 'perception' has no attribute {name!r}")

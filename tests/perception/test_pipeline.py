@@ -79,3 +79,13 @@ def test_annotate_draws_without_changing_the_frame():
     before = frame.copy()
     out = annotate(frame, Perceiver().analyse(frame))
     assert np.array_equal(frame, before) and not np.array_equal(out, frame)
+
+
+def test_bench_is_callable_from_the_package():
+    import perception
+
+    out = perception.bench(frames=12, faces=False)
+    assert out["fps_320x240"] > 0 and out["fps_640x480_cold"] > 0
+    import perception.bench as module
+
+    assert callable(module) and module.bench is not None
