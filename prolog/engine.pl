@@ -9,7 +9,10 @@
             engine_save/3,        % +KB, +File, +Header
             engine_adopt/1,       % +KB
             engine_param/3,       % +KB, ?Name, ?Value
-            engine_responses/2    % +KB, -Responses
+            engine_responses/2,   % +KB, -Responses
+            engine_save_random/1, % +Slot
+            engine_restore_random/1, % +Slot
+            engine_set_random/1   % +SeedSpec
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -164,6 +167,31 @@ engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, Al
     ),
     retractall(prev_(KB, _, _)),
     assertz(prev_(KB, D, Active)).
+
+%!  engine_save_random(+Slot) is det.
+%!  engine_restore_random(+Slot) is det.
+%!  engine_set_random(+SeedSpec) is det.
+%
+%   Save the state of Prolog's random numbers under the atom Slot, restore it, or seed
+%   them (seed(N)): an evaluation can draw its own numbers without changing the learner's
+%   future.
+
+engine_save_random(Slot) :-
+    must_be(atom, Slot),
+    random_property(state(S)),
+    atom_concat('$relrl_random:', Slot, Key),
+    nb_setval(Key, S).
+
+engine_restore_random(Slot) :-
+    atom_concat('$relrl_random:', Slot, Key),
+    nb_getval(Key, S),
+    set_random(state(S)).
+
+engine_set_random(Spec) :-
+    (   ( Spec = state(_) ; Spec = seed(_) )
+    ->  set_random(Spec)
+    ;   domain_error(random_spec, Spec)
+    ).
 
 %!  engine_responses(+KB, -Responses:list) is det.
 %

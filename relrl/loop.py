@@ -76,6 +76,24 @@ class Agent:
         self.states.add(code)
         return out
 
+    def save_random(self) -> Any:
+        """Save the state of every random stream the agent draws from (Prolog's, the
+        learner's); :meth:`restore_random` puts it back."""
+        self.kb.call("relrl_engine:engine_save_random", self.kb.module)
+        return self.learner.rng.bit_generator.state
+
+    def restore_random(self, saved: Any) -> None:
+        """Restore the random streams saved by :meth:`save_random`."""
+        self.kb.call("relrl_engine:engine_restore_random", self.kb.module)
+        self.learner.rng.bit_generator.state = saved
+
+    def reseed(self, seed: int) -> None:
+        """Seed every random stream the agent draws from."""
+        import numpy as np
+
+        self.kb.call("relrl_engine:engine_set_random", ("seed", int(seed)))
+        self.learner.rng = np.random.default_rng(int(seed))
+
     def _index_of(self, action: Term) -> int:
         if action == "none":
             return -1

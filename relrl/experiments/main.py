@@ -9,7 +9,7 @@ from typing import Any
 
 from relrl.experiments.report import aggregate, write_outputs
 from relrl.experiments.runner import run_jobs
-from relrl.experiments.sis import PAPER, SISConfig, run_job
+from relrl.experiments.sis import PAPER, SISConfig, merge_parts, run_job
 
 __all__ = ["run_sis"]
 
@@ -22,8 +22,14 @@ def run_sis(config: SISConfig, out_dir: str | Path, *, workers: int = 1
     out = Path(out_dir)
     t0 = time.perf_counter()
     jobs = config.jobs()
-    raw = run_jobs(run_job, [(config, name, seed) for name, seed in jobs], workers=workers,
-                   units_per_job=config.points + 1)
+    # Split each job's evaluation runs over the workers so that few jobs still fill them.
+    n_parts = max(1, min(workers, config.eval_runs)) if workers > 1 else 1
+    bounds = [(config.eval_runs * k // n_parts, config.eval_runs * (k + 1) // n_parts)
+              for k in range(n_parts)]
+    tasks = [(config, name, seed, None, b) for name, seed in jobs for b in bounds]
+    parts = run_jobs(run_job, tasks, workers=workers, units_per_job=config.points + 1)
+    raw = [merge_parts([p for p in parts if (p["learner"], p["seed"]) == (name, seed)])
+           for name, seed in jobs]
     wall = time.perf_counter() - t0
     timing = {"wall_seconds": wall, "workers": workers, "python": platform.python_version(),
               "machine": platform.machine(),

@@ -56,8 +56,9 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
                              "opportunities": n_opp,
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
-            "states_met": float(np.mean([j["states_met"]["all"] for j in mine])),
-            "states_met_learning": float(np.mean([j["states_met"]["learning"] for j in mine])),
+            "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
+            "states_met_evaluation": float(np.mean([j["states_met"]["evaluation"]
+                                                    for j in mine])),
         }
     return out
 

@@ -31,7 +31,8 @@ def _report(*item: Any) -> None:
 
 
 def _call(job: Callable[..., dict[str, Any]], args: tuple) -> dict[str, Any]:
-    return job(*args, progress=_report)
+    args = tuple(_report if a is None and i == 3 else a for i, a in enumerate(args))
+    return job(*args)
 
 
 class ProgressBar:
@@ -62,7 +63,8 @@ class ProgressBar:
 
 def run_jobs(job: Callable[..., dict[str, Any]], arglist: list[tuple], *, workers: int,
              units_per_job: int) -> list[dict[str, Any]]:
-    """Run ``job(*args, progress=...)`` for every args tuple; results in input order.
+    """Run ``job(*args)`` for every args tuple, with the progress callback put in place of
+    the ``None`` at position 3; results in input order.
 
     ``workers`` <= 1 runs in this process (one Prolog engine here); more uses that many
     spawned worker processes.
@@ -75,7 +77,11 @@ def run_jobs(job: Callable[..., dict[str, Any]], arglist: list[tuple], *, worker
 
     try:
         if workers <= 1 or len(arglist) == 1:
-            return [job(*args, progress=lambda *i: bar.update(label(i))) for args in arglist]
+            def report(*item: Any) -> None:
+                bar.update(label(item))
+
+            return [job(*(report if a is None and i == 3 else a for i, a in enumerate(args)))
+                    for args in arglist]
         ctx = mp.get_context("spawn")
         q = ctx.Queue()
         stop = threading.Event()

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SISConfig", "run_job", "DEFAULT_DOMAIN", "PAPER"]
+__all__ = ["SISConfig", "run_job", "merge_parts", "DEFAULT_DOMAIN", "PAPER"]
 
 DEFAULT_DOMAIN = Path(__file__).resolve().parents[2] / "examples" / "domains" / "sis.pl"
 
@@ -74,14 +74,23 @@ def _nan_to_zero(x: float) -> float:
 
 
 def run_job(config: SISConfig, learner_name: str, seed: int,
-            progress: Callable[[str, int, int], None] | None = None) -> dict[str, Any]:
+            progress: Callable[[str, int, int], None] | None = None,
+            runs: tuple[int, int] | None = None) -> dict[str, Any]:
     """Run one learner with one seed through the whole protocol.
 
+    Each evaluation run draws from random streams seeded for that run alone, and the
+    learner's own streams are saved before an evaluation and restored after it: learning
+    never depends on how much evaluating was done, and evaluation run *k* gives the same
+    numbers whichever process computes it. ``runs=(start, stop)`` computes only those
+    evaluation runs (the runner splits a job's evaluation over worker processes; each
+    part repeats the short learning phase).
+
     Returns a JSON-ready dict: the CGI of every evaluation run at every point, the eye
-    contacts of the first opportunities, the learner's memory, the distinct states met.
+    contacts of the first opportunities, the learner's memory, the states met.
     Wall-clock figures go under ``"timing"`` (kept out of results.json so that the same
     seed gives the same file).
     """
+    start, stop = runs if runs is not None else (0, config.eval_runs)
     from relrl.kb import KnowledgeBase, gateway_calls
     from relrl.learners import make_learner
     from relrl.loop import Agent, Interaction
@@ -107,12 +116,17 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
         learning.reset(seed=seed)
         eval_seeds = np.random.SeedSequence([seed, 1]).generate_state(config.eval_runs)
         learning_states: set[int] = set()
+        eval_states: set[int] = set()
         steps = 0
 
         def evaluate() -> list[float]:
             nonlocal steps
             values = []
-            for run_seed in eval_seeds:
+            saved = agent.save_random()
+            before = set(agent.states)
+            agent.states.clear()
+            for run_seed in eval_seeds[start:stop]:
+                agent.reseed(int(run_seed))
                 metrics = GazeMetrics()
                 ev = Interaction(eval_env, agent, on_step=lambda r: metrics.add(r.info["record"]))
                 ev.reset(seed=int(run_seed))
@@ -121,16 +135,16 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
                 steps += config.eval_steps
                 values.append(_nan_to_zero(metrics.cgi().value))
             agent.end_episode()
+            agent.restore_random(saved)
+            eval_states.update(agent.states)
+            agent.states = before
             return values
 
         curve = []
         for point in range(config.points + 1):
             if point > 0:
-                before = set(agent.states)
-                agent.states.clear()
                 learning.run(config.block, learning=True, keep=False)
                 learning_states |= agent.states
-                agent.states |= before
                 steps += config.block
             values = evaluate()
             curve.append({"point": point, "learning_steps": point * config.block,
@@ -150,7 +164,10 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
             "mutual_gaze_events": learning_metrics.mutual_gaze_events,
             "learning_cgi": _nan_to_zero(learning_metrics.cgi().value),
             "memory": learner.size(),
-            "states_met": {"learning": len(learning_states), "all": len(agent.states)},
+            "states_met": {"learning": len(learning_states),
+                           "all": len(learning_states | eval_states)},
+            "runs": [start, stop],
+            "eval_states": sorted(eval_states),
         }
         elapsed = time.perf_counter() - t_start
         calls = gateway_calls() - calls0
@@ -160,3 +177,37 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
         return result
     finally:
         kb.close()
+
+
+def merge_parts(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    """Join the parts of one (learner, seed) job computed by different processes.
+
+    The learning phase is the same in every part (it never depends on the evaluation);
+    the evaluation runs are concatenated in order.
+    """
+    parts = sorted(parts, key=lambda p: p["runs"][0])
+    first = parts[0]
+    for p in parts[1:]:
+        for key in ("eye_contacts", "memory", "mutual_gaze_events", "learning_cgi"):
+            if p[key] != first[key]:
+                raise RuntimeError(f"parts of {first['learner']} seed {first['seed']} disagree "
+                                   f"on {key}: the learning phase is not repeatable")
+    job = {k: v for k, v in first.items() if k not in ("runs", "eval_states", "timing")}
+    job["curve"] = []
+    for i, point in enumerate(first["curve"]):
+        runs = [v for p in parts for v in p["curve"][i]["cgi_runs"]]
+        job["curve"].append({"point": point["point"], "learning_steps": point["learning_steps"],
+                             "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
+                             "cgi_runs": runs})
+    learning_states = first["states_met"]["learning"]
+    eval_states = set().union(*(p["eval_states"] for p in parts))
+    job["states_met"] = {"learning": learning_states, "evaluation": len(eval_states)}
+    job["timing"] = {
+        "seconds": sum(p["timing"]["seconds"] for p in parts),
+        "steps": sum(p["timing"]["steps"] for p in parts),
+        "parts": len(parts),
+    }
+    job["timing"]["steps_per_second"] = job["timing"]["steps"] / job["timing"]["seconds"]
+    job["timing"]["gateway_calls_per_step"] = float(np.mean(
+        [p["timing"]["gateway_calls_per_step"] for p in parts]))
+    return job

@@ -52,13 +52,19 @@ class QLearner(Learner):
         return row
 
     def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term:
-        """Update Q for the previous step (Eq. 3), then choose epsilon-greedily."""
-        row = self._row(out.code, out.necessity)
+        """Update Q for the previous step (Eq. 3), then choose epsilon-greedily.
+
+        Without learning, a state never met gets no row (every Q is q_init): evaluating
+        leaves the table as it was."""
+        if learning:
+            row = self._row(out.code, out.necessity)
+        else:
+            row = self._rows.get((out.code, out.necessity), -1)
         allowed = [self._index[format_term(r)] for r in out.allowed]
         q = self._q
         if learning and self._prev is not None and allowed:
             prev_row, prev_action = self._prev
-            target = out.reward + self.params["gamma"] * q[row, allowed].max()
+            target = out.reward + self.params["gamma"] * q[row, allowed].max()  # row >= 0
             q[prev_row, prev_action] += self.params["alpha"] * (target - q[prev_row, prev_action])
         if not allowed:
             self._prev = None
@@ -69,11 +75,12 @@ class QLearner(Learner):
         if epsilon > 0 and self.rng.random() < epsilon:
             choice = allowed[int(self.rng.integers(len(allowed)))]
         else:
-            values = q[row, allowed]
+            values = q[row, allowed] if row >= 0 else np.full(len(allowed),
+                                                              self.params["q_init"])
             best = np.flatnonzero(values == values.max())
             choice = allowed[int(best[self.rng.integers(len(best))])] if len(best) > 1 \
                 else allowed[int(best[0])]
-        self._prev = (row, choice)
+        self._prev = (row, choice) if learning else None
         return self.responses[choice]
 
     def end_episode(self) -> None:

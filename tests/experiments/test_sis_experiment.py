@@ -53,7 +53,8 @@ def test_learning_improves_gaze_following(learner: str) -> None:
     curve = [c["cgi_mean"] for c in result["curve"]]
     assert curve[0] < 0.5            # no knowledge yet (chance is about 0.2)
     assert curve[-1] > curve[0] + 0.3
-    assert result["timing"]["gateway_calls_per_step"] == pytest.approx(1.0, abs=0.01)
+    # one call per step, plus a few per evaluation run (seeding, saving random streams)
+    assert result["timing"]["gateway_calls_per_step"] == pytest.approx(1.0, abs=0.02)
 
 
 def test_without_matplotlib_a_note(tmp_path: Path, monkeypatch) -> None:
