@@ -10,15 +10,21 @@ STAMP  := $(VENV)/.installed
 
 setup: swipl $(STAMP)
 
+# Debian packages: SWI-Prolog (the knowledge layer) and espeak-ng (the robot's voice, and
+# the synthetic caregiver words the speech tests recognise). Installed only when missing.
 swipl:
-	@command -v swipl >/dev/null 2>&1 || { \
-	  echo "installing swi-prolog-nox from Debian's packages"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq swi-prolog-nox; }
+	@missing=""; \
+	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
+	command -v espeak-ng >/dev/null 2>&1 || missing="$$missing espeak-ng"; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing$$missing from Debian's packages"; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	fi
 
-$(STAMP): pyproject.toml
+$(STAMP): pyproject.toml Makefile
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev]'
+	$(BIN)/pip install -q -e '.[dev,speech]'
 	@touch $(STAMP)
 
 demo: setup

@@ -52,5 +52,12 @@ def __getattr__(name: str) -> Any:
     if name == "bench":  # the submodule, which is callable as the bench() function
         return import_module("perception.bench")
     if name in _WHERE:
-        return getattr(import_module(_WHERE[name]), name)
+        module = _WHERE[name]
+        loaded = import_module(module)
+        # Importing a submodule binds its name on this package (perception.render the
+        # module would shadow render the function): bind every name it provides now.
+        for other, where in _WHERE.items():
+            if where == module:
+                globals()[other] = getattr(loaded, other)
+        return globals()[name]
     raise AttributeError(f"module 'perception' has no attribute {name!r}")

@@ -92,3 +92,15 @@ def test_video_file_source(tmp_path):
 def test_registry_has_every_kind():
     assert {"cam", "file", "dir", "image", "synthetic"} <= set(SOURCES)
     assert isinstance(open_camera("synthetic://"), SyntheticCamera)
+
+
+def test_render_is_the_function_after_importing_sceneview() -> None:
+    """Regression: importing SceneView first bound perception.render to the submodule."""
+    import subprocess
+    import sys
+
+    code = ("from perception import SceneView, render; import perception; "
+            "assert callable(render) and not hasattr(render, '__path__'), render; "
+            "assert perception.render is render; print('ok')")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stdout.strip() == "ok", proc.stderr
