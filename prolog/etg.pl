@@ -24,10 +24,8 @@ examples, unlike TG):
     Q-hat = Q(s, a) + alpha * (r + gamma * max_a' Q(s', a') - Q(s, a))      (Eq. 4)
 
 Algorithm 3 (insertion): sort s down the tree; at a leaf, update the action's Q (or insert
-the action with its necessity); at an empty branch (null), generate a leaf there. When
-choosing (and for the max of Eq. 4), a state that reaches an empty branch uses the nearest
-leaf, the one down the other branch of that test: it is the tree's best guess for a state it
-has not met.
+the action with its necessity); at an empty branch (null), generate a leaf there. A state
+that reaches an empty branch has no entries yet: every response has Q = q_init.
 
 The paper does not say when a leaf is split, and with a single initial leaf and no split
 nothing could ever be told apart. relrl's rule, which keeps the tree economic: a leaf
@@ -72,12 +70,14 @@ etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
 scored(Best, Q-_) :-
     Q =:= Best.
 
-%   The entries that estimate Q for a state: its leaf's or, for a state that sorts to an
-%   empty branch (never met), those of the nearest leaf (qtree_nearest_leaf/3): the tree
-%   generalises from the states that share the tests on the way down.
+%   The entries of the state's own leaf; none when it reaches an empty branch (a state
+%   the tree has not met: every response then has Q = q_init).
 leaf_entries(KB, D, Entries) :-
-    qtree_nearest_leaf(KB, D, Id),
-    qtree_leaf(KB, Id, _, Entries).
+    qtree_sort(KB, D, Where),
+    (   Where = leaf(Id)
+    ->  qtree_leaf(KB, Id, _, Entries)
+    ;   Entries = []
+    ).
 
 %!  etg_update(+KB, +D0, +A0, +N0, +R, +D1, +N1, +Allowed1, +Params) is det.
 %
@@ -113,11 +113,8 @@ allowed_or_any(Allowed, A) :- memberchk(A, Allowed).
 insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
     qtree_sort(KB, D, Where),
     (   Where = null(Parent, Branch)
-    ->  leaf_entries(KB, D, Inherited),
-        qtree_entry_q(Inherited, A, N, Qinit, Old),
-        Q is Old + Alpha * (Target - Old),
-        qtree_put_entry(Inherited, e(A, Q, N), Entries),
-        qtree_grow(KB, Parent, Branch, D, Entries, _)
+    ->  Q is Qinit + Alpha * (Target - Qinit),
+        qtree_grow(KB, Parent, Branch, D, [e(A, Q, N)], _)
     ;   Where = leaf(Id),
         qtree_leaf(KB, Id, Rep0, Entries0),
         qtree_entry_q(Entries0, A, N, Qinit, Old),

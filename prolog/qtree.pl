@@ -7,7 +7,6 @@
             qtree_grow/6,         % +Tree, +Parent, +Branch, +Rep, +Entries, -Id
             qtree_split/3,        % +Tree, +LeafId, +TestIndex
             qtree_path/3,         % +Tree, +Description, -Path
-            qtree_nearest_leaf/3, % +Tree, +Description, -Id
             qtree_size/4,         % +Tree, -Nodes, -Leaves, -Entries
             qtree_node/3,         % +Tree, ?Id, ?Node
             qtree_clear/1,        % +Tree
@@ -130,29 +129,6 @@ sort_from(Tree, Id, D, Where) :-
         ;   sort_from(Tree, Next, D, Where)
         )
     ;   Where = leaf(Id)
-    ).
-
-%!  qtree_nearest_leaf(+Tree, +Description, -Id) is det.
-%
-%   Id is the leaf the state reaches or, where it reaches an empty branch, the leaf it
-%   reaches by going on down the other branch of that test: the nearest states the tree
-%   knows. Every test node has at least one branch that is not empty.
-
-qtree_nearest_leaf(Tree, D, Id) :-
-    nearest_from(Tree, 0, D, Id).
-
-nearest_from(Tree, Id0, D, Id) :-
-    node_(Tree, Id0, Node),
-    (   Node = test(I, _, Yes, No)
-    ->  (   test_holds(D, I)
-        ->  First = Yes, Other = No
-        ;   First = No, Other = Yes
-        ),
-        (   First \== nil
-        ->  nearest_from(Tree, First, D, Id)
-        ;   nearest_from(Tree, Other, D, Id)
-        )
-    ;   Id = Id0
     ).
 
 %!  qtree_path(+Tree, +Description, -Path:list) is det.

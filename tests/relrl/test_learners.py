@@ -108,21 +108,19 @@ def test_etg_tree_shape_and_leaf_order() -> None:
     assert tree_nodes(kb) == {0: ("leaf", light, [("e", "a", 5.25, "hunger"),
                                                   ("e", "b", 1.75, "hunger")])}
     # 4. dark, b, r=-1: target -1 + 0.9*5.25 = 3.725, error 1.975 > 1: split on the first
-    #    test telling light from dark, stimulus(light); dark gets a new leaf on the null side,
-    #    starting from the shared leaf's entries: Q(b) = 1.75 + 0.5 * (3.725 - 1.75).
+    #    test telling light from dark, stimulus(light); dark gets a new leaf on the null side:
+    #    Q(b) = 0 + 0.5 * (3.725 - 0).
     etg_call(kb, dark, "b", "hunger", -1, light, "hunger", [])
     nodes = tree_nodes(kb)
     assert nodes[0] == ("test", 0, ("stimulus", "light"), 1, 2)
     assert nodes[1] == ("leaf", light, [("e", "a", 5.25, "hunger"), ("e", "b", 1.75, "hunger")])
-    assert nodes[2] == ("leaf", dark, [("e", "a", 5.25, "hunger"),
-                                       ("e", "b", pytest.approx(2.7375), "hunger")])
+    assert nodes[2] == ("leaf", dark, [("e", "b", pytest.approx(1.8625), "hunger")])
     # 5. dark, c, r=10: target 10 + 0.9*5.25, Q = 7.3625 goes first in the leaf.
     etg_call(kb, dark, "c", "hunger", 10, light, "hunger", [])
     assert tree_nodes(kb)[2] == ("leaf", dark, [("e", "c", pytest.approx(7.3625), "hunger"),
-                                                ("e", "a", 5.25, "hunger"),
-                                                ("e", "b", pytest.approx(2.7375), "hunger")])
+                                                ("e", "b", pytest.approx(1.8625), "hunger")])
     (size,) = kb.call("relrl_engine:engine_size", kb.module, Var())
-    assert size == ("etg", 3, 2, 5, 8)   # 3 nodes, 2 leaves, 5 entries, 8 positions
+    assert size == ("etg", 3, 2, 4, 7)   # 3 nodes, 2 leaves, 4 entries, 7 positions
     kb.close()
 
 
