@@ -299,7 +299,8 @@ def load_calibration(path: str | Path | None = None) -> Calibration:
     seen: dict[int, str] = {}
     for s in servos.values():
         if s.channel in seen:
-            fail(f"servos.{s.name}.channel", f"channel {s.channel} is also used by {seen[s.channel]}")
+            fail(f"servos.{s.name}.channel",
+                 f"channel {s.channel} is also used by {seen[s.channel]}")
         seen[s.channel] = s.name
     directions = _parse_directions(data.get("directions"), servos, fail)
     scripts = parse_scripts(data.get("scripts", {}), "scripts", servos, directions, fail)

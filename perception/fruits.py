@@ -34,7 +34,7 @@ def fruit_session(presentations: int = 60, seed: int = 0, light: tuple[float, fl
     namer = FruitNamer(params or ART2Params())
     perceiver = Perceiver()
     missed = 0
-    for i in range(presentations):
+    for _ in range(presentations):
         fruit = FRUITS[int(rng.integers(len(FRUITS)))]
         place = _PLACES[int(rng.integers(len(_PLACES)))]
         view = SceneView(place, None, {place: fruit}, float(rng.uniform(*light)),

@@ -71,8 +71,9 @@ def check_command(cmd: Command, max_channel: int) -> None:
     """Refuse a command no servo should get (the last guard before encoding).
 
     Raises:
-        HeadError: the pulse is outside 500..2500 us or the servo's own range, the speed is not positive, or the
-            channel does not exist on the controller. Reaching this is a bug upstream.
+        HeadError: the pulse is outside 500..2500 us or the servo's own range, the speed is
+            not positive, or the channel does not exist on the controller. Reaching this is
+            a bug upstream.
     """
     lo, hi = max(ABSOLUTE_RANGE[0], cmd.lo), min(ABSOLUTE_RANGE[1], cmd.hi)
     if not isinstance(cmd.pulse_us, int) or not lo <= cmd.pulse_us <= hi:

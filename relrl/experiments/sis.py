@@ -128,7 +128,8 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
             for run_seed in eval_seeds[start:stop]:
                 agent.reseed(int(run_seed))
                 metrics = GazeMetrics()
-                ev = Interaction(eval_env, agent, on_step=lambda r: metrics.add(r.info["record"]))
+                ev = Interaction(eval_env, agent,
+                                 on_step=lambda r, m=metrics: m.add(r.info["record"]))
                 ev.reset(seed=int(run_seed))
                 ev.run(config.eval_steps, learning=False,
                        explore=config.eval_policy == "behaviour", keep=False)

@@ -5,7 +5,7 @@ Example:
     >>> learner = make_learner("etg", epsilon=0.1)
 """
 
-from relrl.learners.base import LEARNERS, Learner, StepOut, make_learner, register
 from relrl.learners import contingency, etg, qlearning  # noqa: F401  (registers them)
+from relrl.learners.base import LEARNERS, Learner, StepOut, make_learner, register
 
 __all__ = ["LEARNERS", "Learner", "StepOut", "make_learner", "register"]

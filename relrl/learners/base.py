@@ -109,7 +109,7 @@ class Learner(abc.ABC):
         """Return the response to emit. Prolog learners have already chosen."""
         return out.action
 
-    def end_episode(self) -> None:
+    def end_episode(self) -> None:  # noqa: B027 - an optional hook
         """Called when an interaction ends (the engine forgets the last step)."""
 
     def size(self) -> dict[str, int]:

@@ -38,7 +38,8 @@ BAD = {
                     "unit(n, recurrent_weight, 1).\nunit(n, delta, 0).\nunit(n, threshold, 0.5).\n",
                     ":4: unit parameter bias of necessity n must be a number, not high"),
     "unknown_param": ("stimulus(face).\nresponse(r).\nnecessity(n).\nunit(n, bias, 1).\n"
-                      "unit(n, recurrent_weight, 1).\nunit(n, delta, 0).\nunit(n, threshold, 0.5).\n"
+                      "unit(n, recurrent_weight, 1).\nunit(n, delta, 0).\n"
+                      "unit(n, threshold, 0.5).\n"
                       "unit(n, gain, 2).\n", ":8: unknown unit parameter gain of necessity n"),
     "missing_param": ("stimulus(face).\nresponse(r).\nnecessity(n).\nunit(n, bias, 1).\n",
                       ":3: necessity n has no recurrent_weight parameter"),

@@ -63,7 +63,8 @@ def test_untrained_learner_is_near_chance() -> None:
 
 def test_eq3_by_hand() -> None:
     kb = KnowledgeBase(TINY)
-    agent = Agent(kb, make_learner("qlearning", alpha=0.5, gamma=0.9, epsilon=0.0, q_init=0.0), seed=0)
+    learner = make_learner("qlearning", alpha=0.5, gamma=0.9, epsilon=0.0, q_init=0.0)
+    agent = Agent(kb, learner, seed=0)
     q = agent.learner
     out1 = agent.step([("see", "light")])
     a1 = out1.action
