@@ -137,10 +137,7 @@ engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, Al
         Elements = Percepts
     ),
     wm_insert(KB, Elements),
-    config(KB, features, Features),
-    features_code(KB, Features, Code),
-    config(KB, extra_tests, Extra),
-    describe(KB, Extra, Code, D),
+    description_now(KB, Code, D),
     config(KB, units, Units),
     motivation_step(KB, Units, Outputs, Active),
     pairs_values(Outputs, Ys),
@@ -199,6 +196,14 @@ engine_set_random(Spec) :-
 
 engine_responses(KB, Responses) :-
     config(KB, responses, Responses).
+
+%   The state code of working memory now, and its description: the code with a bit for
+%   each extra ETG test above it.
+description_now(KB, Code, D) :-
+    config(KB, features, Features),
+    features_code(KB, Features, Code),
+    config(KB, extra_tests, Extra),
+    describe(KB, Extra, Code, D).
 
 %   The description: the state code, with a bit for each extra ETG test above it.
 describe(_, [], Code, Code) :- !.
@@ -280,10 +285,7 @@ explain(KB, D, N, Explanation) :-
 %   the units would give now; nothing is learned or moved).
 
 engine_explain_now(KB, Explanation) :-
-    config(KB, features, Features),
-    features_code(KB, Features, Code),
-    config(KB, extra_tests, Extra),
-    describe(KB, Extra, Code, D),
+    description_now(KB, _, D),
     config(KB, units, Units),
     motivation_peek(KB, Units, _, N),
     explain(KB, D, N, Explanation).

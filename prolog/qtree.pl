@@ -118,17 +118,20 @@ qtree_sort(Tree, D, Where) :-
     sort_from(Tree, 0, D, Where).
 
 sort_from(Tree, Id, D, Where) :-
-    node_(Tree, Id, Node),
-    (   Node = test(I, _, Yes, No)
-    ->  (   test_holds(D, I)
-        ->  Next = Yes, Branch = yes
-        ;   Next = No, Branch = no
-        ),
-        (   Next == nil
+    (   step_down(Tree, Id, D, _, Branch, Next)
+    ->  (   Next == nil
         ->  Where = null(Id, Branch)
         ;   sort_from(Tree, Next, D, Where)
         )
     ;   Where = leaf(Id)
+    ).
+
+%   Id is a test node; the state described by D takes its Branch (yes or no) to Next.
+step_down(Tree, Id, D, Goal, Branch, Next) :-
+    node_(Tree, Id, test(I, Goal, Yes, No)),
+    (   test_holds(D, I)
+    ->  Branch = yes, Next = Yes
+    ;   Branch = no, Next = No
     ).
 
 %!  qtree_path(+Tree, +Description, -Path:list) is det.
@@ -140,12 +143,8 @@ qtree_path(Tree, D, Path) :-
     path_from(Tree, 0, D, Path).
 
 path_from(Tree, Id, D, Path) :-
-    node_(Tree, Id, Node),
-    (   Node = test(I, Goal, Yes, No)
-    ->  (   test_holds(D, I)
-        ->  Next = Yes, Outcome = true
-        ;   Next = No, Outcome = false
-        ),
+    (   step_down(Tree, Id, D, Goal, Branch, Next)
+    ->  ( Branch == yes -> Outcome = true ; Outcome = false ),
         Path = [Goal-Outcome|Rest],
         (   Next == nil
         ->  Rest = [null]
