@@ -269,8 +269,12 @@ class _Engine:
             self.put_term(rest, t)
             while self.get_list(rest, head, rest):
                 items.append(self.get(head))
-            if self.term_type(rest) != _PL_NIL:  # partial list: keep the tail
-                items.append(self.get(rest))
+            if self.term_type(rest) != _PL_NIL:
+                # A partial list [a, b|T]: as the '[|]' compounds it is made of.
+                value: Term = self.get(rest)
+                for item in reversed(items):
+                    value = ("[|]", item, value)
+                return value
             return items
         if kind == _PL_TERM:
             name = c_size_t()

@@ -9,7 +9,7 @@ Prolog                        Python
 atom ``face``                 ``"face"`` (str)
 integer, float                ``int``, ``float``
 string ``"hello"``            ``"hello"`` (str; an atom when sent back)
-list ``[a, b]``               ``["a", "b"]``
+list ``[a, b]``               ``["a", "b"]`` (a partial list ``[a|T]`` is ``("[|]", "a", T)``)
 compound ``pose(face, left)`` ``("pose", "face", "left")`` — functor first
 unbound variable              :class:`Var`
 ============================  =====================================================

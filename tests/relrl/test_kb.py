@@ -157,3 +157,10 @@ def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
     for _ in range(1_300_000):
         engine.run("true", 0, ())
     assert engine.run(("=", Var(), "still alive"), 0, (0,)) == ["still alive"]
+
+
+def test_partial_list_keeps_its_tail(fruits: KnowledgeBase) -> None:
+    """Regression: [1, 2|T] came back as [1, 2, T], a proper list of three."""
+    (value,) = fruits.call("=", Var(), ("[|]", 1, ("[|]", 2, Var("T"))))
+    assert value[0] == "[|]" and value[1] == 1
+    assert value[2][0] == "[|]" and value[2][1] == 2 and isinstance(value[2][2], Var)
