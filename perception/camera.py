@@ -21,6 +21,7 @@ Every source is a context manager; ``read()`` returns the next BGR frame or ``No
 
 from __future__ import annotations
 
+import abc
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Self
@@ -49,7 +50,7 @@ def read_image(path: str | Path) -> np.ndarray:
     return img
 
 
-class Camera:
+class Camera(abc.ABC):
     """Base class of camera sources: override :meth:`read` and, if needed, :meth:`_release`."""
 
     name = "camera"
@@ -57,11 +58,11 @@ class Camera:
     def __init__(self) -> None:
         self._closed = False
 
-    def read(self) -> np.ndarray | None:  # pragma: no cover - abstract
+    @abc.abstractmethod
+    def read(self) -> np.ndarray | None:
         """The next BGR frame, or ``None`` when the source has no more."""
-        raise NotImplementedError
 
-    def _release(self) -> None:
+    def _release(self) -> None:  # noqa: B027 - an optional hook
         """Free the device (called once by :meth:`close`)."""
 
     def close(self) -> None:
