@@ -67,8 +67,8 @@ class Agent:
         responses = self.responses
         allowed = [i for i in range(len(responses)) if mask >> i & 1]
         out = StepOut(code, necessity, dict(zip(self.necessities, ys, strict=True)), reward,
-                      [responses[i] for i in allowed], responses[action] if action >= 0 else "none")
-        out.extra["allowed_index"] = allowed
+                      [responses[i] for i in allowed], responses[action] if action >= 0 else "none",
+                      allowed)
         out.action = self.learner.act(out, learning, explore)
         self.emitted = out.action
         self._emitted = self._index_of(out.action)

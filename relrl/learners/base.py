@@ -35,6 +35,7 @@ class StepOut:
     reward: float                  #: reward for the previous response
     allowed: list[Term]            #: responses allowed now
     action: Term                   #: the learner's choice ("none" when nothing is allowed)
+    allowed_index: list[int] = field(default_factory=list)  #: their indices (declaration order)
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -112,14 +113,15 @@ class Learner(abc.ABC):
     def end_episode(self) -> None:  # noqa: B027 - an optional hook
         """Called when an interaction ends (the engine forgets the last step)."""
 
+    @abc.abstractmethod
     def size(self) -> dict[str, int]:
         """The learner's memory, with ``positions`` in the paper's sense."""
+
+    def _engine_size(self) -> Term:
+        """The engine's report of a Prolog learner's memory (relrl_engine:engine_size/2)."""
         assert self.kb is not None
         (size,) = self.kb.call("relrl_engine:engine_size", self.kb.module, Var())
-        return self._size_from(size)
-
-    def _size_from(self, size: Term) -> dict[str, int]:
-        raise NotImplementedError(f"{type(self).__name__} must report its size")
+        return size
 
     def explain(self, *, now: bool = False) -> dict[str, Any]:
         """Why the learner chooses what it chooses in the last step's state (or, with
@@ -135,8 +137,9 @@ class Learner(abc.ABC):
         (text,) = self.kb.call("relrl_engine:engine_tree", self.kb.module, Var())
         return text
 
+    @abc.abstractmethod
     def _explain_from(self, exp: Term) -> dict[str, Any]:
-        raise NotImplementedError(f"{type(self).__name__} must explain its choice")
+        """Turn the engine's explanation term into a dict (see :meth:`explain`)."""
 
     def save(self, path: str | Path, header: str = "") -> Path:
         """Save the learned knowledge (atomic write); returns the file written."""

@@ -32,8 +32,9 @@ class ContingencyLearner(Learner):
             raise ConfigError("need 0 < min_fitness <= default_fitness <= max_fitness, got "
                               f"{p['min_fitness']}, {p['default_fitness']}, {p['max_fitness']}")
 
-    def _size_from(self, size: Term) -> dict[str, int]:
-        _, rules, positions = size
+    def size(self) -> dict[str, int]:
+        """The stored behaviour rules; one position each."""
+        _, rules, positions = self._engine_size()
         return {"rules": rules, "positions": positions}
 
     def _explain_from(self, exp: Term) -> dict[str, Any]:

@@ -24,8 +24,9 @@ class ETGLearner(Learner):
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0,
                 "split_threshold": 0.1}
 
-    def _size_from(self, size: Term) -> dict[str, int]:
-        _, nodes, leaves, entries, positions = size
+    def size(self) -> dict[str, int]:
+        """Nodes, leaves, stored action entries; positions = nodes + entries."""
+        _, nodes, leaves, entries, positions = self._engine_size()
         return {"nodes": nodes, "leaves": leaves, "entries": entries, "positions": positions}
 
     def _explain_from(self, exp: Term) -> dict[str, Any]:

@@ -34,7 +34,6 @@ class QLearner(Learner):
 
     def attach(self, kb, seed):  # type: ignore[override]
         super().attach(kb, seed)
-        self._index = {format_term(r): i for i, r in enumerate(self.responses)}
         self._rows: dict[tuple[int, str], int] = {}
         self._q = np.full((64, len(self.responses)), self.params["q_init"])
         self._prev: tuple[int, int] | None = None
@@ -60,7 +59,7 @@ class QLearner(Learner):
             row = self._row(out.code, out.necessity)
         else:
             row = self._rows.get((out.code, out.necessity), -1)
-        allowed = [self._index[format_term(r)] for r in out.allowed]
+        allowed = out.allowed_index
         q = self._q
         if learning and self._prev is not None and allowed:
             prev_row, prev_action = self._prev
