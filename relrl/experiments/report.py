@@ -126,6 +126,18 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
                         "are in the CSV files.\nInstall the extra to get plots:  "
                         "pip install 'relrl[plots]'\n")
         return [note]
+    def finish(fig, ax, name: str, xlabel: str, ylabel: str, title: str) -> Path:
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.legend()
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        path = out_dir / name
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        return path
+
     files = []
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, s in summary.items():
@@ -133,29 +145,18 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
                     yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3, capsize=3,
                     label=name)
-    ax.set_xlabel("run (evaluation point; 500 learning time units each)")
-    ax.set_ylabel("CGI (mean ± s.d.)")
     ax.set_ylim(-0.05, 1.05)
-    ax.set_title("Fig. 5 — learning evolution (Social Interactive Simulator)")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    files.append(out_dir / "fig5_cgi.png")
-    fig.savefig(files[-1], dpi=120)
-    plt.close(fig)
+    files.append(finish(fig, ax, "fig5_cgi.png",
+                        "run (evaluation point; 500 learning time units each)",
+                        "CGI (mean ± s.d.)",
+                        "Fig. 5 — learning evolution (Social Interactive Simulator)"))
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, s in summary.items():
         cum = s["eye_contacts"]["cumulative_mean"]
         ax.plot(range(1, len(cum) + 1), cum,
                 label=f"{name} ({s['eye_contacts']['mean']:.0f} ± "
                       f"{s['eye_contacts']['std']:.0f})")
-    ax.set_xlabel("eye-contact opportunity")
-    ax.set_ylabel("eye contacts established (cumulative)")
-    ax.set_title("Fig. 4 — capacity of attention (first opportunities)")
-    ax.legend()
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    files.append(out_dir / "fig4_eye_contacts.png")
-    fig.savefig(files[-1], dpi=120)
-    plt.close(fig)
+    files.append(finish(fig, ax, "fig4_eye_contacts.png", "eye-contact opportunity",
+                        "eye contacts established (cumulative)",
+                        "Fig. 4 — capacity of attention (first opportunities)"))
     return files
