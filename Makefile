@@ -10,21 +10,27 @@ STAMP  := $(VENV)/.installed
 
 setup: swipl $(STAMP)
 
-# Debian packages: SWI-Prolog (the knowledge layer) and espeak-ng (the robot's voice, and
-# the synthetic caregiver words the speech tests recognise). Installed only when missing.
+# Debian packages: SWI-Prolog (the knowledge layer), espeak-ng (the robot's voice, and
+# the synthetic caregiver words the speech tests recognise), graphviz (`dot`: the learned tree
+# as a picture), libportaudio2 (the microphone, through sounddevice) and chromium (the headless
+# browser the monitor's tests drive; nothing downloads a browser). Installed only when missing.
 swipl:
 	@missing=""; \
 	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
 	command -v espeak-ng >/dev/null 2>&1 || missing="$$missing espeak-ng"; \
+	command -v dot >/dev/null 2>&1 || missing="$$missing graphviz"; \
+	command -v chromium >/dev/null 2>&1 || missing="$$missing chromium"; \
+	ldconfig -p 2>/dev/null | grep -q libportaudio.so.2 || missing="$$missing libportaudio2"; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing$$missing from Debian's packages"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	    --no-install-recommends $$missing; \
 	fi
 
 $(STAMP): pyproject.toml Makefile
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev,speech]'
+	$(BIN)/pip install -q -e '.[dev,speech,monitor]'
 	@touch $(STAMP)
 
 demo: setup

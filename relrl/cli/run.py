@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from relrl.cli.session_flags import add_session_arguments, session_options
+
 HELP = "run a scripted interaction episode (simulator by default, or camera and head)"
 EXAMPLE = "relrl run examples/episodes/experiment2.toml --out runs/exp2"
 
@@ -30,19 +32,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
     parser.add_argument("--check", action="store_true",
                         help="only check the script and print what it would run")
-
-
-def _reader(queue) -> None:
-    for line in sys.stdin:
-        for word in line.strip().lower().split():
-            queue.put(word)
+    add_session_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     """Check the script, run it, print the summary; 130 when stopped by Ctrl-C."""
-    import queue
-    import threading
-
     from relrl.episodes import RunOptions, StopRequest, load_episode, run_episode
     from relrl.errors import ConfigError
 
@@ -61,26 +55,23 @@ def run(args: argparse.Namespace) -> int:
         step = 0.5 if args.live and args.camera is None else 0.0
     if step < 0:
         raise ConfigError(f"--step-seconds must be >= 0, not {step}")
-    words = None
-    if args.live:
-        words = queue.Queue()
-        threading.Thread(target=_reader, args=(words,), daemon=True).start()
-        print("live session: type words (e.g. apple, attention) and Enter; Ctrl-C stops",
-              flush=True)
     opts = RunOptions(out=Path(args.out) if args.out else None, head=args.head,
                       protocol=args.protocol, camera=args.camera, live=args.live,
-                      step_seconds=step, words=words, plots=not args.no_plots)
+                      step_seconds=step, plots=not args.no_plots)
     stop = StopRequest()
-    with stop.installed():
-        summary = run_episode(episode, opts, stop)
-    print(_report(summary))
-    if args.out:
-        policy = f", {summary['policy']}" if "policy" in summary else ""
-        print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
-    if summary["stopped_early"]:
-        print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}; "
-              "everything up to it is written", file=sys.stderr)
-        return 130
+    with session_options(args, episode, opts) as session:
+        with stop.installed():
+            summary = run_episode(episode, session.opts, stop)
+        print(_report(summary))
+        if args.out:
+            policy = f", {summary['policy']}" if "policy" in summary else ""
+            print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
+        if summary["stopped_early"]:
+            print(f"stopped after time unit {summary['steps']} of "
+                  f"{summary['planned_steps']}; everything up to it is written",
+                  file=sys.stderr)
+            return 130
+        session.hold()
     return 0
 
 
@@ -90,11 +81,15 @@ def _report(s: dict) -> str:
             f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
             f"reward {s['rewards']['total']:+.0f}")
     lines = [head]
+    sim = " (simulated)" if s.get("where", {}).get("simulated_evaluation") else ""
+    if sim and (s.get("evaluation") or "table1" in s):
+        lines.append("  evaluations and naming below ran on the scripted world (simulated), "
+                     "not on the devices")
     for p in s.get("evaluation", []):
-        lines.append(f"  evaluation after {p['learning_steps']:4d} time units: CGI "
+        lines.append(f"  evaluation{sim} after {p['learning_steps']:4d} time units: CGI "
                      f"{p['cgi_mean']:.3f} +- {p['cgi_std']:.3f}")
     if "table1" in s:
-        lines.append("  Table 1 (mean +- sd %, measured | paper):")
+        lines.append(f"  Table 1{sim} (mean +- sd %, measured | paper):")
         for k, (m, sd) in s["table1"]["rates"].items():
             pm, psd = s["table1"]["paper"][k]
             lines.append(f"    {k:16s} {m:6.2f} +- {sd:5.2f} | {pm:6.2f} +- {psd:.2f}")

@@ -1,0 +1,129 @@
+"""The learned tree as a picture: ``{"nodes", "edges"}`` to Graphviz (DOT, SVG, PNG).
+
+A tree learner (ETG, tg) gives its tree as ``learner.graph()``: nodes ``{"id", "kind"
+("test" | "leaf"), "label"}`` and edges ``{"from", "to", "branch" ("yes" | "no")}``.
+:func:`to_dot` draws it (tests as boxes, leaves as rounded boxes with their ranked actions,
+``yes`` edges solid, ``no`` edges dashed) and :func:`render` runs Graphviz's ``dot`` (Debian
+package ``graphviz``, Python package ``graphviz`` from the ``monitor`` extra).
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+from relrl.errors import UserError
+
+__all__ = ["GraphError", "learner_graph", "render", "to_dot"]
+
+#: the longest label line drawn; longer lines are cut with an ellipsis.
+LABEL_WIDTH = 48
+#: leaf entries shown per leaf (the best first).
+LEAF_ENTRIES = 4
+
+
+class GraphError(UserError):
+    """The tree cannot be drawn (Graphviz missing, or a learner without a tree)."""
+
+
+def learner_graph(learner: Any) -> dict[str, Any] | None:
+    """The learner's tree as ``{"nodes", "edges"}``, or ``None`` for learners without one."""
+    graph = getattr(learner, "graph", None)
+    if graph is not None:
+        return graph()
+    text = learner.tree()  # engines before learner.graph(): read the tree's text form
+    return parse_tree_text(text) if text else None
+
+
+_TEST = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )?\[(?P<id>\d+)\] (?P<goal>.*) \?$")
+_LEAF = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )?leaf \[(?P<id>\d+)\] (?P<rest>.*)$")
+_NULL = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )null$")
+
+
+def parse_tree_text(text: str) -> dict[str, Any]:
+    """Nodes and edges of a tree drawn as indented text (``relrl_qtree:qtree_format/2``)."""
+    nodes: list[dict[str, Any]] = []
+    edges: list[dict[str, Any]] = []
+    stack: list[tuple[int, str]] = []  # (indent, node id) of open test nodes
+    nulls = 0
+    leaf: dict[str, Any] | None = None
+    for line in text.splitlines():
+        m = _TEST.match(line) or _LEAF.match(line) or _NULL.match(line)
+        if m is None:
+            if leaf is not None and line.strip():
+                leaf["entries"].append(line.strip())
+            continue
+        indent = len(m["ind"])
+        while stack and stack[-1][0] >= indent:
+            stack.pop()
+        if m.re is _NULL:
+            nulls += 1
+            node = {"id": f"null{nulls}", "kind": "null", "label": "null"}
+        elif m.re is _TEST:
+            node = {"id": m["id"], "kind": "test", "label": m["goal"]}
+        else:
+            node = {"id": m["id"], "kind": "leaf", "label": m["rest"], "entries": []}
+        nodes.append(node)
+        leaf = node if node["kind"] == "leaf" else None
+        if stack and m["branch"]:
+            edges.append({"from": stack[-1][1], "to": node["id"],
+                          "branch": m["branch"].strip(" :")})
+        if node["kind"] == "test":
+            stack.append((indent, node["id"]))
+    for node in nodes:
+        if node["kind"] == "leaf":
+            node["label"] = "\n".join([node["label"]] + node.pop("entries")[:LEAF_ENTRIES])
+    return {"nodes": nodes, "edges": edges}
+
+
+def _cut(text: str) -> str:
+    lines = str(text).splitlines() or [""]
+    return "\n".join(s if len(s) <= LABEL_WIDTH else s[:LABEL_WIDTH - 1] + "…" for s in lines)
+
+
+def to_dot(graph: dict[str, Any], title: str = "") -> Any:
+    """A ``graphviz.Digraph`` of the tree.
+
+    Raises:
+        GraphError: the Python package ``graphviz`` is not installed.
+    """
+    try:
+        import graphviz
+    except ImportError:
+        raise GraphError("drawing the tree needs the optional extra: pip install "
+                         "'relrl[monitor]' (the graphviz package)") from None
+    dot = graphviz.Digraph("tree", graph_attr={"rankdir": "TB", "fontsize": "10",
+                                               "label": title, "labelloc": "t"},
+                           node_attr={"fontname": "Helvetica", "fontsize": "9"},
+                           edge_attr={"fontname": "Helvetica", "fontsize": "8"})
+    styles = {"test": {"shape": "box", "style": "filled", "fillcolor": "#dbe9f6"},
+              "leaf": {"shape": "box", "style": "rounded,filled", "fillcolor": "#e6f4e1"},
+              "null": {"shape": "plaintext", "fontcolor": "#888888"}}
+    for node in graph.get("nodes", []):
+        dot.node(str(node["id"]), _cut(node.get("label", "")),
+                 **styles.get(node.get("kind", "leaf"), styles["leaf"]))
+    for edge in graph.get("edges", []):
+        branch = edge.get("branch", "")
+        dot.edge(str(edge["from"]), str(edge["to"]), label=str(branch),
+                 style="dashed" if branch == "no" else "solid")
+    return dot
+
+
+def render(graph: dict[str, Any], fmt: str = "svg", title: str = "") -> bytes:
+    """The tree drawn by Graphviz's ``dot`` in ``fmt`` (svg, png, pdf, dot).
+
+    Raises:
+        GraphError: Graphviz (the ``dot`` program) is missing, or ``fmt`` is unknown.
+    """
+    dot = to_dot(graph, title)
+    if fmt == "dot":
+        return dot.source.encode()
+    import graphviz
+
+    try:
+        return dot.pipe(format=fmt)
+    except graphviz.ExecutableNotFound:
+        raise GraphError("Graphviz's dot program is missing; install the Debian package "
+                         "graphviz") from None
+    except ValueError as exc:
+        raise GraphError(f"cannot draw the tree as {fmt!r}: {exc}") from None
