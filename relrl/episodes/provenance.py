@@ -23,7 +23,8 @@ def provenance(opts: Any) -> dict[str, Any]:
         opts: the session's :class:`~relrl.episodes.session.RunOptions`.
     """
     camera, head = opts.camera, opts.head
-    on_devices = camera is not None or head is not None
+    # the simulated head moves nothing real: a session with it alone is all simulation
+    on_devices = camera is not None or (head is not None and head != "sim")
     devices = ", ".join(x for x in (f"camera {camera}" if camera is not None else "",
                                     f"head {head}" if head is not None else "") if x)
     where: dict[str, Any] = {

@@ -129,6 +129,8 @@ class ReplaySource:
         frame = self.rec.frame_at(t)
         out["frame_index"] = frame["index"] if frame else None
         out["frame_t"] = frame["t"] if frame else None
+        seen = self.rec.row(frame["t"]) if frame else None
+        out["overlay_of_frame"] = seen.get("overlay") if seen else None
         tree_i = bisect.bisect_right(self.rec._tree_t, t) - 1
         out["tree_version"] = tree_i
         return out

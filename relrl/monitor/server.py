@@ -188,7 +188,11 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
     async def series(request: Any) -> Any:
         return _json(source.series())
 
+    async def no_icon(request: Any) -> Any:
+        return Response(status_code=204)
+
     routes = [Route("/", index), Route("/api/info", info), Route("/tree.svg", tree),
+              Route("/favicon.ico", no_icon),
               Mount("/static", StaticFiles(directory=STATIC))]
     if source.mode == "live":
         routes += [Route("/api/events", events), Route("/frame.jpg", frame)]
