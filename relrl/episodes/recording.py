@@ -156,7 +156,7 @@ class SessionTap:
             if record and out is not None else None  # noqa: SIM115
         self._tree_key: Any = None
         self._tree_next = 0.0
-        self._seen: tuple[Any, Any] = (None, None)
+        self._seen: tuple[Any, Any, Any] = (None, None, None)
         self.files: dict[str, str] = {}
         if record and out is not None:
             self.files = _copy_script(run.episode, out)
@@ -175,18 +175,22 @@ class SessionTap:
 
     def start(self) -> None:
         """The world has been reset: remember the first frame it perceived."""
-        self._seen = (getattr(self.env, "last_frame", None),
-                      getattr(self.env, "last_percept", None))
+        self._seen = self._now_seen()
         self._tree(0, force=True)
+
+    def _now_seen(self) -> tuple[Any, Any, Any]:
+        """The world's last frame, what perception found in it and where the head looked."""
+        env = self.env
+        return (getattr(env, "last_frame", None), getattr(env, "last_percept", None),
+                getattr(env, "focus", None))
 
     def step(self, record: Any, phase: str, *, outcome: str | None = None,
              said: str | None = None) -> dict[str, Any] | None:
         """One time unit: returns the trace row when one was built."""
         run, hub = self.run, self.hub
         out = record.out
-        frame, percept = self._seen
-        self._seen = (getattr(self.env, "last_frame", None),
-                      getattr(self.env, "last_percept", None))
+        frame, percept, looked = self._seen  # what this step's percepts came from
+        self._seen = self._now_seen()
         if hub is not None:
             hub.tick(run.t, list(out.outputs.values()), float(out.reward))
         publish = hub is not None and hub.due()
@@ -201,7 +205,7 @@ class SessionTap:
                       "heard": info["words"], "naming": outcome, "said": said,
                       "overlay": overlay_of(percept, frame)}
         if self.frames is not None and frame is not None and self.frames.due():
-            view.extra["frame"] = self.frames.add(frame, run.t, info["record"].focus)
+            view.extra["frame"] = self.frames.add(frame, run.t, looked)
         row = view.row()
         if self.trace is not None:
             self.trace.write(json.dumps(row, sort_keys=True) + "\n")
@@ -247,9 +251,9 @@ class SessionTap:
             what was recorded (frames, bytes), for ``session.json``.
         """
         self._tree(self.run.t, force=True)
-        frame = self._seen[0]
+        frame, _, looked = self._seen
         if self.frames is not None and self.frames.rate <= 0 and frame is not None:
-            self.frames.add(frame, self.run.t + 1, getattr(self.env, "focus", None))
+            self.frames.add(frame, self.run.t + 1, looked)
         if self.hub is not None:
             self.hub.finish()
         return self.close()

@@ -77,8 +77,8 @@ class RunOptions:
         step_seconds: pause per time unit (a live session on the simulator is slowed down so
             a person can follow and type).
         stream: where the live view goes.
-        words: a source of typed/recognised words (``poll()`` once per time unit, see
-            :mod:`relrl.listen`), or ``None``.
+        words: a source of typed/recognised words: a :class:`relrl.listen.WordSource`
+            (``poll()`` once per time unit) or a queue (``get_nowait()``), or ``None``.
         plots: write PNG plots (needs matplotlib).
         monitor: the live monitor's :class:`relrl.monitor.Hub`, or ``None``.
         record: record frames, trees and events into ``out`` (:mod:`.recording`).
@@ -178,8 +178,22 @@ def _on_step(run: _Run, record: Any, phase: str) -> None:
 
 def _pull_words(run: _Run, env: Any) -> None:
     """Words heard in this time unit (typed, recognised from the microphone or a file)."""
-    if run.opts.words is not None:
-        for word in run.opts.words.poll():
+    source = run.opts.words
+    if source is None:
+        return
+    if hasattr(source, "poll"):  # a relrl.listen.WordSource
+        words = source.poll()
+    else:  # a queue of words (get_nowait)
+        import queue
+
+        words = []
+        while True:
+            try:
+                words.append(source.get_nowait())
+            except queue.Empty:
+                break
+    for word in words:
+        if word:
             env.hear(word)
 
 

@@ -112,7 +112,8 @@ class Hub:
                 return None, version, series_count
             new = min(self._series_count - series_count, len(self._series))
             series = list(self._series)[len(self._series) - new:] if new > 0 else []
-            msg = {"view": self.view, "series": series, "tree_version": self.tree_version,
+            msg = {"info": {"rate": self.rate, **self.info}, "view": self.view,
+                   "series": series, "tree_version": self.tree_version,
                    "events": list(self.events), "finished": self.finished}
             return msg, self.version, self._series_count
 

@@ -301,7 +301,7 @@ class MonitorServer:
             self._server = None
 
     def __enter__(self) -> MonitorServer:
-        return self.start()
+        return self if self._server is not None else self.start()
 
     def __exit__(self, *exc: object) -> None:
         self.close()

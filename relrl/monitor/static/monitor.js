@@ -274,6 +274,11 @@ function live() {
   const es = new EventSource(url("api/events"));
   es.onmessage = (ev) => {
     const msg = JSON.parse(ev.data);
+    const info = JSON.stringify(msg.info);
+    if (msg.info && info !== state.infoText) {
+      state.infoText = info;
+      showInfo({ mode: "live", ...msg.info });
+    }
     for (const p of msg.series || []) state.series.push(p);
     if (state.series.length > KEEP) state.series.splice(0, state.series.length - KEEP);
     drawPlot();
