@@ -55,8 +55,9 @@ class Segmenter:
 
     A frame (30 ms) is voiced when its RMS is above ``max(min_rms, ratio x noise)``, the noise
     floor following the quietest frames. An utterance starts at the first voiced frame (with
-    ``pre_ms`` of audio before it) and ends after ``silence_ms`` of unvoiced frames; shorter
-    than ``min_ms`` it is dropped, longer than ``max_ms`` it is cut.
+    ``pre_ms`` of audio before it) and ends after ``silence_ms`` of unvoiced frames; with less
+    than ``min_ms`` of voiced frames it is dropped (a click), longer than ``max_ms`` it is
+    cut.
     """
 
     def __init__(self, *, min_rms: float = 300.0, ratio: float = 3.0, silence_ms: int = 300,
@@ -71,6 +72,7 @@ class Segmenter:
         self._pre: list[np.ndarray] = []
         self._voice: list[np.ndarray] | None = None
         self._quiet = 0
+        self._voiced = 0
 
     def feed(self, samples: np.ndarray) -> list[np.ndarray]:
         """Add samples; returns the utterances completed by them."""
@@ -86,21 +88,23 @@ class Segmenter:
                 self.noise = 0.95 * self.noise + 0.05 * rms
             if self._voice is None:
                 if voiced:
-                    self._voice, self._quiet = [*self._pre, frame], 0
+                    self._voice, self._quiet, self._voiced = [*self._pre, frame], 0, 1
                     self._pre = []
                 else:
                     self._pre = (self._pre + [frame])[-self.pre:]
                 continue
             self._voice.append(frame)
             self._quiet = 0 if voiced else self._quiet + 1
+            self._voiced += voiced
             if self._quiet >= self.silence or len(self._voice) * FRAME >= self.max_len:
                 done += self._end()
         return done
 
     def _end(self) -> list[np.ndarray]:
         voice, self._voice = self._voice or [], None
-        audio = np.concatenate(voice) if voice else np.zeros(0, np.int16)
-        return [audio] if len(audio) >= self.min_len else []
+        if self._voiced * FRAME < self.min_len:  # a click, not a word
+            return []
+        return [np.concatenate(voice)]
 
     def flush(self) -> list[np.ndarray]:
         """The utterance still open at the end of the audio, if any."""

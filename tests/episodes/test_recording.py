@@ -77,7 +77,7 @@ def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
         recorded = [p for p in row["percepts"] if not p.startswith(("hear(", "at("))
                     or p.startswith("at(object")]
         same += seen == recorded
-    assert same >= 38, f"only {same} of 40 frames perceived as recorded"
+    assert same >= 39, f"only {same} of 40 frames perceived as recorded"
     # and a whole session runs on them as its camera
     again = tmp_path / "again"
     assert main(["run", str(script), "--camera", str(out), "--out", str(again),
