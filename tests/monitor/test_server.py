@@ -13,7 +13,7 @@ import pytest
 from relrl.cli import main
 from relrl.errors import ConfigError
 from relrl.monitor import Hub, start_live
-from relrl.monitor.server import MonitorServer, LiveSource, is_loopback, parse_address
+from relrl.monitor.server import LiveSource, MonitorServer, is_loopback, parse_address
 
 PATHS = ["/", "/api/info", "/api/events", "/frame.jpg", "/tree.svg", "/static/monitor.js"]
 
