@@ -63,10 +63,13 @@ class Hub:
         return time.perf_counter() >= self._next
 
     def tick(self, t: int, activation: list[float], reward: float) -> None:
-        """One time unit's necessity outputs and reward (every unit; kept for the plot)."""
-        with self._lock:
-            self._series.append([t, activation, reward])
-            self._series_count += 1
+        """One time unit's necessity outputs and reward (every unit; kept for the plot).
+
+        No lock: only the control loop appends, and a deque's append (like the reader's
+        copy of it) is atomic under the GIL."""
+        n = self._series_count + 1
+        self._series.append((n, t, activation, reward))
+        self._series_count = n
 
     def publish(self, view: dict[str, Any], frame: Any = None) -> None:
         """Hand over the newest view (a :meth:`StepView.row`) and its camera frame."""
@@ -110,12 +113,13 @@ class Hub:
         with self._lock:
             if version == self.version and series_count == self._series_count:
                 return None, version, series_count
-            new = min(self._series_count - series_count, len(self._series))
-            series = list(self._series)[len(self._series) - new:] if new > 0 else []
+            points = list(self._series)  # one atomic copy
+            count = points[-1][0] if points else 0
+            series = [[t, ys, r] for n, t, ys, r in points if n > series_count]
             msg = {"info": {"rate": self.rate, **self.info}, "view": self.view,
                    "series": series, "tree_version": self.tree_version,
                    "events": list(self.events), "finished": self.finished}
-            return msg, self.version, self._series_count
+            return msg, self.version, count
 
     def jpeg(self, quality: int = 80) -> tuple[int, bytes] | None:
         """The newest frame as JPEG bytes with its sequence number (encoded once)."""
