@@ -40,6 +40,8 @@ from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
 
 __all__ = ["FrameRecorder", "SessionTap", "write_manifest"]
 
+#: what a traced or shown step asks the engine for, in the step's one gateway call.
+WANTS = ("memory", "explain")
 #: seconds between checks of whether the learner's tree changed.
 TREE_PERIOD = 1.0
 
@@ -157,6 +159,7 @@ class SessionTap:
         self._tree_key: Any = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
+        self._asked = False
         self.files: dict[str, str] = {}
         if record and out is not None:
             self.files = _copy_script(run.episode, out)
@@ -184,6 +187,12 @@ class SessionTap:
         return (getattr(env, "last_frame", None), getattr(env, "last_percept", None),
                 getattr(env, "focus", None))
 
+    def want(self) -> tuple[str, ...]:
+        """What the next step is to report from its one gateway call: working memory and
+        the explanation when this time unit is traced or shown, nothing otherwise."""
+        self._asked = self.trace is not None or (self.hub is not None and self.hub.due())
+        return WANTS if self._asked else ()
+
     def step(self, record: Any, phase: str, *, outcome: str | None = None,
              said: str | None = None) -> dict[str, Any] | None:
         """One time unit: returns the trace row when one was built."""
@@ -193,12 +202,12 @@ class SessionTap:
         self._seen = self._now_seen()
         if hub is not None:
             hub.tick(run.t, list(out.outputs.values()), float(out.reward))
-        publish = hub is not None and hub.due()
-        if self.trace is None and not publish:
+        if not self._asked:  # neither traced nor shown: the plot's point is all
             return None
+        self._asked = False
+        publish = hub is not None and hub.due()
         info = record.info
-        view = view_of(run.t, phase, record, memory=run.kb.memory(),
-                       explanation=run.learner.explain())
+        view = view_of(run.t, phase, record)
         view.head = head_view(self.head)
         view.metrics = metrics_view(run.metrics)
         view.extra = {"caregiver": info.get("scene"), "focus": info["record"].focus,

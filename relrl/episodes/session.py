@@ -145,9 +145,10 @@ def _live_line(t: int, phase: str, record: Any, outcome: str | None, said: str |
     wants = (f"{out.necessity} ({out.outputs.get(out.necessity, 0.0):.2f})"
              if out.necessity != "none" else
              "nothing (" + ", ".join(f"{k} {v:.2f}" for k, v in out.outputs.items()) + ")")
+    does = format_term(out.action) if out.action is not None else "nothing"
     text = (f"t={t:<4d} [{phase}] perceives: "
             f"{', '.join(format_term(p) for p in record.percepts)}\n"
-            f"       wants: {wants}  does: {format_term(out.action)}  reward {out.reward:+.0f}")
+            f"       wants: {wants}  does: {does}  reward {out.reward:+.0f}")
     if said:
         text += f'  says: "{said}"'
     if outcome:
@@ -257,7 +258,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             phase_name = phase.name
             _pull_words(run, env)
             run.t = t
-            interaction.run(1, learning=phase.learning, keep=False)
+            interaction.run(1, learning=phase.learning, keep=False, want=run.tap.want())
             bar.update(1)
             if opts.step_seconds:
                 time.sleep(opts.step_seconds)

@@ -34,11 +34,14 @@ def _rate(learner: str, steps: int, seed: int, on_step: Any = None) -> float:
         env = SharedAttentionEnv(make_caregiver("paper", {"attention_during_gaze": True}),
                                  max_steps=None, record_trace=False)
         tap = on_step(agent) if on_step is not None else None
+        want = tap.want if tap is not None else tuple
         interaction = Interaction(env, agent, on_step=tap)
         interaction.reset(seed=seed)
-        interaction.run(500, keep=False)
+        for _ in range(500):  # warm up: the tree exists
+            interaction.run(1, keep=False, want=want())
         t0 = time.perf_counter()
-        interaction.run(steps, keep=False)
+        for _ in range(steps):  # one time unit at a time, as a session runs
+            interaction.run(1, keep=False, want=want())
         return steps / (time.perf_counter() - t0)
 
 

@@ -9,7 +9,6 @@ package ``graphviz``, Python package ``graphviz`` from the ``monitor`` extra).
 
 from __future__ import annotations
 
-import re
 from typing import Any
 
 from relrl.errors import UserError
@@ -28,52 +27,8 @@ class GraphError(UserError):
 
 def learner_graph(learner: Any) -> dict[str, Any] | None:
     """The learner's tree as ``{"nodes", "edges"}``, or ``None`` for learners without one."""
-    graph = getattr(learner, "graph", None)
-    if graph is not None:
-        return graph()
-    text = learner.tree()  # engines before learner.graph(): read the tree's text form
-    return parse_tree_text(text) if text else None
-
-
-_TEST = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )?\[(?P<id>\d+)\] (?P<goal>.*) \?$")
-_LEAF = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )?leaf \[(?P<id>\d+)\] (?P<rest>.*)$")
-_NULL = re.compile(r"^(?P<ind>\s*)(?P<branch>yes: |no:  )null$")
-
-
-def parse_tree_text(text: str) -> dict[str, Any]:
-    """Nodes and edges of a tree drawn as indented text (``relrl_qtree:qtree_format/2``)."""
-    nodes: list[dict[str, Any]] = []
-    edges: list[dict[str, Any]] = []
-    stack: list[tuple[int, str]] = []  # (indent, node id) of open test nodes
-    nulls = 0
-    leaf: dict[str, Any] | None = None
-    for line in text.splitlines():
-        m = _TEST.match(line) or _LEAF.match(line) or _NULL.match(line)
-        if m is None:
-            if leaf is not None and line.strip():
-                leaf["entries"].append(line.strip())
-            continue
-        indent = len(m["ind"])
-        while stack and stack[-1][0] >= indent:
-            stack.pop()
-        if m.re is _NULL:
-            nulls += 1
-            node = {"id": f"null{nulls}", "kind": "null", "label": "null"}
-        elif m.re is _TEST:
-            node = {"id": m["id"], "kind": "test", "label": m["goal"]}
-        else:
-            node = {"id": m["id"], "kind": "leaf", "label": m["rest"], "entries": []}
-        nodes.append(node)
-        leaf = node if node["kind"] == "leaf" else None
-        if stack and m["branch"]:
-            edges.append({"from": stack[-1][1], "to": node["id"],
-                          "branch": m["branch"].strip(" :")})
-        if node["kind"] == "test":
-            stack.append((indent, node["id"]))
-    for node in nodes:
-        if node["kind"] == "leaf":
-            node["label"] = "\n".join([node["label"]] + node.pop("entries")[:LEAF_ENTRIES])
-    return {"nodes": nodes, "edges": edges}
+    graph = learner.graph()
+    return graph if graph.get("nodes") else None
 
 
 def _cut(text: str) -> str:

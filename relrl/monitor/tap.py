@@ -1,9 +1,14 @@
-"""The live monitor on any control loop (the simulator, an experiment, a script of yours):
-``Interaction(env, agent, on_step=LoopTap(hub, agent))``.
+"""The live monitor on any control loop (the simulator, an experiment, a script of yours)::
 
-Every step hands the necessity outputs and reward to the hub's plot; at the hub's rate a full
-:class:`~relrl.monitor.view.StepView` (working memory with ages, the explanation) is built
-and published; once a second the learner's tree. Episodes use
+    tap = LoopTap(hub, agent)
+    interaction = Interaction(env, agent, on_step=tap)
+    for _ in range(steps):
+        interaction.run(1, keep=False, want=tap.want())
+
+Every step hands the necessity outputs and reward to the hub's plot; at the hub's rate the
+step is asked (``want``) for working memory and the explanation in its one gateway call,
+and a full :class:`~relrl.monitor.view.StepView` is published; once a second the learner's
+tree. Episodes use
 :class:`relrl.episodes.recording.SessionTap`, which adds frames, the head and the metrics.
 """
 
@@ -32,20 +37,25 @@ class LoopTap:
         self.tree_period = tree_period
         self._tree_next = 0.0
         self.t = 0
+        self._asked = False
         hub.info.setdefault("learner", agent.learner.name)
         hub.info.setdefault("necessities", agent.necessities)
+
+    def want(self) -> tuple[str, ...]:
+        """What the next step is to report (memory and explanation when a view is due)."""
+        self._asked = self.hub.due()
+        return ("memory", "explain") if self._asked else ()
 
     def __call__(self, record: Any) -> None:
         self.t += 1
         out = record.out
         hub = self.hub
         hub.tick(self.t, list(out.outputs.values()), float(out.reward))
-        if not hub.due():
+        if not self._asked:
             return
+        self._asked = False
         learner = self.agent.learner
-        view = view_of(self.t, self.phase, record, memory=self.agent.kb.memory(),
-                       explanation=learner.explain())
-        hub.publish(view.row())
+        hub.publish(view_of(self.t, self.phase, record).row())
         now = time.perf_counter()
         if now >= self._tree_next:
             from relrl.monitor.graph import learner_graph

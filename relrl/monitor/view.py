@@ -68,8 +68,8 @@ class StepView:
         return out
 
 
-def _none(term: Any) -> str | None:
-    return None if term is None or term == "none" else format_term(term)
+def _text(term: Any) -> str | None:
+    return None if term is None else format_term(term)
 
 
 def _finite(x: float) -> float | None:
@@ -99,10 +99,10 @@ def view_of(t: int, phase: str, record: Any, *, memory: list[tuple[int, Any]] | 
         memory=None if mem is None else [[int(a), format_term(e)] for a, e in mem],
         memory_size=size,
         state=int(out.code),
-        necessity=_none(out.necessity),
+        necessity=None if out.necessity in (None, "none") else str(out.necessity),
         activation={k: round(float(v), 6) for k, v in out.outputs.items()},
         reward=float(out.reward),
-        response=_none(out.action),
+        response=_text(out.action),
         allowed=[format_term(a) for a in out.allowed],
         explanation=exp,
     )

@@ -7,30 +7,21 @@ from pathlib import Path
 import pytest
 
 from relrl.cli import main
-from relrl.monitor.graph import parse_tree_text, render
+from relrl.monitor.graph import render
 from tests.monitor.conftest import FRUITS, episode
 
-TEXT = """[0] stimulus(face) ?
-    yes: [1] fact(frontal(face)) ?
-        yes: leaf [3] state 129
-              look(centre)  Q=31.0000  [socialize]
-              look(left)  Q=29.2000  [socialize]
-        no:  null
-    no:  leaf [2] state 8
-          look(down)  Q=29.5000  [socialize]
-"""
 
-
-def test_the_tree_text_reads_back_as_a_graph() -> None:
-    g = parse_tree_text(TEXT)
-    kinds = {n["id"]: n["kind"] for n in g["nodes"]}
-    assert kinds == {"0": "test", "1": "test", "3": "leaf", "null1": "null", "2": "leaf"}
-    assert {(e["from"], e["to"], e["branch"]) for e in g["edges"]} == {
-        ("0", "1", "yes"), ("1", "3", "yes"), ("1", "null1", "no"), ("0", "2", "no")}
-    leaf = next(n for n in g["nodes"] if n["id"] == "3")
-    assert leaf["label"].splitlines()[1].startswith("look(centre)")
+def test_a_graph_is_drawn_by_graphviz() -> None:
+    g = {"nodes": [{"id": "n0", "kind": "test", "label": "stimulus(face)"},
+                   {"id": "n1", "kind": "leaf", "label": "look(centre) 31.0"},
+                   {"id": "n2", "kind": "leaf", "label": "look(down) 29.5"}],
+         "edges": [{"from": "n0", "to": "n1", "branch": "yes"},
+                   {"from": "n0", "to": "n2", "branch": "no"}]}
     svg = render(g).decode()
-    assert "<svg" in svg and "frontal(face)" in svg and "look(centre)" in svg
+    assert "<svg" in svg and "stimulus(face)" in svg and "look(centre)" in svg
+    assert svg.count('class="node"') == 3 and svg.count('class="edge"') == 2
+    assert 'stroke-dasharray' in svg  # the "no" branch is dashed
+    assert render(g, "dot").decode().startswith("digraph tree {")
 
 
 def _policy(tmp_path: Path, learner: str) -> Path:
