@@ -137,7 +137,10 @@ function showExplanation(v) {
     row(tb, [r.response, value == null ? "" : fmt(value, 3)],
         r.response === v.response ? "chosen" : "");
   }
-  if (!ranked.length) row(tb, ["no stored choices here: every response starts equal", ""]);
+  if (v.response && !ranked.some((r) => r.response === v.response))
+    row(tb, [v.response, "initial value (nothing stored for it here yet)"], "chosen");
+  if (!ranked.length && !v.response)
+    row(tb, ["no stored choices here: every response starts equal", ""]);
   $("allowed").textContent = `allowed: ${(v.allowed || []).join(", ")}`;
 }
 
