@@ -190,11 +190,17 @@ function drawFrame(img, overlay) {
 }
 
 function loadFrame(src, key, overlay) {
-  if (state.frameLoading || key === state.frameShown) return;   // slow browser: skip frames
+  // only the newest frame is wanted; one request at a time (a slow browser skips frames)
+  state.wanted = { src, key, overlay };
+  if (state.frameLoading || key === state.frameShown) return;
   state.frameLoading = true;
   const img = new Image();
-  img.onload = () => { state.frameLoading = false; state.frameShown = key;
-                       $("frame").dataset.frameSeq = String(key); drawFrame(img, overlay); };
+  img.onload = () => {
+    state.frameLoading = false; state.frameShown = key;
+    $("frame").dataset.frameSeq = String(key); drawFrame(img, overlay);
+    const w = state.wanted;                     // a newer one arrived meanwhile: fetch it now
+    if (w && w.key !== key) loadFrame(w.src, w.key, w.overlay);
+  };
   img.onerror = () => { state.frameLoading = false; };
   img.src = src;
 }
