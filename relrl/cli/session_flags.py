@@ -53,10 +53,11 @@ class Session:
     opts: Any
     server: Any = None
     closers: list[Any] = field(default_factory=list)
+    hold_after: bool = False
 
     def hold(self) -> None:
         """With ``--monitor-hold``: serve until Ctrl-C."""
-        if self.server is None or not getattr(self, "_hold", False):
+        if self.server is None or not self.hold_after:
             return
         print(f"the monitor stays up at {self.server.url} ; Ctrl-C ends it", flush=True)
         try:
@@ -109,8 +110,7 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
     from relrl import log
 
     _check(args)
-    session = Session(opts)
-    session._hold = args.monitor_hold  # type: ignore[attr-defined]
+    session = Session(opts, hold_after=args.monitor_hold)
     handler = None
     try:
         if opts.out is not None:

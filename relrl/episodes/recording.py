@@ -208,7 +208,7 @@ class SessionTap:
         publish = hub is not None and hub.due()
         info = record.info
         view = view_of(run.t, phase, record)
-        view.head = head_view(self.head)
+        view.head = head_view(self.head, info["record"].focus)
         view.metrics = metrics_view(run.metrics)
         view.extra = {"caregiver": info.get("scene"), "focus": info["record"].focus,
                       "heard": info["words"], "naming": outcome, "said": said,

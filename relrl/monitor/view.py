@@ -108,10 +108,11 @@ def view_of(t: int, phase: str, record: Any, *, memory: list[tuple[int, Any]] | 
     )
 
 
-def head_view(head: Any) -> dict[str, Any] | None:
+def head_view(head: Any, looking_at: str | None = None) -> dict[str, Any] | None:
     """The commanded pose of a :class:`head.Head` (``None`` for no head): per servo the
     pulse width in microseconds, its offset from the calibrated centre and the nominal angle
-    (:data:`NOMINAL_DEG_PER_US`), and the direction the head is at."""
+    (:data:`NOMINAL_DEG_PER_US`), and where the head looks (as the world knows it: asking
+    a serial head would cost a round trip on the wire)."""
     if head is None:
         return None
     servos = head.calibration.servos
@@ -120,7 +121,7 @@ def head_view(head: Any) -> dict[str, Any] | None:
         offset = int(us) - servos[name].centre
         pose[name] = {"us": int(us), "offset_us": offset,
                       "deg": round(offset * NOMINAL_DEG_PER_US, 1)}
-    return {"servos": pose, "looking_at": head.looking_at(), "clamped": head.clamped_count}
+    return {"servos": pose, "looking_at": looking_at, "clamped": head.clamped_count}
 
 
 def metrics_view(metrics: Any) -> dict[str, Any]:

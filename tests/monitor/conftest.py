@@ -80,7 +80,8 @@ class RelrlProcess:
                                      text=True, cwd=ROOT)
         self.lines: list[str] = []
 
-    def url(self, timeout: float = 60.0) -> str:
+    def wait_for(self, pattern: str, timeout: float = 60.0) -> re.Match[str]:
+        """Read output lines until one matches ``pattern``."""
         deadline = time.monotonic() + timeout
         assert self.proc.stdout is not None
         while time.monotonic() < deadline:
@@ -88,10 +89,14 @@ class RelrlProcess:
             if not line:
                 break
             self.lines.append(line)
-            m = re.search(r"(http://\S+)", line)
+            m = re.search(pattern, line)
             if m:
-                return m.group(1)
-        raise AssertionError("no monitor address printed: " + "".join(self.lines))
+                return m
+        raise AssertionError(f"never printed {pattern!r}: " + "".join(self.lines))
+
+    def url(self, timeout: float = 60.0) -> str:
+        """The monitor's address, once printed."""
+        return self.wait_for(r"(http://\S+)", timeout).group(1)
 
     def finish(self, timeout: float = 120.0) -> tuple[int, str]:
         out, _ = self.proc.communicate(timeout=timeout)

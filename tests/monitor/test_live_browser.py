@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import time
 from pathlib import Path
 
@@ -23,7 +24,7 @@ def _wait(page, condition, timeout: float = 30.0) -> None:
 
 def test_live_page_updates_frame_plot_and_explanation(page, relrl_process,
                                                       tmp_path: Path) -> None:
-    script = episode(tmp_path, steps=250)
+    script = episode(tmp_path, steps=2000)  # stopped by Ctrl-C once the page has updated
     proc = relrl_process("run", str(script), "--monitor", "--monitor-rate", "8",
                          "--head", "sim", "--step-seconds", "0.03", "--no-plots")
     url = proc.url()
@@ -51,9 +52,10 @@ def test_live_page_updates_frame_plot_and_explanation(page, relrl_process,
     assert "see(" in page.inner_text("#percepts")
     page.screenshot(path=str(tmp_path / "live.png"), full_page=True)
     assert (tmp_path / "live.png").stat().st_size > 10_000
-    code, out = proc.finish()
-    assert code == 0, out
     assert not page.errors, page.errors
+    proc.proc.send_signal(signal.SIGINT)  # Ctrl-C: the run stops cleanly, monitor and all
+    code, out = proc.finish()
+    assert code == 130 and "everything up to it is written" in out, out
 
 
 def test_page_says_finished_and_shows_the_tree(page, relrl_process, tmp_path: Path) -> None:
@@ -67,6 +69,7 @@ def test_page_says_finished_and_shows_the_tree(page, relrl_process, tmp_path: Pa
     assert page.evaluate("document.getElementById('tree').naturalWidth") > 50
     assert "symbolic" in page.inner_text("#frame-note")
     assert _attr(page, "#plot", "data-points") == 60
-    proc.proc.send_signal(2)
+    proc.wait_for("the monitor stays up")  # the summary is written; Ctrl-C ends the page
+    proc.proc.send_signal(signal.SIGINT)
     code, out = proc.finish()
     assert code == 0, out

@@ -150,7 +150,7 @@ function showHead(h) {
   if (!h) { $("head-note").textContent = "no head in this session (--head PORT drives one)"; return; }
   for (const [name, s] of Object.entries(h.servos || {}))
     row(tb, [name, s.us, (s.offset_us > 0 ? "+" : "") + s.offset_us, s.deg]);
-  $("head-note").textContent = `at ${h.looking_at || "no calibrated direction (moving?)"}; ` +
+  $("head-note").textContent = `looking ${h.looking_at || "?"}; ` +
     `angles nominal (0.09°/µs); ${h.clamped} values clamped to the calibration so far`;
 }
 
