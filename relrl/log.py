@@ -38,7 +38,6 @@ def setup(verbosity: int = 0) -> None:
                                            else "%(levelname)s %(name)s: %(message)s"))
     root.addHandler(handler)
     root.setLevel(logging.DEBUG)
-    root.propagate = False
 
 
 def quiet() -> bool:

@@ -157,6 +157,7 @@ class SessionTap:
         self._events = open(out / "events.jsonl", "w", encoding="utf-8") \
             if record and out is not None else None  # noqa: SIM115
         self._tree_key: Any = None
+        self._tree_graph: dict[str, Any] | None = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
@@ -231,9 +232,10 @@ class SessionTap:
         if not force and now < self._tree_next:
             return
         self._tree_next = now + TREE_PERIOD
-        from relrl.monitor.graph import learner_graph
+        from relrl.monitor.graph import shown_graph
 
-        graph = learner_graph(self.run.learner)
+        graph = shown_graph(self.run.learner, self._tree_graph)
+        self._tree_graph = graph
         key = json.dumps(graph, sort_keys=True)
         if key == self._tree_key:
             return

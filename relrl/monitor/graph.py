@@ -31,6 +31,21 @@ def learner_graph(learner: Any) -> dict[str, Any] | None:
     return graph if graph.get("nodes") else None
 
 
+def shown_graph(learner: Any, previous: dict[str, Any] | None) -> dict[str, Any] | None:
+    """:func:`learner_graph` for the monitor: when the query runs out of time (a machine
+    too busy to answer within the gateway's limit) the robot goes on and the page keeps the
+    tree it has (``previous``); the miss is logged."""
+    import logging
+
+    from relrl.errors import QueryTimeout
+
+    try:
+        return learner_graph(learner)
+    except QueryTimeout as exc:
+        logging.getLogger(__name__).warning("the tree was not redrawn: %s", exc)
+        return previous
+
+
 def _cut(text: str) -> str:
     lines = str(text).splitlines() or [""]
     return "\n".join(s if len(s) <= LABEL_WIDTH else s[:LABEL_WIDTH - 1] + "…" for s in lines)

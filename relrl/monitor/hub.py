@@ -25,6 +25,8 @@ __all__ = ["Hub"]
 
 #: points of the necessity series kept for a browser that connects late.
 SERIES_KEEP = 2000
+#: points sent in one message at most (the newest; the page plots the last 600).
+SERIES_SEND = 600
 
 
 class Hub:
@@ -115,7 +117,7 @@ class Hub:
                 return None, version, series_count
             points = list(self._series)  # one atomic copy
             count = points[-1][0] if points else 0
-            series = [[t, ys, r] for n, t, ys, r in points if n > series_count]
+            series = [[t, ys, r] for n, t, ys, r in points[-SERIES_SEND:] if n > series_count]
             msg = {"info": {"rate": self.rate, **self.info}, "view": self.view,
                    "series": series, "tree_version": self.tree_version,
                    "events": list(self.events), "finished": self.finished}

@@ -58,7 +58,7 @@ class LoopTap:
         hub.publish(view_of(self.t, self.phase, record).row())
         now = time.perf_counter()
         if now >= self._tree_next:
-            from relrl.monitor.graph import learner_graph
+            from relrl.monitor.graph import shown_graph
 
             self._tree_next = now + self.tree_period
-            hub.set_tree(learner_graph(learner))
+            hub.set_tree(shown_graph(learner, hub.tree))

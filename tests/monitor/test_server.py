@@ -147,3 +147,16 @@ def test_the_hub_paces_views_at_its_rate() -> None:
     assert not hub.due()   # the next view is due half a second later
     with pytest.raises(ValueError):
         Hub(rate=0)
+
+
+def test_a_tree_query_out_of_time_keeps_the_last_tree(caplog) -> None:
+    from relrl.errors import QueryTimeout
+    from relrl.monitor.graph import shown_graph
+
+    class Slow:
+        def graph(self):
+            raise QueryTimeout("query ran longer than 10 s")
+
+    last = {"nodes": [{"id": 0, "kind": "leaf", "label": "x"}], "edges": []}
+    assert shown_graph(Slow(), last) is last
+    assert "the tree was not redrawn" in caplog.text
