@@ -196,7 +196,7 @@ def most_salient(frame: np.ndarray, params: SaliencyParams = SaliencyParams(),
     _, labels = cv2.connectedComponents(above, connectivity=8)
     small = (labels == labels[py, px]).astype(np.uint8) * 255
     mask = cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
-    mask = np.where(mask >= 128, 255, 0).astype(np.uint8)
+    cv2.threshold(mask, 127, 255, cv2.THRESH_BINARY, dst=mask)  # 255 where >= 128, else 0
     area = float(np.count_nonzero(mask)) / (w * h)
     if area < params.min_area:
         return None
