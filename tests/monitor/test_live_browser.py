@@ -66,7 +66,9 @@ def test_page_says_finished_and_shows_the_tree(page, relrl_process, tmp_path: Pa
     page.goto(url)
     page.wait_for_selector("#mode.finished", timeout=60_000)
     page.wait_for_selector("#tree:not([hidden])", timeout=30_000)
-    assert page.evaluate("document.getElementById('tree').naturalWidth") > 50
+    # the tree's picture (an SVG drawn by Graphviz) has loaded, whatever redraw came last
+    page.wait_for_function("() => { const i = document.getElementById('tree');"
+                           " return i.complete && i.naturalWidth > 50; }", timeout=30_000)
     assert "symbolic" in page.inner_text("#frame-note")
     assert _attr(page, "#plot", "data-points") == 60
     proc.wait_for("the monitor stays up")  # the summary is written; Ctrl-C ends the page
