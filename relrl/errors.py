@@ -20,6 +20,7 @@ __all__ = [
     "QueryTimeout",
     "DomainError",
     "ConfigError",
+    "OutputError",
 ]
 
 
@@ -74,3 +75,8 @@ class DomainError(UserError):
 
 class ConfigError(UserError):
     """A bad option value: a flag, a parameter, a configuration file entry."""
+
+
+class OutputError(ConfigError):
+    """An output folder or file that cannot be used: a file where a folder is needed, a folder
+    that cannot be created or written, a non-empty folder of another run."""
