@@ -6,6 +6,8 @@ import argparse
 
 HELP = "print the perception facts of an image (or camera frames) as Prolog terms"
 EXAMPLE = "relrl perceive photo.png --annotate out.png"
+#: the file types --annotate writes.
+IMAGE_OUT = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -31,11 +33,18 @@ def run(args: argparse.Namespace) -> int:
     from perception.errors import PerceptionError
     from perception.facts import format_fact
     from perception.pipeline import Perceiver, annotate
+    from perception.vocab import PLACES
+    from relrl.outdir import check_out_file, write_atomic
 
     if (args.image is None) == (args.camera is None):
         raise PerceptionError("give either an IMAGE or --camera SRC (not both)")
     if args.frames < 1:
         raise PerceptionError(f"--frames must be at least 1, got {args.frames}")
+    if args.looking_at is not None and args.looking_at not in PLACES:
+        raise PerceptionError(f"--looking-at {args.looking_at!r}: use one of "
+                              f"{', '.join(PLACES)}")
+    annotate_to = check_out_file(args.annotate, "--annotate", suffixes=IMAGE_OUT) \
+        if args.annotate else None  # before reading a single frame
     perceiver = Perceiver()
     if args.image is not None:
         frames = [read_image(args.image)]
@@ -56,7 +65,10 @@ def run(args: argparse.Namespace) -> int:
         percept = perceiver.analyse(frame, args.looking_at)
         for fact in percept.facts:
             print(format_fact(fact))
-    if args.annotate and not cv2.imwrite(args.annotate, annotate(frames[-1], percept)):
-        raise PerceptionError(f"cannot write {args.annotate!r}; use a .png or .jpg path in "
-                              "an existing folder")
+    if annotate_to is not None:
+        ext = annotate_to.suffix.lower() if annotate_to.suffix.lower() in IMAGE_OUT else ".png"
+        ok, data = cv2.imencode(ext, annotate(frames[-1], percept))
+        if not ok:
+            raise PerceptionError(f"--annotate {annotate_to}: OpenCV cannot write {ext} files")
+        write_atomic(annotate_to, data.tobytes())
     return 0
