@@ -9,6 +9,7 @@ state, necessity, reward and allowed responses from that same call and chooses i
 from __future__ import annotations
 
 import abc
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -87,6 +88,9 @@ class Learner(abc.ABC):
             except (TypeError, ValueError):
                 raise ConfigError(f"parameter {key} of learner {self.name!r} must be a number, "
                                   f"not {value!r}") from None
+            if not math.isfinite(self.params[key]):
+                raise ConfigError(f"parameter {key} of learner {self.name!r} must be a finite "
+                                  f"number, not {value!r}")
         self._check_params()
         self.kb: KnowledgeBase | None = None
         self.rng = np.random.default_rng(0)
