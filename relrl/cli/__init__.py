@@ -4,7 +4,9 @@ Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EX
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
 pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
 
-Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2.
+Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2 (an
+error that lists several problems -- a bad episode script -- prints one ``file:line: problem``
+line each, then the count).
 """
 
 from __future__ import annotations
@@ -75,7 +77,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args._run(args) or 0)
     except UserError as exc:
-        print(f"relrl {args.command}: {exc}", file=sys.stderr)
+        *problems, last = str(exc).splitlines() or [type(exc).__name__]
+        for line in problems:  # several problems: "file:line: problem" each, then a count
+            print(line, file=sys.stderr)
+        print(f"relrl {args.command}: {last}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"relrl {args.command}: interrupted", file=sys.stderr)
