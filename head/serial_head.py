@@ -38,7 +38,13 @@ class SerialLink:
         self.protocol = protocol
         self.timeout = timeout
         self.bytes_written = 0
-        self._serial_errors = (serial.SerialException, OSError)
+        self._serial_errors: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+        try:  # pyserial's POSIX port lets termios errors through (e.g. a hung-up terminal)
+            import termios
+
+            self._serial_errors += (termios.error,)
+        except ImportError:  # pragma: no cover - Windows
+            pass
         opener = factory or serial.serial_for_url
         try:
             self.serial = opener(port, baudrate=baudrate, timeout=timeout,

@@ -160,7 +160,11 @@ class _Folder(Camera):
         if self._closed or self._next >= len(self._files):
             return None
         self._next += 1
-        return read_image(self._files[self._next - 1])
+        path = self._files[self._next - 1]
+        if not path.exists():
+            raise CameraError(f"lost the camera ({self.name}): {path} is gone (moved or "
+                              "deleted while reading)")
+        return read_image(path)
 
 
 class _Image(_Folder):

@@ -241,7 +241,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     run = _Run(episode, opts)
     trace = _Trace(out / "trace.jsonl" if out is not None else None)
     env = actuator = None
-    written = False
+    written = failed = False
     try:
         env, actuator = _world(episode, opts)
         phase_name = episode.phase_at(1).name
@@ -297,15 +297,34 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             _write_outputs(run, out, summary, timing)
         return summary
     except BaseException as exc:  # a lost device, a fault, a second Ctrl-C
+        failed = True
         if out is not None and not written:
             keep_partial(run, out, t0, exc)
         raise
     finally:
         trace.close()
-        for thing in (actuator, env):
-            if thing is not None:
-                thing.close()
-        run.close()
+        try:
+            _release(actuator, env, quiet=failed)
+        finally:
+            run.close()
+
+
+def _release(*things: Any, quiet: bool) -> None:
+    """Close the head and the camera (each, even when one fails). After an error (``quiet``)
+    their errors are dropped: a lost port cannot centre the head, and the first error is
+    the one to report."""
+    from relrl.errors import UserError
+
+    first: UserError | None = None
+    for thing in things:
+        if thing is None:
+            continue
+        try:
+            thing.close()
+        except UserError as exc:
+            first = first or exc
+    if first is not None and not quiet:
+        raise first
 
 
 def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
