@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
 def _run(episode, opts, stop) -> dict:
     """Run the episode; a user's error ends with one line that says what was kept."""
     from relrl.episodes import run_episode
-    from relrl.errors import PrologError, UserError
+    from relrl.errors import UserError
 
     try:
         with stop.installed():
@@ -130,10 +130,6 @@ def _run(episode, opts, stop) -> dict:
         if kept is None:
             raise
         raise UserError(f"{exc}; {kept}") from None
-    except PrologError as exc:  # a rule of the domain failed with an error while running
-        kept = getattr(exc, "kept", None)
-        raise UserError(f"{episode.domain}: a rule raised an error: {exc.message}"
-                        + (f"; {kept}" if kept else "")) from None
 
 
 def _report(s: dict) -> str:
