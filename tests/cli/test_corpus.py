@@ -165,3 +165,12 @@ def test_an_episode_file_reports_all_its_errors(capsys, corpus):
     assert err[1] == (f"{corpus}/empty.toml:1: the script needs at least one [[phase]] "
                       "with steps = N")
     assert err[2] == f"relrl run: 2 problems in {corpus}/empty.toml" and len(err) == 3
+
+
+def test_bytes_typed_under_live_that_are_not_utf8_are_skipped(capsys, monkeypatch, corpus):
+    typed = io.TextIOWrapper(io.BytesIO(b"\xff\xfe\n apple caf\xc3 Lemon!\n"), encoding="utf-8")
+    monkeypatch.setattr(sys, "stdin", typed)
+    assert main(["run", str(corpus / "ok.toml"), "--live", "--step-seconds", "0.05"]) == 0
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err and "hear(apple)" in captured.out
+    assert "ignored '\ufffd\ufffd'" in captured.err and "ignored 'lemon!'" in captured.err
