@@ -52,6 +52,8 @@ def read_image(path: str | Path) -> np.ndarray:
     p = Path(path)
     if p.is_dir():
         raise ImageError(f"{str(path)!r} is a folder; give an image file (or --camera DIR)")
+    if p.exists() and not p.is_file():
+        raise ImageError(f"{str(path)!r} is not a regular file (a device or a pipe?)")
     if not p.is_file():
         raise ImageError(f"no such image file: {str(path)!r}")
     width, height, kind = header_size(p)

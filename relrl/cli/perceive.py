@@ -26,7 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Print one fact per line; frames from a camera are separated by a ``% frame N`` line."""
+    """Print one fact per line; with ``--frames N`` (N > 1) each frame starts with a
+    ``% frame I`` line. Frames are read and analysed one at a time."""
     import cv2
 
     from perception.camera import open_camera, read_image
@@ -46,28 +47,31 @@ def run(args: argparse.Namespace) -> int:
     annotate_to = check_out_file(args.annotate, "--annotate", suffixes=IMAGE_OUT) \
         if args.annotate else None  # before reading a single frame
     perceiver = Perceiver()
-    if args.image is not None:
-        frames = [read_image(args.image)]
-    else:
+
+    def frames():  # one at a time: --frames 1000000 holds one frame, not a million
+        if args.image is not None:
+            yield read_image(args.image)
+            return
         with open_camera(args.camera) as cam:
-            frames = []
             for _ in range(args.frames):
                 frame = cam.read()
                 if frame is None:
-                    break
-                frames.append(frame)
-        if not frames:
-            raise PerceptionError(f"camera {args.camera!r} gave no frame")
-    percept = None
-    for i, frame in enumerate(frames):
-        if len(frames) > 1:
+                    return
+                yield frame
+
+    last = percept = None
+    for i, frame in enumerate(frames()):
+        if args.frames > 1:
             print(f"% frame {i}")
         percept = perceiver.analyse(frame, args.looking_at)
         for fact in percept.facts:
             print(format_fact(fact))
+        last = frame
+    if last is None:
+        raise PerceptionError(f"camera {args.camera!r} gave no frame")
     if annotate_to is not None:
         ext = annotate_to.suffix.lower() if annotate_to.suffix.lower() in IMAGE_OUT else ".png"
-        ok, data = cv2.imencode(ext, annotate(frames[-1], percept))
+        ok, data = cv2.imencode(ext, annotate(last, percept))
         if not ok:
             raise PerceptionError(f"--annotate {annotate_to}: OpenCV cannot write {ext} files")
         write_atomic(annotate_to, data.tobytes())

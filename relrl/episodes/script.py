@@ -144,6 +144,8 @@ class Episode:
 # ---- locating keys in the text -----------------------------------------------------------------
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+#: the most evaluation runs per point, and naming executions, a script may ask for.
+MAX_RUNS = 10_000
 #: problems listed in full before the rest are counted.
 MAX_LISTED = 20
 #: names in --out that belong to the run itself (a policy may not take them).
@@ -238,10 +240,12 @@ class _Checker:
         return value
 
     def positive(self, table: dict[str, Any], key: str, default: int, where: tuple,
-                 minimum: int = 1) -> int:
+                 minimum: int = 1, maximum: int | None = None) -> int:
         value = self.get(table, key, int, default, where)
-        if value < minimum:
-            self.fail(where + (key,), f"{key} must be at least {minimum}, not {value}")
+        if value < minimum or (maximum is not None and value > maximum):
+            bound = f"at least {minimum}" if maximum is None else \
+                f"from {minimum} to {maximum}"
+            self.fail(where + (key,), f"{key} must be {bound}, not {value}")
             return default
         return value
 
@@ -477,13 +481,13 @@ def _optional_tables(c: _Checker, data: dict[str, Any], ep: Episode) -> None:
         w = ("evaluation",)
         c.keys(ev, ("every", "runs", "steps"), w)
         ep.evaluation = {"every": c.positive(ev, "every", 10, w),
-                         "runs": c.positive(ev, "runs", 5, w),
+                         "runs": c.positive(ev, "runs", 5, w, maximum=MAX_RUNS),
                          "steps": c.positive(ev, "steps", 100, w)}
     if "naming" in data:
         nm = c.table(data, "naming")
         w = ("naming",)
         c.keys(nm, ("executions", "presentations", "confident_after", "max_steps"), w)
-        ep.naming = {"executions": c.positive(nm, "executions", 5, w),
+        ep.naming = {"executions": c.positive(nm, "executions", 5, w, maximum=MAX_RUNS),
                      "presentations": c.positive(nm, "presentations", 40, w),
                      "confident_after": c.positive(nm, "confident_after", 3, w),
                      "max_steps": c.positive(nm, "max_steps", 1000, w)}

@@ -174,3 +174,17 @@ def test_bytes_typed_under_live_that_are_not_utf8_are_skipped(capsys, monkeypatc
     captured = capsys.readouterr()
     assert "Traceback" not in captured.err and "hear(apple)" in captured.out
     assert "ignored '\ufffd\ufffd'" in captured.err and "ignored 'lemon!'" in captured.err
+
+
+def test_bytes_piped_into_the_shell_that_are_not_utf8(capsys, monkeypatch):
+    piped = io.TextIOWrapper(io.BytesIO(b"response(R).\n\xff\xfe.\n"), encoding="utf-8")
+    monkeypatch.setattr(sys, "stdin", piped)
+    assert main(["shell", str(FRUITS)]) == 2  # the second query is an error, said in a line
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err + captured.out and "R = look(centre)" in captured.out
+
+
+def test_an_image_path_that_is_a_device(capsys, tmp_path):
+    (tmp_path / "zero.png").symlink_to("/dev/zero")
+    one_line_exit_2(capsys, ["perceive", str(tmp_path / "zero.png")], "zero.png",
+                    "not a regular file")

@@ -198,3 +198,8 @@ def test_checking_is_linear_in_the_events() -> None:
         ep = parse_episode(body + events, "many.toml")
     assert len(ep.events) == 5001 and ep.events[-1].line == 1 + body.count("\n") + 4 * 4999
     assert seen[0].scanned <= 2 * len(seen[0].lines)
+
+
+def test_evaluation_runs_are_bounded() -> None:
+    with pytest.raises(EpisodeError, match="runs must be from 1 to 10000, not 1000000000"):
+        parse_episode(GOOD + "[evaluation]\nruns = 1000000000\n", "e.toml")
