@@ -153,6 +153,7 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.executions: list[dict[str, Any]] = []
         self.t = 0
+        self.done = 0  # learning time units finished (traced)
         self.in_view = None
 
     def close(self) -> None:
@@ -181,6 +182,7 @@ TRACE_WANTS = ("memory_size", "explain")
 
 def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
     """Trace, naming and live output of one time unit."""
+    run.done += 1
     info = record.info
     said = None
     if record.out.action == "name_object":
@@ -411,10 +413,10 @@ def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
     from relrl.errors import RelrlError
 
     ep = run.episode
-    why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    run.t = min(run.t, run.done)  # the time unit in progress did not finish
     try:
-        summary = _summary(run, stopped=True, why=why)
-        summary["error"] = why
+        summary = _summary(run, stopped=True, why=type(exc).__name__)
+        summary["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         _write_outputs(run, out, summary, {"seconds": time.perf_counter() - t0,
                                            "learning_steps": run.t})
     except (RelrlError, OSError) as inner:
