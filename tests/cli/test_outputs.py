@@ -150,3 +150,11 @@ def test_head_calibrate_creates_its_folder(tmp_path, monkeypatch, umask_022):
     monkeypatch.setattr(sys, "stdin", io.StringIO("+ x w"))
     assert main(["head", "calibrate", "-o", str(path)]) == 0
     assert "[servos." in path.read_text() and _mode(path) == 0o644
+
+
+def test_a_q_table_is_written_0644_too(tmp_path, umask_022):
+    script = tmp_path / "q.toml"
+    script.write_text(episode_text(head='learner = "qlearning"\npolicy_save = "q.npz"'))
+    out = tmp_path / "out"
+    assert main(["run", str(script), "--out", str(out), "--no-plots"]) == 0
+    assert _mode(out / "q.npz") == 0o644 and list(out.glob(".*.tmp")) == []
