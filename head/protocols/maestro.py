@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from head.errors import ProtocolError
-from head.protocols import ABSOLUTE_RANGE, Command, Link, Protocol, check_command
+from head.protocols import Command, Link, Protocol, check_command, check_position
 
 __all__ = ["ERROR_BITS", "Maestro"]
 
@@ -73,13 +73,7 @@ class Maestro(Protocol):
         out = {}
         for ch in channels:
             lo, hi = link.transact(bytes((GET_POSITION, ch)), 2, f"position of channel {ch}")
-            us = (lo | hi << 8) / 4.0
-            if us and not ABSOLUTE_RANGE[0] <= us <= ABSOLUTE_RANGE[1]:
-                raise ProtocolError(
-                    f"maestro on {link.port}: channel {ch} reports position {us:g} us, outside "
-                    f"{ABSOLUTE_RANGE[0]}..{ABSOLUTE_RANGE[1]} (garbage on the line?); check "
-                    "--protocol and the baud rate")
-            out[ch] = us
+            out[ch] = check_position(self.name, link, ch, (lo | hi << 8) / 4.0)
         return out
 
     def query_moving(self, link: Link, targets: dict[int, int]) -> bool:

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from head.errors import ProtocolError
-from head.protocols import ABSOLUTE_RANGE, Command, Link, Protocol, check_command
+from head.protocols import Command, Link, Protocol, check_command, check_position
 
 __all__ = ["SSC32"]
 
@@ -55,11 +55,5 @@ class SSC32(Protocol):
             return {}
         query = " ".join(f"QP {ch}" for ch in channels) + "\r"
         answer = link.transact(query.encode("ascii"), len(channels), "positions (QP)")
-        out = {ch: float(b * 10) for ch, b in zip(channels, answer, strict=True)}
-        for ch, us in out.items():
-            if us and not ABSOLUTE_RANGE[0] <= us <= ABSOLUTE_RANGE[1]:
-                raise ProtocolError(
-                    f"ssc32 on {link.port}: channel {ch} reports position {us:g} us, outside "
-                    f"{ABSOLUTE_RANGE[0]}..{ABSOLUTE_RANGE[1]} (garbage on the line?); check "
-                    "--protocol and the baud rate")
-        return out
+        return {ch: check_position(self.name, link, ch, float(b * 10))
+                for ch, b in zip(channels, answer, strict=True)}

@@ -52,3 +52,37 @@ def test_maestro_error_register_with_undefined_bits_is_garbage():
     with pytest.raises(ProtocolError, match="12266"):
         Maestro().query_positions(Link((12266 * 4).to_bytes(2, "little")), [0])
     assert Maestro().query_positions(Link(b"\x00\x00"), [0]) == {0: 0.0}  # channel off
+
+
+def test_bytes_beyond_the_answer_are_garbage():
+    from head.errors import ProtocolError
+    from head.serial_head import SerialLink
+
+    class Chatty:
+        """A port that answers what was asked and then some."""
+
+        in_waiting = 3
+
+        def __init__(self, *args, **kwargs) -> None:
+            pass
+
+        def reset_input_buffer(self) -> None:
+            pass
+
+        def write(self, data: bytes) -> int:
+            return len(data)
+
+        def flush(self) -> None:
+            pass
+
+        def read(self, size: int) -> bytes:
+            return bytes(size)
+
+        def close(self) -> None:
+            pass
+
+    link = SerialLink("chatty", 9600, 0.1, "maestro", factory=Chatty)
+    with pytest.raises(ProtocolError, match="3 bytes more than the 2 asked"):
+        link.transact(b"\x90\x00", 2, "position of channel 0")
+    Chatty.in_waiting = 0
+    assert link.transact(b"\x90\x00", 2, "position of channel 0") == b"\x00\x00"
