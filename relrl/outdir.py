@@ -3,9 +3,11 @@
 The policy (``docs/outputs.md``):
 
 * ``--out DIR`` names the folder. It is created when missing. A folder that already holds
-  files is refused (exit 2) unless ``--overwrite`` is given; then the files of the earlier
-  relrl run there (listed in its ``.relrl-run.json``) are deleted first, so no stale file of
-  that run sits beside the new ones. Files relrl did not write are never deleted.
+  files is refused (exit 2) unless ``--overwrite`` is given; then the files the earlier relrl
+  run wrote there (listed in its ``.relrl-run.json``) are deleted first, so no stale file of
+  that run sits beside the new ones; other files are kept (a run killed before finishing its
+  record owns everything but what it found there). A folder without a record is never
+  emptied.
 * Without ``--out``, ``relrl experiment`` and ``relrl demo`` write a fresh folder
   ``runs/NAME-YYYYMMDD-HHMMSS`` (``-2``, ``-3``... when taken): re-running never mixes runs.
 * Everything is checked before any work starts: a path that is a file or a device, lies
@@ -259,9 +261,14 @@ class OutDir:
                   f"({earlier.get('started', '?')})" if earlier else f"{len(present)} files")
             raise OutputError(f"{what} {path}: the folder is not empty (it holds {by}); "
                               "pass --overwrite to replace them, or choose a new folder")
-        # an earlier run's files: everything but what was already there when it started (its
-        # record lists those as kept, even when it was killed before finishing its record)
-        ours = present - set(earlier.get("kept", [])) if earlier else set()
+        # the earlier run's files: those its record lists; a run killed before it finished
+        # its record lists none, and then everything but what it found there is its own
+        if not earlier:
+            ours: set[str] = set()
+        elif earlier.get("ended"):
+            ours = set(earlier.get("files", [])) & present
+        else:
+            ours = present - set(earlier.get("kept", []))
         for name in sorted(ours):
             try:
                 (path / name).unlink()

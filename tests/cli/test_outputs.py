@@ -35,22 +35,36 @@ def test_run_refuses_the_folder_of_another_run_unless_overwrite(capsys, tmp_path
     script.write_text(episode_text())
     out = tmp_path / "out"
     assert main(["run", str(script), "--out", str(out), "--no-plots"]) == 0
-    (out / "notes.txt").write_text("mine\n")
-    (out / "stale.png").write_bytes(b"an earlier run's plot")
     record = json.loads((out / ".relrl-run.json").read_text())
     assert record["status"] == "complete" and "summary.json" in record["files"]
     capsys.readouterr()
-    line = one_line_exit_2(capsys, ["run", str(script), "--out", str(out)],
-                           str(out), "not empty", f"relrl run {script}", "--overwrite")
-    assert "Traceback" not in line
-    # the earlier record lists what it wrote; a file that appeared later counts as its own
-    # unless it was there before the run started (kept): overwrite removes the run's files
-    record["kept"] = ["notes.txt"]
+    one_line_exit_2(capsys, ["run", str(script), "--out", str(out)],
+                    str(out), "not empty", f"relrl run {script}", "--overwrite")
+    # as if the earlier run had also drawn a plot this one does not draw; a note is added
+    record["files"].append("stale.png")
     (out / ".relrl-run.json").write_text(json.dumps(record))
+    (out / "stale.png").write_bytes(b"an earlier run's plot")
+    (out / "notes.txt").write_text("mine\n")
     assert main(["run", str(script), "--out", str(out), "--no-plots", "--overwrite"]) == 0
     assert (out / "notes.txt").read_text() == "mine\n"
     assert not (out / "stale.png").exists()
-    assert json.loads((out / ".relrl-run.json").read_text())["kept"] == ["notes.txt"]
+    record = json.loads((out / ".relrl-run.json").read_text())
+    assert record["kept"] == ["notes.txt"] and "notes.txt" not in record["files"]
+
+
+def test_overwrite_after_a_run_killed_before_its_record_was_finished(tmp_path):
+    script = tmp_path / "e.toml"
+    script.write_text(episode_text())
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    (out / ".relrl-run.json").write_text(json.dumps(
+        {"command": "relrl run x.toml", "started": "2025-01-01T00:00:00", "ended": None,
+         "status": "running", "files": [], "kept": ["notes.txt"]}))
+    (out / "trace.jsonl").write_text("{}\n")
+    (out / "policy-old.pl").write_text("% half a run\n")
+    assert main(["run", str(script), "--out", str(out), "--no-plots", "--overwrite"]) == 0
+    assert (out / "notes.txt").exists() and not (out / "policy-old.pl").exists()
 
 
 def test_a_folder_of_other_files_is_refused_and_never_emptied(capsys, tmp_path):
