@@ -82,8 +82,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(line, file=sys.stderr)
         print(f"relrl {args.command}: {last}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"relrl {args.command}: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        kept = getattr(exc, "kept", None)  # what a run wrote before it stopped
+        print(f"relrl {args.command}: interrupted" + (f"; {kept}" if kept else ""),
+              file=sys.stderr)
         return 130
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()

@@ -410,8 +410,6 @@ def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
     """Write the summary and the policy learned so far, marked partial, after ``exc`` ended
     the run early; ``exc.kept`` then says what was written (the command line adds it to
     its one-line message). Never raises: the original error is what the user must see."""
-    from relrl.errors import RelrlError
-
     ep = run.episode
     run.t = min(run.t, run.done)  # the time unit in progress did not finish
     try:
@@ -419,7 +417,7 @@ def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
         summary["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         _write_outputs(run, out, summary, {"seconds": time.perf_counter() - t0,
                                            "learning_steps": run.t})
-    except (RelrlError, OSError) as inner:
+    except Exception as inner:  # whatever it is, the first error is the one that goes on
         exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore[attr-defined]
         return
     policy = f" and {summary['policy']}" if "policy" in summary else ""
