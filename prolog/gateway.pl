@@ -341,8 +341,9 @@ gw_load(File, Module, Limit, Problems) :-
         ),
         findall(P, retract(collected(Key, P)), Problems0),
         exclude(cancelled_halt_warning(Result), Problems0, Problems)
-    ;   format(string(Msg), "no such file", []),
-        Problems = [problem(error, File, 0, Msg)]
+    ;   exists_directory(File)
+    ->  Problems = [problem(error, File, 0, "a directory, not a Prolog file")]
+    ;   Problems = [problem(error, File, 0, "no such file")]
     ).
 
 %   The directive whose halt was cancelled also "failed": one problem for it is enough.
@@ -370,7 +371,7 @@ note_exception(Key, File, Limit, E) :-
     ->  error_result(E, error(_, Msg)),
         F = File, L = 0
     ;   message_string(E, Msg),
-        (   E = error(_, file(F, L, _, _))
+        (   E = error(_, Context), nonvar(Context), Context = file(F, L, _, _)
         ->  true
         ;   F = File, L = 0
         )
@@ -388,7 +389,10 @@ user:message_hook(Term, Kind, Lines) :-
     strip_location(Msg0, Msg),
     assertz(collected(Key, problem(Kind, File, Line, Msg))).
 
-message_location(error(_, file(File, Line, _, _)), File, Line) :- !.
+message_location(error(_, Context), File, Line) :-
+    nonvar(Context),
+    Context = file(File, Line, _, _),
+    !.
 message_location(_, File, Line) :-
     source_location(File, Line), !.
 message_location(_, '', 0).

@@ -18,6 +18,7 @@
             allowed/1,            % ?Response
             allowed_responses/1   % -Responses
           ]).
+:- use_module(library(arithmetic)).   % the same arithmetic checks for every load
 :- use_module(memory).
 :- use_module(declarations).
 :- use_module(perception).

@@ -18,6 +18,7 @@ from __future__ import annotations
 import abc
 import logging
 import queue
+import re
 import sys
 import threading
 import wave
@@ -35,6 +36,8 @@ __all__ = ["AudioFileWords", "Listener", "MicWords", "Segmenter", "TypedWords",
 log = logging.getLogger(__name__)
 
 RATE = 16000
+#: what a typed word may be.
+_WORD = re.compile(r"[a-z][a-z0-9_]*")
 #: samples per analysis frame (30 ms at 16 kHz).
 FRAME = 480
 
@@ -148,17 +151,25 @@ class Listener:
 
 
 class TypedWords(WordSource):
-    """Words typed on a stream (standard input), read by a daemon thread."""
+    """Words typed on a stream (standard input), read by a daemon thread; bytes that are not
+    UTF-8, and tokens that are not words (letters, digits, ``_``), are skipped with a line
+    on standard error."""
 
     def __init__(self, stream: Any = None) -> None:
         self._queue: queue.Queue[str] = queue.Queue()
-        threading.Thread(target=self._read, args=(stream or sys.stdin,), daemon=True,
+        stream = stream if stream is not None else getattr(sys.stdin, "buffer", sys.stdin)
+        threading.Thread(target=self._read, args=(stream,), daemon=True,
                          name="relrl-typed").start()
 
     def _read(self, stream: Any) -> None:
-        for line in stream:
+        for raw in stream:
+            line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else raw
             for word in line.strip().lower().split():
-                self._queue.put(word)
+                if _WORD.fullmatch(word):
+                    self._queue.put(word)
+                else:
+                    print(f"relrl run: ignored {word!r}: type words of letters, digits and _",
+                          file=sys.stderr, flush=True)
 
     def poll(self) -> list[str]:
         return _drain(self._queue)

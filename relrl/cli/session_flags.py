@@ -46,6 +46,11 @@ def add_session_arguments(parser: argparse.ArgumentParser) -> None:
                    help="seconds of --audio heard per time unit (0.5)")
 
 
+class _Closing:
+    def __init__(self, fn: Any) -> None:
+        self.close = fn
+
+
 @dataclass
 class Session:
     """What the flags started; :meth:`hold` keeps the monitor up after the run."""
@@ -54,6 +59,16 @@ class Session:
     server: Any = None
     closers: list[Any] = field(default_factory=list)
     hold_after: bool = False
+
+    def log_to(self, path: Any) -> None:
+        """Also log to ``path`` (the session's ``run.log``) until the session ends."""
+        import logging
+
+        from relrl import log
+
+        handler = log.add_file(path)
+        self.closers.append(_Closing(lambda: log.remove_file(handler)))
+        logging.getLogger("relrl.run").debug("session started: %s", " ".join(sys.argv))
 
     def hold(self) -> None:
         """With ``--monitor-hold``: serve until Ctrl-C."""
@@ -107,19 +122,9 @@ def _check(args: argparse.Namespace) -> None:
 def session_options(args: argparse.Namespace, episode: Any, opts: Any):
     """Start what the flags ask for around a run; yields a :class:`Session` whose ``opts``
     carry the monitor, the recording settings and the word sources."""
-    from relrl import log
-
     _check(args)
     session = Session(opts, hold_after=args.monitor_hold)
-    handler = None
     try:
-        if opts.out is not None:
-            opts.out.mkdir(parents=True, exist_ok=True)
-            handler = log.add_file(opts.out / "run.log")
-            log_cmd = " ".join(sys.argv)
-            import logging
-
-            logging.getLogger("relrl.run").debug("session started: %s", log_cmd)
         opts.record = args.record
         opts.record_rate = args.record_rate
         opts.record_quality = args.record_quality
@@ -136,5 +141,3 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
     finally:
         for thing in reversed(session.closers):
             thing.close()
-        if handler is not None:
-            log.remove_file(handler)
