@@ -52,12 +52,12 @@ def test_relrl_tree_draws_an_etg_policy(tmp_path: Path, capsys) -> None:
 
 @pytest.mark.parametrize("case", ["contingency", "no-domain", "bad-format", "missing"])
 def test_relrl_tree_errors_are_one_line(tmp_path: Path, capsys, case: str) -> None:
-    policy = _policy(tmp_path, "contingency") if case == "contingency" else tmp_path / "p.pl"
-    args = {"contingency": [str(policy), "--domain", str(FRUITS)],
-            "no-domain": [str(_policy(tmp_path, "etg"))],
-            "bad-format": [str(_policy(tmp_path, "etg")), "--domain", str(FRUITS),
-                           "--out", str(tmp_path / "t.gif")],
-            "missing": [str(tmp_path / "nothing.pl"), "--domain", str(FRUITS)]}[case]
+    args = {"contingency": lambda: [str(_policy(tmp_path, "contingency")), "--domain",
+                                    str(FRUITS)],
+            "no-domain": lambda: [str(_policy(tmp_path, "etg"))],
+            "bad-format": lambda: [str(_policy(tmp_path, "etg")), "--domain", str(FRUITS),
+                                   "--out", str(tmp_path / "t.gif")],
+            "missing": lambda: [str(tmp_path / "nothing.pl"), "--domain", str(FRUITS)]}[case]()
     capsys.readouterr()
     assert main(["tree", *args]) == 2
     err = capsys.readouterr().err.strip().splitlines()
