@@ -34,13 +34,13 @@ from pathlib import Path
 from typing import Any
 
 from relrl.errors import PrologError, PrologLoadError, QueryTimeout, RelrlError
+from relrl.resources import prolog_dir
 from relrl.terms import Term, Var
 
 __all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
 
-#: Where the knowledge layer's .pl files live (override with RELRL_PROLOG_DIR).
-PROLOG_DIR = Path(os.environ.get("RELRL_PROLOG_DIR",
-                                 Path(__file__).resolve().parent.parent / "prolog"))
+#: Where the knowledge layer's .pl files live: package data (override with RELRL_PROLOG_DIR).
+PROLOG_DIR = prolog_dir()
 
 #: Seconds a single gateway call may run before it raises QueryTimeout.
 DEFAULT_TIMEOUT = 10.0
