@@ -4,7 +4,8 @@ Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EX
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
 pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
 
-Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2.
+Errors a user can cause (:data:`relrl.errors.USER_ERRORS`: relrl's ``UserError`` and the error
+bases of the ``head`` and ``perception`` packages) print one line and exit 2.
 """
 
 from __future__ import annotations
@@ -13,8 +14,6 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
-
-from relrl.errors import UserError
 
 __all__ = ["main", "SUBCOMMANDS"]
 
@@ -28,6 +27,7 @@ SUBCOMMANDS: dict[str, str] = {
     "perceive": "relrl.cli.perceive",
     "head": "relrl.cli.head",
     "demo": "relrl.cli.demo",
+    "examples": "relrl.cli.examples",
 }
 
 
@@ -69,9 +69,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
+    from relrl.errors import USER_ERRORS
+
     try:
         return int(args._run(args) or 0)
-    except UserError as exc:
+    except USER_ERRORS as exc:
         print(f"relrl {args.command}: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
