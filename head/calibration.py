@@ -35,6 +35,7 @@ import tempfile
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from importlib.resources import files
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -60,8 +61,9 @@ PULSE_RANGE: tuple[int, int] = (500, 2500)
 MAX_SPEED = 20_000.0
 #: the slowest speed, microseconds per second (one unit of the Maestro's speed setting).
 MIN_SPEED = 25.0
-#: the calibration used when none is given.
-DEFAULT_CALIBRATION = Path(__file__).resolve().parent.parent / "examples/heads/wha8030.toml"
+#: the calibration used when none is given: package data of ``head`` (in the source tree
+#: ``head/calibrations`` links to ``examples/heads``).
+DEFAULT_CALIBRATION = Path(str(files("head") / "calibrations" / "wha8030.toml"))
 
 _NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 _HEAD_KEYS = frozenset({"name", "protocol", "baudrate", "tolerance_us", "scripts"})
