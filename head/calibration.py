@@ -41,6 +41,7 @@ from typing import Any, NoReturn
 
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
 from head.scripts import MotorScript, normalise_response, parse_scripts
+from percepts import PLACES
 
 __all__ = [
     "DEFAULT_CALIBRATION",
@@ -53,8 +54,9 @@ __all__ = [
     "save_calibration",
 ]
 
-#: the six directions of the paper's head; ``centre`` looks forward, at the caregiver.
-DIRECTIONS: tuple[str, ...] = ("left", "left_down", "down", "right_down", "right", "centre")
+#: the six directions of the paper's head (the shared vocabulary's places); ``centre`` looks
+#: forward, at the caregiver.
+DIRECTIONS: tuple[str, ...] = PLACES
 #: the absolute range of pulse widths any hobby servo accepts, in microseconds.
 PULSE_RANGE: tuple[int, int] = (500, 2500)
 #: the fastest a servo may be calibrated to move, in microseconds per second.
