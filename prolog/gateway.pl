@@ -150,6 +150,8 @@ python_api(relrl_responses:allowed_responses/2).
 python_api(relrl_declarations:necessity_inputs/3).
 python_api(relrl_check:check_domain/2).
 python_api(relrl_check:rule_listing/2).
+python_api(relrl_percepts:world_problems/3).
+python_api(relrl_percepts:unread_percepts/3).
 python_api(relrl_gateway:gw_new_kb/1).
 python_api(relrl_gateway:gw_drop_kb/1).
 python_api(relrl_gateway:gw_load/4).
@@ -594,9 +596,11 @@ answer_text(Bindings0, Text) :-
 
 answer_mode(Options) :-
     (   nb_current(relrl_answer_mode, write)
-    ->  Options = [quoted(true), spacing(next_argument), max_depth(MaxDepth)],
+    ->  Options = [quoted(true), numbervars(true), spacing(next_argument),
+                   max_depth(MaxDepth)],
         safe_write_depth(MaxDepth)
-    ;   Options = [quoted(true), portray(true), max_depth(10), spacing(next_argument)]
+    ;   Options = [quoted(true), portray(true), numbervars(true), max_depth(10),
+                   spacing(next_argument)]
     ).
 
 %   Writing a term recurses in C: beyond some thousands of levels the host's C stack
