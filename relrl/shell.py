@@ -477,6 +477,11 @@ def _add(shell: Shell, text: str) -> None:
     terms = shell.parse_terms(text)
     shell.kb.insert(terms)
     shell.print(f"inserted {len(terms)} element{'s' if len(terms) != 1 else ''}")
+    from relrl.validate import unread_percepts
+
+    for term in unread_percepts(shell.kb, terms):
+        shell.print(f"warning: {format_term(term)} is not a percept of this domain: no "
+                    f"stimulus, fact or rule perceives it (a typo?)")
 
 
 @command("memory", ":memory", "show working memory with ages")
