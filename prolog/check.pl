@@ -1,6 +1,8 @@
 :- module(relrl_check,
           [ check_domain/2,       % +KB, -Problems
-            rule_listing/2        % +KB, -Rules
+            rule_listing/2,       % +KB, -Rules
+            body_goal/2,          % +Body, -Goal
+            data_goal/2           % +Declaration, -Goal
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -83,11 +85,21 @@ undefined_call(KB, problem(File, Line, Msg)) :-
     functor(Head, HN, HA),
     format(string(Msg), "~q calls undefined predicate ~q", [HN/HA, PI]).
 
+%!  data_goal(+Declaration, -Goal) is semidet.
+%
+%   Goal is the goal a declaration holds as data: fact(G), unit_input(_, G, _),
+%   satisfier(_, G, _), behaviour(G, _, _, _), etg_test(G).
+
 data_goal(fact(G), G).
 data_goal(unit_input(_, G, _), G).
 data_goal(satisfier(_, G, _), G).
 data_goal(behaviour(G, _, _, _), G).
 data_goal(etg_test(G), G).
+
+%!  body_goal(+Body, -Goal) is nondet.
+%
+%   Goal is a goal of the clause body Body, through control constructs and meta-calls
+%   (not through module-qualified goals).
 
 body_goal(Var, _) :- var(Var), !, fail.
 body_goal(true, _) :- !, fail.

@@ -6,6 +6,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(declarations).
+:- use_module(check, [body_goal/2, data_goal/2]).
 
 /** <module> What a domain perceives, against what a world perceives
 
@@ -207,7 +208,9 @@ perceived_by(_, Reads, Percept) :-
 domain_read(KB, Read) :-
     own_clause(KB, Head, Body, _),
     (   body_goal(Body, Goal)
-    ;   data_goal(Head, Goal0),
+    ;   (   data_goal(Head, Goal0)
+        ;   Head = relation(Goal0)
+        ),
         body_goal(Goal0, Goal)
     ),
     goal_read(Goal, Read).
@@ -216,26 +219,3 @@ goal_read(Goal, Read) :-
     percept_read(Goal, Read).
 goal_read(Goal, Read) :-
     sense_of_fact(Goal, Read, _).
-
-data_goal(fact(G), G).
-data_goal(unit_input(_, G, _), G).
-data_goal(satisfier(_, G, _), G).
-data_goal(behaviour(G, _, _, _), G).
-data_goal(etg_test(G), G).
-data_goal(relation(G), G).
-
-%   The goals of a body, through control constructs and meta-calls.
-body_goal(Var, _) :- var(Var), !, fail.
-body_goal((A, B), G) :- !, ( body_goal(A, G) ; body_goal(B, G) ).
-body_goal((A ; B), G) :- !, ( body_goal(A, G) ; body_goal(B, G) ).
-body_goal((A -> B), G) :- !, ( body_goal(A, G) ; body_goal(B, G) ).
-body_goal((A *-> B), G) :- !, ( body_goal(A, G) ; body_goal(B, G) ).
-body_goal(\+ A, G) :- !, body_goal(A, G).
-body_goal(call(A), G) :- !, body_goal(A, G).
-body_goal(once(A), G) :- !, body_goal(A, G).
-body_goal(ignore(A), G) :- !, body_goal(A, G).
-body_goal(forall(A, B), G) :- !, ( body_goal(A, G) ; body_goal(B, G) ).
-body_goal(findall(_, A, _), G) :- !, body_goal(A, G).
-body_goal(aggregate_all(_, A, _), G) :- !, body_goal(A, G).
-body_goal(_:A, G) :- !, body_goal(A, G).
-body_goal(G, G) :- callable(G).
