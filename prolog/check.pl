@@ -2,7 +2,8 @@
           [ check_domain/2,       % +KB, -Problems
             rule_listing/2,       % +KB, -Rules
             body_goal/2,          % +Body, -Goal
-            data_goal/2           % +Declaration, -Goal
+            data_goal/2,          % +Declaration, -Goal
+            clause_location/3     % +ClauseRef, -File, -Line
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -46,7 +47,9 @@ problem(KB, P) :- bad_unit(KB, P).
 problem(KB, P) :- undeclared_reference(KB, P).
 problem(KB, P) :- empty_declaration(KB, P).
 
-%   Where a clause of KB came from.
+%!  clause_location(+Ref, -File, -Line) is det.
+%
+%   Where the clause Ref came from ('' and 0 when unknown).
 
 clause_location(Ref, File, Line) :-
     (   clause_property(Ref, file(File0))

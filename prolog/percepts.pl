@@ -6,7 +6,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(declarations).
-:- use_module(check, [body_goal/2, data_goal/2]).
+:- use_module(check, [body_goal/2, data_goal/2, clause_location/3]).
 
 /** <module> What a domain perceives, against what a world perceives
 
@@ -173,16 +173,6 @@ own_clause(KB, Head, Body, Ref) :-
     domain_predicate(KB, Head),
     \+ predicate_property(KB:Head, foreign),
     clause(KB:Head, Body, Ref).
-
-clause_location(Ref, File, Line) :-
-    (   clause_property(Ref, file(File0))
-    ->  File = File0
-    ;   File = ''
-    ),
-    (   clause_property(Ref, line_count(Line0))
-    ->  Line = Line0
-    ;   Line = 0
-    ).
 
 %!  unread_percepts(+KB, +Percepts:list, -Unread:list) is det.
 %
