@@ -280,7 +280,8 @@ class Shell:
         Raises:
             PrologLoadError: the file has an error (or, the shell being strict, a warning).
         """
-        self._check_files([*self.loaded, Path(path)])
+        self._check_files([*(p for p in self.loaded if p.exists()), Path(path)],
+                          "nothing loaded")
         self.kb.load(path)
         self._note_loaded(path)
 
@@ -303,21 +304,23 @@ class Shell:
                 changed.append(path)
         if not changed:
             return []
-        self._check_files(list(self.loaded))
+        self._check_files([p for p in self.loaded if p.exists()],
+                          "not reloaded: its last good version stays")
         for path in changed:
             self.kb.load(path)
             self._note_loaded(path)
             self.print(f"% {_shown(path)} reloaded")
         return changed
 
-    def _check_files(self, paths: list[Path]) -> None:
+    def _check_files(self, paths: list[Path], outcome: str) -> None:
+        """Load ``paths`` into a scratch knowledge base; a load error names ``outcome``."""
         scratch = KnowledgeBase(timeout=self.kb.timeout)
         try:
             for p in paths:
                 try:
                     scratch.load(p)
                 except PrologLoadError as exc:
-                    raise PrologLoadError(exc.path, exc.line, exc.text + " (nothing loaded)",
+                    raise PrologLoadError(exc.path, exc.line, f"{exc.text} ({outcome})",
                                           exc.problems) from None
         finally:
             scratch.close()
@@ -394,6 +397,14 @@ class Shell:
         if buffer.strip():
             self.execute(buffer)
 
+    def _execute_at_terminal(self, text: str) -> None:
+        """Ctrl-C stops the query (once Prolog gives control back: at the latest when the
+        time limit strikes) and returns to the prompt, as at swipl's toplevel."""
+        try:
+            self.execute(text)
+        except KeyboardInterrupt:
+            self.print("\n% interrupted\n")
+
     def interact(self) -> None:
         """Prompt at a terminal with line editing and history until :quit or end of input."""
         try:
@@ -421,11 +432,11 @@ class Shell:
                     continue
                 stripped = line.strip()
                 if not buffer and stripped.startswith(":"):
-                    self.execute(stripped)
+                    self._execute_at_terminal(stripped)
                     continue
                 buffer += line + "\n"
                 if stripped.endswith("."):
-                    self.execute(buffer)
+                    self._execute_at_terminal(buffer)
                     buffer = ""
         finally:
             self.interactive = False

@@ -7,6 +7,7 @@ import io
 import os
 import re
 import select
+import signal
 import subprocess
 import sys
 import time
@@ -182,6 +183,7 @@ def test_make_reloads_changed_files_and_keeps_a_broken_one(shell, write_domain) 
     sh.run_lines(["make.\n", "extra(X).\n"])
     lines = out.getvalue().splitlines()
     assert lines[0].startswith("error: ") and "extra.pl:1" in lines[0]
+    assert lines[0].endswith("(not reloaded: its last good version stays)")
     assert lines[1:] == ["X = 2 ;", "X = 3."]   # the last good version stays
 
 
@@ -311,3 +313,12 @@ def test_terminal_time_limit_per_answer(terminal) -> None:
     terminal.send(";")
     text = terminal.expect(r"\?- ", timeout=30)
     assert "error: query ran longer than 2 s" in text
+
+
+def test_terminal_ctrl_c_returns_to_the_prompt(terminal) -> None:
+    terminal.send("repeat, fail.\n")
+    time.sleep(0.5)
+    terminal.proc.send_signal(signal.SIGINT)     # as Ctrl-C: noticed when Prolog returns
+    assert "% interrupted" in terminal.expect(r"\?- ", timeout=30)
+    terminal.send("stimulus(face).\n")
+    assert terminal.expect(r"\?- ").endswith("\ntrue.\n\n?- ")
