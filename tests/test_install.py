@@ -67,7 +67,7 @@ def installed(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
 
 
 def _run(cmd: list, installed: dict[str, Path], stdin: str | None = None,
-         timeout: float = 120) -> subprocess.CompletedProcess:
+         timeout: float = 600) -> subprocess.CompletedProcess:
     environ = {k: v for k, v in os.environ.items()
                if k not in ("PYTHONPATH", "RELRL_PROLOG_DIR", "VIRTUAL_ENV")}
     return subprocess.run([str(c) for c in cmd], input=stdin, capture_output=True, text=True,

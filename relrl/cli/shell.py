@@ -36,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
         raise ConfigError(f"--timeout: {exc}") from None
     if args.max < 1:
         raise ConfigError(f"--max {args.max}: use a whole number >= 1")
-    kb = KnowledgeBase(*args.domain, timeout=timeout)
+    kb = KnowledgeBase(*args.domain)
     try:
         shell = Shell(kb, max_solutions=args.max, timeout=timeout)
         from relrl import policy

@@ -87,7 +87,7 @@ def test_piped_shell_process() -> None:
 # -- the toplevel's habits (issue 14) -------------------------------------------------------
 
 def _shell_proc(stdin: str, *args: str, domain: Path = FRUITS,
-                timeout: float = 60) -> subprocess.CompletedProcess:
+                timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "relrl.cli", "shell", str(domain), *args],
                           input=stdin, capture_output=True, text=True, cwd=ROOT,
                           timeout=timeout)
@@ -216,7 +216,7 @@ class _Terminal:
         os.close(slave)
         self.seen = ""
 
-    def expect(self, pattern: str, timeout: float = 30) -> str:
+    def expect(self, pattern: str, timeout: float = 120) -> str:
         """Wait for ``pattern`` (a regex); return the text up to its end and drop it."""
         end = time.monotonic() + timeout
         while True:
@@ -243,7 +243,7 @@ class _Terminal:
 
     def close(self) -> int:
         try:
-            return self.proc.wait(30)
+            return self.proc.wait(120)
         finally:
             os.close(self.master)
 
@@ -311,7 +311,7 @@ def test_terminal_time_limit_per_answer(terminal) -> None:
     terminal.expect(r"X = 1 ")
     time.sleep(2.5)                                    # thinking time is not query time
     terminal.send(";")
-    text = terminal.expect(r"\?- ", timeout=30)
+    text = terminal.expect(r"\?- ")
     assert "error: query ran longer than 2 s" in text
 
 
@@ -319,6 +319,6 @@ def test_terminal_ctrl_c_returns_to_the_prompt(terminal) -> None:
     terminal.send("repeat, fail.\n")
     time.sleep(0.5)
     terminal.proc.send_signal(signal.SIGINT)     # as Ctrl-C: noticed when Prolog returns
-    assert "% interrupted" in terminal.expect(r"\?- ", timeout=30)
+    assert "% interrupted" in terminal.expect(r"\?- ")
     terminal.send("stimulus(face).\n")
     assert terminal.expect(r"\?- ").endswith("\ntrue.\n\n?- ")
