@@ -454,11 +454,35 @@ print_bindings(Named, All, Printed) :-
 
 print_binding(All, _=Value, String) :-
     format(string(String), "~W",
-           [Value, [quoted(true), portray(true), variable_names(All), max_depth(0),
+           [Value, [quoted(true), portray(true), variable_names(All), max_depth(50),
+                    cycles(true),
                     spacing(next_argument)]]).
 
 solution_triples(Named-Printed, Triples) :-
-    maplist([Name=Value, P, Name-Value-P]>>true, Named, Printed, Triples).
+    maplist(solution_triple, Named, Printed, Triples).
+
+%   A value too deep (or cyclic) for Python's side of the gateway goes as its printed text.
+solution_triple(Name=Value, Printed, Name-Value1-Printed) :-
+    (   acyclic_term(Value),
+        depth_within(Value, 300)
+    ->  Value1 = Value
+    ;   Value1 = Printed
+    ).
+
+%   Term nests at most Max compound levels (list elements count a level; the list's own
+%   spine does not, as Python reads lists as sequences).
+depth_within(Term, Max) :-
+    (   var(Term)
+    ->  true
+    ;   atomic(Term)
+    ->  true
+    ;   Max > 0,
+        Max1 is Max - 1,
+        (   is_list(Term)
+        ->  forall(member(X, Term), depth_within(X, Max1))
+        ;   forall(arg(_, Term, X), depth_within(X, Max1))
+        )
+    ).
 
 %!  gw_findall(+Module, +Template, -List) is det.
 %

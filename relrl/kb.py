@@ -531,8 +531,8 @@ class KnowledgeBase:
                                   "abort/0 called while loading") from exc
         problems = [Problem(kind, str(f) if f else str(p), line or None, msg)
                     for (_, kind, f, line, msg) in out[0]]  # type: ignore[index]
-        problems = [Problem(pr.kind, _display_path(pr.path), pr.line, pr.message)
-                    for pr in problems]
+        problems = [Problem(pr.kind, _display_path(pr.path), pr.line,
+                            _KB_MODULE.sub("", pr.message)) for pr in problems]
         errors = [pr for pr in problems if pr.kind == "error" or strict]
         if errors:
             first = errors[0]
