@@ -296,6 +296,7 @@ def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
         name, value, printed = answer[0]
         assert name == "X" and value == printed and printed.startswith("f(f(")
         (answer,), _ = kb.query("numlist(1, 100000, L), foldl([_, A, f(A)]>>true, L, z, T)")
-        assert answer[1][0] == "T" and answer[1][1].endswith("...)))")
+        deep = {name: value for name, value, _ in answer}["T"]
+        assert isinstance(deep, str) and deep.endswith("...)))")
         (answer,), _ = kb.query("X = [1, 2, f(a)]")
         assert answer[0][1] == [1, 2, ("f", "a")]
