@@ -297,6 +297,6 @@ def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
         assert name == "X" and value == printed and printed.startswith("f(f(")
         (answer,), _ = kb.query("numlist(1, 100000, L), foldl([_, A, f(A)]>>true, L, z, T)")
         deep = {name: value for name, value, _ in answer}["T"]
-        assert isinstance(deep, str) and deep.endswith("...)))")
+        assert isinstance(deep, str) and "(...)" in deep
         (answer,), _ = kb.query("X = [1, 2, f(a)]")
         assert answer[0][1] == [1, 2, ("f", "a")]
