@@ -13,7 +13,9 @@ setup: swipl $(STAMP)
 # Debian packages: SWI-Prolog (the knowledge layer), espeak-ng (the robot's voice, and
 # the synthetic caregiver words the speech tests recognise), graphviz (`dot`: the learned tree
 # as a picture), libportaudio2 (the microphone, through sounddevice) and chromium (the headless
-# browser the monitor's tests drive; nothing downloads a browser). Installed only when missing.
+# browser the monitor's tests drive; nothing downloads a browser). Installed only when missing,
+# without recommended packages (swi-prolog-nox recommends a build tool chain relrl does not
+# need).
 swipl:
 	@missing=""; \
 	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
@@ -23,8 +25,8 @@ swipl:
 	ldconfig -p 2>/dev/null | grep -q libportaudio.so.2 || missing="$$missing libportaudio2"; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing$$missing from Debian's packages"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
-	    --no-install-recommends $$missing; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+	    apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
 $(STAMP): pyproject.toml Makefile

@@ -25,6 +25,7 @@
 :- use_module(state).
 :- use_module(responses).
 :- use_module(check).
+:- use_module(percepts).
 :- use_module(engine).
 :- use_module(learners).
 :- use_module(policy).

@@ -288,3 +288,15 @@ def test_arithmetic_errors_load_the_same_before_and_after_a_save(tmp_path: Path)
             KnowledgeBase(path)
         kb, agent, _ = _etg_policy(tmp_path)
         kb.close()
+
+
+def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
+    with KnowledgeBase(TINY) as kb:
+        (answer,), _ = kb.query("X = f(X)")
+        name, value, printed = answer[0]
+        assert name == "X" and value == printed and printed.startswith("f(f(")
+        (answer,), _ = kb.query("numlist(1, 100000, L), foldl([_, A, f(A)]>>true, L, z, T)")
+        deep = {name: value for name, value, _ in answer}["T"]
+        assert isinstance(deep, str) and "(...)" in deep
+        (answer,), _ = kb.query("X = [1, 2, f(a)]")
+        assert answer[0][1] == [1, 2, ("f", "a")]
