@@ -141,6 +141,7 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["random.toml"]),
     ("tree-format", ["tree", "{d}/afile", "--domain", "{fruits}", "--out", "{d}/t.gif"],
      ["t.gif", "format"]),
+    ("examples-copy-file", ["examples", "--copy", "{d}/afile"], ["afile", "not a folder"]),
     # ---- demo ------------------------------------------------------------------------------
     ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
