@@ -21,7 +21,8 @@
 * **Faces**: recall on the 100 faces of scikit-image's ``lfw_subset()`` and false detections on
   its 100 non-faces, with the same detector (full search, all three cascades). The 25x25 crops
   are enlarged to 64x64 and padded by 16 pixels of replicated border, so that the 20x20
-  cascades have the bit of context around the face they were trained with.
+  cascades have the bit of context around the face they were trained with. And the rendered
+  caregiver's pose read right on 192 frames (:func:`pose_figures`).
 
 Run ``python -m perception.bench``. scikit-image is needed for the face figures only.
 """
@@ -38,7 +39,7 @@ import numpy as np
 
 from perception.vocab import GAZE_POSE, PLACES
 
-__all__ = ["FreeCoresPool", "bench", "interaction_views", "lfw_figures"]
+__all__ = ["FreeCoresPool", "bench", "interaction_views", "lfw_figures", "pose_figures"]
 
 
 def interaction_views(n: int = 240, seed: int = 0):
@@ -193,6 +194,27 @@ def lfw_figures() -> dict[str, int]:
             "false_detections": int(sum(found[100:]))}
 
 
+def pose_figures(pool=None) -> dict[str, int]:
+    """Rendered caregiver frames whose pose is read right, full search each: 6 poses x lights
+    0.6, 0.8, 1.0, 1.25 x 320x240 and 640x480 x seeds 0-3 (192 frames). ``pool``: the
+    executor of a pooled search (the same faces as without)."""
+    from perception.faces import FaceTracker
+    from perception.render import SceneView, render
+    from perception.vocab import POSES
+
+    tracker = FaceTracker(pool=pool)
+    right = 0
+    for pose in POSES:
+        for light in (0.6, 0.8, 1.0, 1.25):
+            for size in ((320, 240), (640, 480)):
+                for seed in range(4):
+                    tracker.reset()
+                    face = tracker.detect(render(SceneView("centre", pose, lighting=light,
+                                                           seed=seed), size))
+                    right += face is not None and face.pose == pose
+    return {"pose_frames": 6 * 4 * 2 * 4, "poses_right": right}
+
+
 def _photos(size: tuple[int, int]) -> list[np.ndarray]:
     """scikit-image's astronaut and cameraman (512x512) resized to ``size`` as BGR frames."""
     import cv2
@@ -261,7 +283,8 @@ def bench(frames: int = 240, seed: int = 0, faces: bool = True) -> dict[str, flo
         threads (``*_cold_2threads``) and ``free_cores_fps_photos_*_cold_2threads`` (two
         threads on two free cores), ``ms_photos_320x240_cold`` (CPU ms per frame by stage,
         one thread), ``face_recall`` (fraction), ``faces_found``,
-        ``false_detections`` and the counts behind them.
+        ``false_detections`` and the counts behind them, ``poses_right`` of ``pose_frames``
+        (rendered caregiver poses read right, :func:`pose_figures`).
     """
     import cv2
 
@@ -280,6 +303,7 @@ def bench(frames: int = 240, seed: int = 0, faces: bool = True) -> dict[str, flo
             figures = lfw_figures()  # first: it explains a missing scikit-image
             out.update(_photo_fps(frames))
             out.update(figures)
+            out.update(pose_figures())
             out["face_recall"] = figures["faces_found"] / figures["faces"]
         return out
     finally:

@@ -15,6 +15,7 @@ def test_photo_figures_wall_cpu_and_stages():
     stages = out["ms_photos_320x240_cold"]
     assert set(stages) == {"faces", "saliency", "colour"} and min(stages.values()) > 0
     assert out["faces_found"] >= 90 and out["false_detections"] == 0
+    assert out["pose_frames"] == 192 and out["poses_right"] >= 185
 
 
 def _burn(seconds: float) -> float:
