@@ -8,7 +8,8 @@ the body below it masked out, colour of the salient area -- and turns the result
     see(object).  colour(object, red).  at(object, left_down).
 
 With ``Perceiver(threads=2)`` the stages share two pool threads: the saliency map is computed
-while the faces are searched, and a full face search runs each cascade as two tasks (see
+while the faces are searched, and a full face search runs each cascade as tasks over bands of
+face sizes (see
 :mod:`perception.faces`). The facts are the same as with one thread; the frame takes about half
 the wall time when two cores are free for it (a control loop in the same process or on the same
 machine competes for them).
@@ -30,6 +31,7 @@ from perception.colour import ColourSummary, colour_summary
 from perception.errors import PerceptionError
 from perception.faces import Face, FaceParams, FaceTracker
 from perception.facts import Fact
+from perception.imagesize import check_frame_size
 from perception.saliency import SaliencyParams, SalientArea, most_salient, saliency_map
 from perception.vocab import PLACES
 
@@ -114,6 +116,7 @@ class Perceiver:
             raise PerceptionError(f"a frame must be an (h, w, 3) uint8 BGR array, got {got}")
         if looking_at is not None and looking_at not in PLACES:
             raise PerceptionError(f"unknown place {looking_at!r}; use one of {PLACES}")
+        check_frame_size(frame.shape[1], frame.shape[0], "the frame")
         out = Percept()
         # with a pool the saliency map is computed while the faces are searched
         smap = None if self.pool is None else self.pool.submit(saliency_map, frame,
