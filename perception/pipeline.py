@@ -9,10 +9,9 @@ the body below it masked out, colour of the salient area -- and turns the result
 
 With ``Perceiver(threads=2)`` the stages share two pool threads: the saliency map is computed
 while the faces are searched, and a full face search runs each cascade as tasks over bands of
-face sizes (see
-:mod:`perception.faces`). The facts are the same as with one thread; the frame takes about half
-the wall time when two cores are free for it (a control loop in the same process or on the same
-machine competes for them).
+face sizes (see :mod:`perception.faces`). The facts are the same as with one thread; the frame
+takes about half the wall time when two cores are free for it (a control loop in the same
+process or on the same machine competes for them).
 
 ``at(object, Place)`` is the place the head looks at when the caller says so
 (``looking_at=...``, the robot knows where its head points); otherwise it is read from where the
