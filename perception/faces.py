@@ -140,7 +140,7 @@ _LOCAL = threading.local()
 def _bands(lo: int, hi: int) -> list[tuple[int, int]]:
     """The size range ``[lo, hi]`` cut after each of :data:`_BAND_EDGES` (empty bands left out)."""
     cuts = [lo - 1, *(e for e in _BAND_EDGES if lo <= e < hi), hi]
-    return [(a + 1, b) for a, b in zip(cuts, cuts[1:], strict=False)]
+    return [(a + 1, b) for a, b in zip(cuts, cuts[1:], strict=False) if a < b]
 
 
 def _band_hits(img: np.ndarray, kind: str, params: FaceParams, lo: int,

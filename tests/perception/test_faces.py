@@ -108,3 +108,4 @@ def test_bands_cover_the_sizes_once():
     assert _bands(20, 120) == [(20, 20), (21, 23), (24, 30), (31, 46), (47, 120)]
     assert _bands(25, 40) == [(25, 30), (31, 40)]
     assert _bands(20, 20) == [(20, 20)]
+    assert _bands(20, 16) == []  # a frame too small for any face
