@@ -1,7 +1,8 @@
 """Running an experiment's independent jobs over local worker processes.
 
 Each worker process holds one Prolog engine (pyswip allows one per process). Jobs report
-their progress through a queue; the parent draws a progress bar when stderr is a terminal.
+their progress through a queue; the parent shows it (relrl.progress: a bar with ETA on a
+terminal, log lines elsewhere).
 The design leaves room for a distributed engine (e.g. Ray) to call the same job function.
 """
 
@@ -9,7 +10,6 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import queue as queue_mod
-import sys
 import threading
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
@@ -36,29 +36,28 @@ def _call(job: Callable[..., dict[str, Any]], args: tuple) -> dict[str, Any]:
 
 
 class ProgressBar:
-    """A one-line progress bar on a terminal; silent otherwise."""
+    """The experiment's progress (:func:`relrl.progress.progress`): a tqdm bar with ETA on
+    a terminal, log lines otherwise; workers report to the parent, which owns it."""
 
-    def __init__(self, total: int, stream: Any = None) -> None:
+    def __init__(self, total: int) -> None:
+        from relrl.progress import progress
+
         self.total = total
-        self.done = 0
-        self.stream = sys.stderr if stream is None else stream  # the stderr of now
-        self.active = bool(getattr(stream, "isatty", lambda: False)())
+        self._progress = progress(total, "experiment", unit="point")
+
+    @property
+    def done(self) -> int:
+        """Units done so far."""
+        return self._progress.n
 
     def update(self, label: str) -> None:
-        """One unit done."""
-        self.done += 1
-        if self.active:
-            width = 30
-            filled = int(width * self.done / max(1, self.total))
-            self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] "
-                              f"{self.done}/{self.total} {label:<40}")
-            self.stream.flush()
+        """One unit done (``label`` says which)."""
+        self._progress.set_description(label)
+        self._progress.update(1)
 
     def close(self) -> None:
-        """End the bar's line."""
-        if self.active:
-            self.stream.write("\n")
-            self.stream.flush()
+        """End the bar."""
+        self._progress.close()
 
 
 def run_jobs(job: Callable[..., dict[str, Any]], arglist: list[tuple], *, workers: int,
