@@ -78,24 +78,17 @@ def run(args: argparse.Namespace) -> int:
         policy = f", {summary['policy']}" if "policy" in summary else ""
         print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
     if summary["stopped_early"]:
-        print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}; "
+        print(f"stopped after time unit {summary['units']} of {summary['planned_steps']}; "
               "everything up to it is written", file=sys.stderr)
         return 130
     return 0
 
 
 def _report(s: dict) -> str:
+    from relrl.experiments.fruits import report_lines
+
     cgi = "n/a" if s["cgi"] is None else f"{s['cgi']:.3f}"
-    head = (f"{s['episode']}: {s['steps']} time units, CGI {cgi} ({s['correct_shifts']}/"
-            f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
-            f"reward {s['rewards']['total']:+.0f}")
-    lines = [head]
-    for p in s.get("evaluation", []):
-        lines.append(f"  evaluation after {p['learning_steps']:4d} time units: CGI "
-                     f"{p['cgi_mean']:.3f} +- {p['cgi_std']:.3f}")
-    if "table1" in s:
-        lines.append("  Table 1 (mean +- sd %, measured | paper):")
-        for k, (m, sd) in s["table1"]["rates"].items():
-            pm, psd = s["table1"]["paper"][k]
-            lines.append(f"    {k:16s} {m:6.2f} +- {sd:5.2f} | {pm:6.2f} +- {psd:.2f}")
-    return "\n".join(lines)
+    head = (f"{s['episode']}: {s['units']} time units ({s['time_unit']}s, {s['steps']} control "
+            f"steps), CGI {cgi} ({s['correct_shifts']}/{s['shifts']} shifts), eye contacts "
+            f"{s['eye_contacts']}/{s['opportunities']}, reward {s['rewards']['total']:+.0f}")
+    return "\n".join([head] + report_lines(s))

@@ -136,6 +136,7 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.executions: list[dict[str, Any]] = []
         self.t = 0
+        self.units = 0
         self.in_view = None
 
     def close(self) -> None:
@@ -174,7 +175,7 @@ def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
     stats["attention"] += int(info["record"].attention)
     out = record.out
     trace.write({
-        "t": run.t, "phase": phase,
+        "t": run.t, "unit": info.get("unit", run.t), "phase": phase,
         "percepts": [format_term(p) for p in record.percepts],
         "memory": len(run.kb.memory()),
         "state": out.code, "necessity": out.necessity,
@@ -237,25 +238,34 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
 
         def evaluate() -> None:
             point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
-            point["learning_steps"] = run.t
+            point["units"], point["control_steps_learning"] = run.units, run.t
             run.curve.append(point)
             if opts.live:
-                print(f"evaluation after {run.t} time units: CGI {point['cgi_mean']:.3f} +- "
-                      f"{point['cgi_std']:.3f}", file=opts.stream, flush=True)
+                print(f"evaluation after {run.units} time units: CGI {point['cgi_mean']:.3f} "
+                      f"+- {point['cgi_std']:.3f}", file=opts.stream, flush=True)
             # learning resumes where it stopped: the world keeps its time line (and phase)
 
-        for t in range(1, episode.steps + 1):
+        cycles = episode.time_unit == "interaction"
+        bound = fruits.unit_bound(episode) if cycles else 1
+        for unit in range(1, episode.steps + 1):
             if stop():
                 break
-            if ev and (t - 1) % ev["every"] == 0:
+            if ev and (unit - 1) % ev["every"] == 0:
                 evaluate()
-            phase = episode.phase_at(t)
+            phase = episode.phase_at(unit)
             phase_name = phase.name
-            _pull_words(run, env)
-            run.t = t
-            interaction.run(1, learning=phase.learning, keep=False)
-            if opts.step_seconds:
-                time.sleep(opts.step_seconds)
+            for _ in range(bound):   # one time unit: a control step, or a whole cycle
+                if stop():
+                    break
+                _pull_words(run, env)
+                run.t += 1
+                interaction.run(1, learning=phase.learning, keep=False)
+                if opts.step_seconds:
+                    time.sleep(opts.step_seconds)
+                if not cycles or env.units_done >= unit:
+                    break
+            if not stop():
+                run.units = unit
         if ev and not stop() and episode.steps % ev["every"] == 0:
             evaluate()
         if episode.naming and not stop():
@@ -270,7 +280,9 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                           f"({res['presentations']} presentations)", file=opts.stream,
                           flush=True)
         summary = _summary(run, stopped=stop())
-        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t}
+        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t,
+                  "evaluation_steps": sum(p["control_steps"] for p in run.curve),
+                  "naming_steps": sum(e["steps"] for e in run.executions)}
         if out is not None:
             _write_outputs(run, out, summary, timing)
         return summary
@@ -284,7 +296,11 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
 
 def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
     from relrl.episodes.devices import DeviceWorld, HeadActuator
+    from relrl.errors import ConfigError
 
+    if opts.camera is not None and episode.time_unit != "step":
+        raise ConfigError(f"{episode.path}: time_unit = {episode.time_unit!r} counts the "
+                          "simulated caregiver's cycles; on a camera use time_unit = \"step\"")
     actuator = None
     if opts.head is not None:
         from head import open_head
@@ -309,7 +325,8 @@ def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
     summary: dict[str, Any] = {
         "episode": ep.name, "script": str(ep.path), "seed": ep.seed,
         "learner": {"name": ep.learner, "params": run.learner.params},
-        "steps": run.t, "planned_steps": ep.steps, "stopped_early": stopped,
+        "time_unit": ep.time_unit, "units": run.units, "steps": run.t,
+        "planned_steps": ep.steps, "stopped_early": stopped,
         "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
         "eye_contacts": e.established, "opportunities": e.opportunities,
         "mutual_gaze_events": m.mutual_gaze_events,
@@ -322,9 +339,7 @@ def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
-        summary["table1"] = {"executions": run.executions,
-                             "rates": fruits.rates(run.executions),
-                             "paper": fruits.PAPER["table1"]}
+        summary["table1"] = fruits.table1(run.executions)
     return summary
 
 
@@ -336,7 +351,8 @@ def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
     if ep.policy_save:
         path = out / ep.policy_save
         run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
-                               f"seed {ep.seed}, {run.t} time units")
+                               f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "
+                               f"{run.t} control steps")
         summary["policy"] = path.name
     write_json_atomic(out / "summary.json", summary)
     write_json_atomic(out / "timing.json", timing)
