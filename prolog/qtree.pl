@@ -82,6 +82,8 @@ qtree_restore(Tree, Tests, Nodes) :-
 
 qtree_clear(Tree) :-
     must_be(atom, Tree),
+    memo_key(Tree, Key),
+    nb_setval(Key, none),
     retractall(node_(Tree, _, _)),
     retractall(next_id_(Tree, _)),
     retractall(tests_(Tree, _)).
@@ -94,7 +96,10 @@ qtree_tests(Tree, Tests) :-
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
-    node_(Tree, Id, Node).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, Node))
+    ;   node_(Tree, Id, Node)
+    ).
 
 %!  test_holds(+Description, +Index) is semidet.
 
@@ -116,7 +121,31 @@ first_difference(D1, D2, Index) :-
 %   reaches an empty branch (Branch is yes or no).
 
 qtree_sort(Tree, D, Where) :-
-    sort_from(Tree, 0, D, Where).
+    memo_key(Tree, Key),
+    next_id_(Tree, Version),
+    (   nb_current(Key, memo(Version, D1-W1, D2-W2))
+    ->  (   D1 =:= D
+        ->  Where = W1
+        ;   D2 =:= D
+        ->  Where = W2
+        ;   sort_from(Tree, 0, D, Where),
+            nb_setval(Key, memo(Version, D-Where, D1-W1))
+        )
+    ;   sort_from(Tree, 0, D, Where),
+        nb_setval(Key, memo(Version, D-Where, -1-none))
+    ).
+
+%   The last two states sorted and where they went, valid while the tree's shape is the
+%   same (every grow or split takes a new node id, so the next id is the shape's version):
+%   the control step sorts each state twice (to choose, then to learn from it).
+memo_key(Tree, Key) :-
+    (   memo_key_(Tree, Key0)
+    ->  Key = Key0
+    ;   atom_concat('$relrl_qsort:', Tree, Key),
+        assertz(memo_key_(Tree, Key))
+    ).
+
+:- dynamic memo_key_/2.
 
 sort_from(Tree, Id, D, Where) :-
     (   step_down(Tree, Id, D, _, Branch, Next)
@@ -129,7 +158,7 @@ sort_from(Tree, Id, D, Where) :-
 
 %   Id is a test node; the state described by D takes its Branch (yes or no) to Next.
 step_down(Tree, Id, D, Goal, Branch, Next) :-
-    node_(Tree, Id, test(I, Goal, Yes, No)),
+    once(node_(Tree, Id, test(I, Goal, Yes, No))),
     (   test_holds(D, I)
     ->  Branch = yes, Next = Yes
     ;   Branch = no, Next = No
@@ -157,7 +186,10 @@ path_from(Tree, Id, D, Path) :-
 %!  qtree_leaf(+Tree, ?Id, -Rep, -Entries) is nondet.
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
-    node_(Tree, Id, leaf(Rep, Entries)).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, leaf(Rep, Entries)))
+    ;   node_(Tree, Id, leaf(Rep, Entries))
+    ).
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.
 
@@ -169,7 +201,7 @@ qtree_set_leaf(Tree, Id, _, _) :-
     existence_error(qtree_leaf, Tree-Id).
 
 new_id(Tree, Id) :-
-    retract(next_id_(Tree, Id)),
+    once(retract(next_id_(Tree, Id))),
     Id1 is Id + 1,
     assertz(next_id_(Tree, Id1)).
 
@@ -179,7 +211,7 @@ new_id(Tree, Id) :-
 
 qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
     must_be(oneof([yes, no]), Branch),
-    retract(node_(Tree, Parent, test(I, Goal, Yes, No))),
+    once(retract(node_(Tree, Parent, test(I, Goal, Yes, No)))),
     new_id(Tree, Id),
     (   Branch == yes
     ->  must_be(oneof([nil]), Yes), Node = test(I, Goal, Id, No)
@@ -194,7 +226,7 @@ qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
 %   representative takes; the other branch is empty (nil).
 
 qtree_split(Tree, LeafId, I) :-
-    retract(node_(Tree, LeafId, leaf(Rep, Entries))),
+    once(retract(node_(Tree, LeafId, leaf(Rep, Entries)))),
     tests_(Tree, Tests),
     nth0(I, Tests, Goal),
     new_id(Tree, Id),
