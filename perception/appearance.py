@@ -305,13 +305,17 @@ NONE = Appearance(Light(), Optics(0.0, 0.0, 0.0, 0.0))
 
 
 def blur_kernel(length: float, angle: float) -> np.ndarray:
-    """A normalised line kernel for motion blur of ``length`` pixels at ``angle`` degrees."""
-    n = max(1, int(math.ceil(length)))
-    size = n | 1
-    k = np.zeros((size, size), np.float32)
+    """A normalised line kernel for motion blur of ``length`` pixels at ``angle`` degrees
+    (to the nearest half pixel and degree)."""
+    return _line_kernel(round(2.0 * float(length)) / 2.0, float(round(angle))).copy()
+
+
+@functools.lru_cache(maxsize=512)
+def _line_kernel(length: float, angle: float) -> np.ndarray:
+    size = max(1, math.ceil(length)) | 1
     c = size // 2
     a = math.radians(angle)
-    for s in np.linspace(-length / 2.0, length / 2.0, 2 * size + 1):
-        x, y = int(round(c + s * math.cos(a))), int(round(c + s * math.sin(a)))
-        k[y, x] = 1.0
+    s = np.linspace(-length / 2.0, length / 2.0, 2 * size + 1)
+    k = np.zeros((size, size), np.float32)
+    k[np.rint(c + s * math.sin(a)).astype(int), np.rint(c + s * math.cos(a)).astype(int)] = 1.0
     return k / k.sum()

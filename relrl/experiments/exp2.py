@@ -60,6 +60,8 @@ def run_job(script: str, learner: str, seed: int, progress: Any, time_unit: str,
         ep.perception = overrides["perception"]
     if overrides.get("executions") is not None and ep.naming is not None:
         ep.naming["executions"] = int(overrides["executions"])
+    if time_unit not in overrides.get("table1_units", (time_unit,)):
+        ep.naming = None
     t0 = time.perf_counter()
     s = run_episode(ep, RunOptions(plots=False))
     if progress is not None:
@@ -230,6 +232,10 @@ def _options(argv: list[str] | None) -> argparse.Namespace:
                         help="evaluate every N learning time units (default 10)")
     parser.add_argument("--executions", type=int, default=None,
                         help="naming executions per run (default: the script's)")
+    parser.add_argument("--table1-units", default="interaction",
+                        help="the time units whose runs also do the naming executions "
+                             "(Table 1; default interaction, the documented reading; all: "
+                             "every one)")
     parser.add_argument("--perception", choices=["render", "symbolic"], default=None,
                         help="override the script's perception (symbolic: no Table 1)")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
@@ -275,8 +281,10 @@ def main(argv: list[str] | None = None) -> int:
     except UserError as exc:
         print(f"exp2: {exc}", file=sys.stderr)
         return 2
+    table1_units = units if args.table1_units == "all" else \
+        [u.strip() for u in args.table1_units.split(",") if u.strip()]
     overrides = {"every": args.every, "perception": args.perception,
-                 "executions": args.executions}
+                 "executions": args.executions, "table1_units": table1_units}
     tasks = [(args.script, name, seed, None, unit, overrides)
              for name in learners for unit in units for seed in seeds]
     t0 = time.perf_counter()

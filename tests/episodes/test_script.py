@@ -51,7 +51,7 @@ def test_experiment2_has_the_papers_settings() -> None:
     assert [p.steps for p in ep.phases] == [30, 70]
     assert ep.phases[0].objects is False
     assert ep.time_unit == "interaction" and ep.variation == "camera"
-    assert ep.evaluation == {"every": 20, "runs": 5, "steps": 100, "policy": "behaviour"}
+    assert ep.evaluation == {"every": 25, "runs": 5, "steps": 100, "policy": "behaviour"}
     assert ep.naming["executions"] == 5 and ep.naming["presentations"] == 150
 
 

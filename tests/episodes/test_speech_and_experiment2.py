@@ -41,7 +41,7 @@ def test_experiment2_small_on_rendered_frames(tmp_path: Path) -> None:
     text = (ROOT / "examples" / "episodes" / "experiment2.toml").read_text()
     text = text.replace('"../domains/fruits.pl"', f'"{ROOT / "examples/domains/fruits.pl"}"')
     for old, new in [("steps = 30", "steps = 3"), ("steps = 70", "steps = 7"),
-                     ("every = 20", "every = 5"), ("runs = 5", "runs = 1"),
+                     ("every = 25", "every = 5"), ("runs = 5", "runs = 1"),
                      ("steps = 100", "steps = 4"), ("executions = 5", "executions = 2"),
                      ("presentations = 150", "presentations = 4"),
                      ("max_steps = 3000", "max_steps = 60")]:
