@@ -51,8 +51,9 @@ def run(args: argparse.Namespace) -> int:
         episode.seed = args.seed
     if args.check:
         print(f"{args.episode}: ok - {episode.name}: {len(episode.phases)} phases, "
-              f"{episode.steps} time units, {len(episode.events)} events, learner "
-              f"{episode.learner} {episode.learner_params}, domain {episode.domain.name}")
+              f"{episode.steps} time units ({episode.time_unit}s), {len(episode.events)} events, "
+              f"learner {episode.learner} {episode.learner_params}, domain "
+              f"{episode.domain.name}")
         return 0
     if args.protocol and not args.head:
         raise ConfigError("--protocol needs --head PORT")

@@ -38,8 +38,9 @@ PAPER: dict[str, Any] = {
                  "weights": {"hear(attention)": 1.5, "see(frontal(face))": 0.95,
                              "see(looking_frontal(face))": 0.5,
                              "see(looking_fruit(object))": 1.5},
-                 "learning_steps": 100, "without_objects": 30, "eval_runs": 5,
-                 "eval_steps": 100, "executions": 5},
+                 "learning_units": 100, "without_objects": 30, "eval_runs": 5,
+                 "eval_units": 100, "executions": 5,
+                 "time_unit": "\"time units or runs\" (our reading: an interaction cycle)"},
 }
 
 

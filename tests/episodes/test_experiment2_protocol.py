@@ -217,3 +217,11 @@ def test_sweep_writes_tables_and_plots(tmp_path) -> None:
     for f in ("table1.csv", "table1_summary.csv", "confusion.csv", "fig6.png"):
         assert (out / f).exists(), f
     assert main(["--script", str(path), "--learners", "nope", "--out", str(out)]) == 2
+
+
+def test_interaction_units_need_the_simulated_caregiver(tmp_path) -> None:
+    from relrl.errors import ConfigError
+
+    ep = parse_episode(script(PHASES, time_unit="interaction"), tmp_path / "c.toml")
+    with pytest.raises(ConfigError, match="on a camera use time_unit"):
+        run_episode(ep, RunOptions(camera="synthetic://?looking_at=centre", plots=False))
