@@ -204,10 +204,12 @@ def test_an_interrupted_evaluation_point_is_flagged(tmp_path):
     full = run_episode(ep, RunOptions(plots=False))
     assert [p["interrupted"] for p in full["evaluation"]] == [False, False, False]
     assert all(p["runs"] == {"done": 4, "planned": 4} for p in full["evaluation"])
-    # stop in the middle of the second point's third run: 1 + 4*11 (first point) + 3 learning
-    # units + 1 + 2*11 + 5 looks
+    # stop in the middle of the second point's third run. Looks: 1 before the first unit,
+    # 4 runs x 12 (1 before the run, 1 per step of 10, 1 after it), 2 more for unit 1 and 3
+    # each for units 2 and 3 (before, in and after the unit), 1 before unit 4, two runs of 12,
+    # then 1 + 5 into the third run
     cut = run_episode(ep, RunOptions(out=tmp_path / "out", plots=False),
-                      StopAfter(1 + 44 + 3 + 1 + 22 + 5))
+                      StopAfter(1 + 4 * 12 + 2 + 2 * 3 + 1 + 2 * 12 + 1 + 5))
     first, second = cut["evaluation"]
     assert not first["interrupted"] and first == full["evaluation"][0]
     assert second["interrupted"] and second["runs"] == {"done": 2, "planned": 4}
