@@ -64,6 +64,6 @@ def test_a_session_writes_its_log_file(tmp_path: Path, capsys) -> None:
     assert main(["run", "-q", str(script), "--out", str(out), "--no-plots"]) == 0
     assert "evaluation after" not in capsys.readouterr().err  # -q: warnings only
     text = (out / "run.log").read_text()
-    assert "session started" in text and "evaluation after 10 time units" in text
+    assert "session started" in text and "evaluation after 10 steps" in text
     assert main(["-v", "run", str(script), "--out", str(tmp_path / "o2"), "--no-plots"]) == 0
-    assert "evaluation after 10 time units" in capsys.readouterr().err
+    assert "evaluation after 10 steps" in capsys.readouterr().err
