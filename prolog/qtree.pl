@@ -11,6 +11,7 @@
             qtree_node/3,         % +Tree, ?Id, ?Node
             qtree_clear/1,        % +Tree
             qtree_format/2,       % +Tree, -Text
+            qtree_graph/2,        % +Tree, -Graph
             qtree_restore/3,      % +Tree, +Tests, +Nodes
             qtree_put_entry/3,    % +Entries0, +Entry, -Entries
             qtree_entry_q/5,      % +Entries, +Action, +Necessity, +Default, -Q
@@ -271,3 +272,34 @@ format_branch(_, nil, Indent, Label) :-
     format("~w~wnull~n", [Indent, Label]).
 format_branch(Tree, Id, Indent, Label) :-
     format_node(Tree, Id, Indent, Label).
+
+%!  qtree_graph(+Tree, -Graph) is det.
+%
+%   Graph is graph(Nodes, Edges) for drawing Tree: node(Id, test, Label) for a test node
+%   (Label its goal as text), node(Id, leaf, Label) for a leaf (its entries, best first),
+%   node(nil(Parent, Branch), null, "null") for an empty branch, and edge(From, To, yes|no).
+
+qtree_graph(Tree, graph(Nodes, Edges)) :-
+    findall(N, graph_node(Tree, N), Nodes),
+    findall(E, graph_edge(Tree, E), Edges).
+
+graph_node(Tree, node(Id, test, Label)) :-
+    node_(Tree, Id, test(_, Goal, _, _)),
+    format(string(Label), "~q", [Goal]).
+graph_node(Tree, node(Id, leaf, Label)) :-
+    node_(Tree, Id, leaf(_, Entries)),
+    findall(L, ( member(e(A, Q, N), Entries),
+                 format(string(L), "~q ~2f [~q]", [A, Q, N]) ), Lines),
+    atomic_list_concat(Lines, '\n', Atom),
+    atom_string(Atom, Label).
+graph_node(Tree, node(nil(Id, Branch), null, "null")) :-
+    node_(Tree, Id, test(_, _, Yes, No)),
+    member(Branch-nil, [yes-Yes, no-No]).
+
+graph_edge(Tree, edge(Id, To, Branch)) :-
+    node_(Tree, Id, test(_, _, Yes, No)),
+    member(Branch-Child, [yes-Yes, no-No]),
+    (   Child == nil
+    ->  To = nil(Id, Branch)
+    ;   To = Child
+    ).
