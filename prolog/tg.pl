@@ -21,6 +21,7 @@
 :- use_module(library(pairs)).
 :- use_module(library(random)).
 :- use_module(declarations).
+:- use_module(engine).
 :- use_module(tg_bias).
 :- use_module(tg_stats).
 
@@ -30,7 +31,7 @@ In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001). The Q-function i
 first-order regression tree over examples (State, Action, Necessity, Q-target):
 
   - State is the relational view of the domain (a sorted list of ground facts, see
-    tg_bias:relational_state/2), Action the response the value is for, Necessity the active
+    engine:engine_relational_state/2), Action the response the value is for, Necessity the active
     necessity;
   - an internal node holds a conjunction of literals from the language bias (rmode/1); it
     succeeds on an example when the conjunction of every test on the yes-branches from the
@@ -64,34 +65,43 @@ min_examples, reward_positive, reward_negative.
 
 % ---- the learner's state -------------------------------------------------------------------
 
-%   '$tg_tree:KB'   tree(Root, NextId, Version, Bias, Responses)
-%                   Root: node(Id, Lits, New, Yes, No) | leaf(Id, PathLits, Vars, Cands)
-%   '$tg_leaves:KB' an array term leaves(L1, ..., Lk); Li = l(Q, N, M, S, SS, C) for leaf i
-%                   or `free`: Q estimate, examples counted in it (partition + own), M, S,
-%                   SS of the examples since the leaf was made, C = c(M1, S1, SS1, M2, ...)
-%                   for its candidates in order.
-%   '$tg_params:KB' p(Alpha, Gamma, Epsilon, Qinit, Level, MinExamples)
+%   Two global variables per knowledge base:
+%
+%   '$tg_tree:KB'  tree(Root, NextId, Bias, Responses), read (copied) only when the tree
+%                  changes, is explained, drawn or saved. Root is a leaf(Id, PathLits,
+%                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
+%                  along the path, as in the tree.
+%   '$tg:KB'       tg(Params, Leaves, Cache, Version), read in place on every step:
+%                  Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples);
+%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C) for leaf i (or
+%                  `free`): the Q estimate and the examples counted in it (its partition's
+%                  and its own), the count, sum and sum of squares of the Q-targets since
+%                  the leaf was made, and C = c(M1, S1, SS1, M2, ...) the same for each
+%                  candidate, in order; the numbers are updated with nb_setarg/3.
+%                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
+%                  sorted the next state's allowed actions, reused by the choice that
+%                  follows in the same step while the tree is unchanged (Version).
 
-key(Kind, KB, Key) :-
-    atomic_list_concat(['$tg_', Kind, ':', KB], Key).
-
-tree(KB, Tree) :-
-    key(tree, KB, K),
-    (   nb_current(K, Tree0)
-    ->  copy_term(Tree0, Tree)
-    ;   existence_error(tg_tree, KB)
+data(KB, D) :-
+    atom_concat('$tg:', KB, K),
+    (   nb_current(K, D0)
+    ->  D = D0
+    ;   existence_error(tg_learner, KB)
     ).
 
-params(KB, P) :-
-    key(params, KB, K),
-    nb_getval(K, P).
+tree(KB, Tree) :-
+    atom_concat('$tg_tree:', KB, K),
+    (   nb_current(K, Tree0)
+    ->  copy_term(Tree0, Tree)
+    ;   existence_error(tg_learner, KB)
+    ).
 
-leaves(KB, Leaves) :-
-    key(leaves, KB, K),
-    nb_getval(K, Leaves).
+set_tree(KB, Tree) :-
+    atom_concat('$tg_tree:', KB, K),
+    nb_setval(K, Tree).
 
 leaf_stats(KB, Id, L) :-
-    leaves(KB, Leaves),
+    data(KB, tg(_, Leaves, _, _)),
     arg(Id, Leaves, L).
 
 %!  tg_init(+KB, +Params:list) is det.
@@ -101,28 +111,24 @@ leaf_stats(KB, Id, L) :-
 tg_init(KB, Params) :-
     must_be(atom, KB),
     must_be(list, Params),
-    maplist(param(Params), [alpha, gamma, epsilon, q_init, significance, min_examples],
-            [Alpha, Gamma, Epsilon, Qinit, Level, MinEx0]),
-    MinEx is max(3, round(MinEx0)),
-    key(params, KB, PK),
-    nb_setval(PK, p(Alpha, Gamma, Epsilon, Qinit, Level, MinEx)),
-    ( memberchk(temperature=Tau, Params) -> true ; Tau = 0 ),
-    key(temperature, KB, TK), nb_setval(TK, Tau),
+    maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
+                            min_examples],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0]),
+    MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
     new_stats(Qinit, 0, K, L),
-    key(leaves, KB, LK),
-    functor(Leaves, leaves, 16),
-    forall(between(1, 16, I), nb_setarg(I, Leaves, free)),
-    nb_setarg(1, Leaves, L),
-    nb_setval(LK, Leaves),
-    set_tree(KB, tree(Root, 2, 0, Bias, Responses)),
-    compile_tree(KB, Root),
+    empty_leaves(16, Leaves0),
+    setarg(1, Leaves0, L),
+    atom_concat('$tg:', KB, DK),
+    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx), Leaves0, none, 0)),
+    set_tree(KB, tree(Root, 2, Bias, Responses)),
     retractall(tg_cands_(KB, _, _, _, _, _)),
-    compile_leaf(KB, Root).
+    compile_leaf(KB, Root),
+    compile_tree(KB, Root).
 
 param(Params, Name, Value) :-
     (   memberchk(Name=V, Params)
@@ -131,20 +137,21 @@ param(Params, Name, Value) :-
     ;   existence_error(tg_parameter, Name)
     ).
 
+empty_leaves(Cap, Leaves) :-
+    length(Free, Cap),
+    maplist(=(free), Free),
+    Leaves =.. [leaves|Free].
+
 new_stats(Q, N, K, l(Q, N, 0, 0.0, 0.0, C)) :-
     findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
     C =.. [c|Xs].
 
-set_tree(KB, Tree) :-
-    key(tree, KB, K),
-    nb_setval(K, Tree).
-
 %!  tg_state(+KB, -Facts:list) is det.
 %
-%   The relational view of KB now (sorted ground facts).
+%   The relational view of KB now (sorted ground facts; engine_relational_state/2).
 
 tg_state(KB, Facts) :-
-    relational_state(KB, Facts).
+    engine_relational_state(KB, Facts).
 
 % ---- compiling the tree --------------------------------------------------------------------
 
@@ -213,44 +220,63 @@ tg_q(KB, Facts, Action, N, Q) :-
 
 %!  tg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
-%   Action is one of the Allowed responses: with Mode learn or explore, a random one with
-%   probability epsilon; otherwise one with the largest Q (ties broken at random).
+%   Action is one of the Allowed responses. With Mode learn or explore: with temperature
+%   T > 0, drawn with probability proportional to exp(Q / T) (Boltzmann exploration);
+%   with T = 0, a random one with probability epsilon and otherwise a greedy one. With
+%   Mode greedy, one with the largest Q. Ties are broken at random.
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
-    params(KB, p(_, _, Epsilon, _, _, _)),
-    key(temperature, KB, TK), nb_getval(TK, Tau),
-    (   Mode \== greedy, Tau > 0
-    ->  scored(KB, Facts, N, Allowed, Scored),
-        softmax_member(Scored, Tau, Action)
-    ;   Mode \== greedy,
+    data(KB, D),
+    D = tg(p(_, _, Epsilon, Tau, _, _), Leaves, Cache, Version),
+    (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
     ->  random_member(Action, Allowed)
-    ;   scored(KB, Facts, N, Allowed, Scored),
-        max_member(Best-_, Scored),
-        include(scored_as(Best), Scored, Ties),
-        random_member(_-Action, Ties)
+    ;   (   Cache = last(F1, N1, A1, Ids, Version), F1 == Facts, N1 == N, A1 == Allowed
+        ->  maplist(leaf_q(Leaves), Ids, Qs)
+        ;   maplist(sorted_q(KB, Leaves, Facts, N), Allowed, Qs)
+        ),
+        max_list(Qs, Best),
+        (   Mode \== greedy, Tau > 0
+        ->  softmax_member(Qs, Allowed, Best, Tau, Action)
+        ;   ties(Qs, Allowed, Best, Ties),
+            random_member(Action, Ties)
+        )
     ).
 
-softmax_member(Scored, Tau, Action) :-
-    max_member(Best-_, Scored),
-    foldl([Q-_, W0, W]>>(W is W0 + exp((Q - Best) / Tau)), Scored, 0.0, Total),
-    X is random_float * Total,
-    pick(Scored, Best, Tau, X, Action).
+leaf_q(Leaves, Id, Q) :-
+    arg(Id, Leaves, L),
+    arg(1, L, Q).
 
-pick([Q-A|Rest], Best, Tau, X, Action) :-
+sorted_q(KB, Leaves, Facts, N, A, Q) :-
+    tg_sort_(KB, Facts, A, N, Leaf),
+    leaf_q(Leaves, Leaf, Q).
+
+ties([], [], _, []).
+ties([Q|Qs], [A|As], Best, Ties) :-
+    (   Q =:= Best
+    ->  Ties = [A|Ties1]
+    ;   Ties = Ties1
+    ),
+    ties(Qs, As, Best, Ties1).
+
+softmax_member(Qs, Allowed, Best, Tau, Action) :-
+    weights(Qs, Best, Tau, Ws, 0.0, Total),
+    X is random_float * Total,
+    pick(Ws, Allowed, X, Action).
+
+weights([], _, _, [], T, T).
+weights([Q|Qs], Best, Tau, [W|Ws], T0, T) :-
     W is exp((Q - Best) / Tau),
-    (   ( X < W ; Rest == [] )
+    T1 is T0 + W,
+    weights(Qs, Best, Tau, Ws, T1, T).
+
+pick([W|Ws], [A|As], X, Action) :-
+    (   ( X < W ; Ws == [] )
     ->  Action = A
     ;   X1 is X - W,
-        pick(Rest, Best, Tau, X1, Action)
+        pick(Ws, As, X1, Action)
     ).
-
-scored(KB, Facts, N, Allowed, Scored) :-
-    findall(Q-A, ( member(A, Allowed), tg_q(KB, Facts, A, N, Q) ), Scored).
-
-scored_as(Best, Q-_) :-
-    Q =:= Best.
 
 %!  tg_update(+KB, +Transition) is det.
 %
@@ -259,22 +285,21 @@ scored_as(Best, Q-_) :-
 %   Allowed1 (over every response when none is allowed).
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
-    params(KB, p(_, Gamma, _, _, _, _)),
+    data(KB, D),
+    D = tg(p(_, Gamma, _, _, _, _), Leaves, _, Version),
     (   Allowed1 == []
-    ->  key(tree, KB, K), nb_getval(K, tree(_, _, _, _, Next))
+    ->  tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
-    max_q(KB, S1, N1, Next, Max),
+    maplist(sorted_leaf(KB, S1, N1), Next, Ids),
+    maplist(leaf_q(Leaves), Ids, Qs),
+    max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    tg_insert(KB, S0, A0, N0, Target).
+    nb_setarg(3, D, last(S1, N1, Allowed1, Ids, Version)),
+    insert(KB, D, S0, A0, N0, Target).
 
-max_q(KB, Facts, N, [A|As], Max) :-
-    tg_q(KB, Facts, A, N, Q0),
-    foldl(max_q_(KB, Facts, N), As, Q0, Max).
-
-max_q_(KB, Facts, N, A, M0, M) :-
-    tg_q(KB, Facts, A, N, Q),
-    M is max(M0, Q).
+sorted_leaf(KB, Facts, N, A, Leaf) :-
+    tg_sort_(KB, Facts, A, N, Leaf).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
@@ -283,9 +308,13 @@ max_q_(KB, Facts, N, A, M0, M) :-
 %   and split the leaf when its best candidate is significant.
 
 tg_insert(KB, Facts, A, N, Target) :-
+    data(KB, D),
+    insert(KB, D, Facts, A, N, Target).
+
+insert(KB, D, Facts, A, N, Target) :-
+    D = tg(p(Alpha, _, _, _, Level, MinEx), Leaves, _, _),
     tg_sort_(KB, Facts, A, N, Leaf),
-    leaf_stats(KB, Leaf, L),
-    params(KB, p(Alpha, _, _, _, Level, MinEx)),
+    arg(Leaf, Leaves, L),
     L = l(Q0, N0, M0, S0, SS0, C),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
@@ -296,14 +325,15 @@ tg_insert(KB, Facts, A, N, Target) :-
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
     tg_cands_(KB, Leaf, Facts, A, N, Hits),
     count_hits(Hits, C, Target),
-    (   M >= MinEx,
-        best_candidate(C, M, S, Best),
+    (   M >= 2 * MinEx,
+        M /\ 3 =:= 0,                               % every fourth example
+        best_candidate(C, M, S, MinEx, Best),
         Best = I-Yes,
         split_f(s(M, S, SS), Yes, F, Dof),
         functor(C, _, Arity),
         Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
         f_significant(F, Dof, Corrected)
-    ->  split(KB, Leaf, I, Yes, s(M, S, SS))
+    ->  split(KB, D, Leaf, I, Yes, s(M, S, SS))
     ;   true
     ).
 
@@ -315,39 +345,38 @@ count_hits([I|Is], C, T) :-
     arg(J3, C, SS0), SS is SS0 + T * T, nb_setarg(J3, C, SS),
     count_hits(Is, C, T).
 
-%   The candidate whose split explains the most variance: for a fixed total, F grows with
-%   S1^2/M1 + S2^2/M2, so only that is compared. Best = I-s(M1, S1, SS1).
-best_candidate(C, M, S, I-s(M1, S1, SS1)) :-
+%   The candidate whose split explains the most variance, among those that leave at least
+%   MinEx examples on each side: for a fixed total, F grows with S1^2/M1 + S2^2/M2, so only
+%   that is compared. Best = I-s(M1, S1, SS1).
+best_candidate(C, M, S, MinEx, I-s(M1, S1, SS1)) :-
     functor(C, _, Arity),
-    K is Arity // 3,
-    best_from(1, K, C, M, S, none, -1.0, Best),
-    Best \== none,
-    I = Best,
+    Max is M - MinEx,
+    best_from(1, Arity, C, M, S, MinEx, Max, none, -1.0, I),
+    I \== none,
     J is 3 * I - 2, J2 is J + 1, J3 is J + 2,
     arg(J, C, M1), arg(J2, C, S1), arg(J3, C, SS1).
 
-best_from(I, K, C, M, S, B0, G0, B) :-
-    (   I > K
+best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
+    (   J > Arity
     ->  B = B0
-    ;   J is 3 * I - 2,
-        arg(J, C, M1),
-        (   M1 > 0, M1 < M
+    ;   arg(J, C, M1),
+        (   M1 >= Min, M1 =< Max
         ->  J2 is J + 1, arg(J2, C, S1),
             G is S1 * S1 / M1 + (S - S1) * (S - S1) / (M - M1),
             (   G > G0
-            ->  B1 = I, G1 = G
+            ->  B1 is (J + 2) // 3, G1 = G
             ;   B1 = B0, G1 = G0
             )
         ;   B1 = B0, G1 = G0
         ),
-        I1 is I + 1,
-        best_from(I1, K, C, M, S, B1, G1, B)
+        J1 is J + 3,
+        best_from(J1, Arity, C, M, S, Min, Max, B1, G1, B)
     ).
 
 % ---- splitting -----------------------------------------------------------------------------
 
-split(KB, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
-    tree(KB, tree(Root0, Next0, Version0, Bias, Responses)),
+split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
+    tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
     replace_leaf(Root0, LeafId, Leaf, Node, Root),
     Leaf = leaf(LeafId, Path, Vars, Cands),
@@ -365,11 +394,13 @@ split(KB, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
     length(YesCands, KY), length(NoCands, KN),
     new_stats(QYes, M1, KY, LYes),
     new_stats(QNo, M2, KN, LNo),
-    put_leaf(KB, LeafId, free),
-    put_leaf(KB, YesId, LYes),
-    put_leaf(KB, NoId, LNo),
+    put_leaf(D, LeafId, free),
+    put_leaf(D, YesId, LYes),
+    put_leaf(D, NoId, LNo),
+    arg(4, D, Version0),
     Version is Version0 + 1,
-    set_tree(KB, tree(Root, Next, Version, Bias, Responses)),
+    nb_setarg(4, D, Version),
+    set_tree(KB, tree(Root, Next, Bias, Responses)),
     retractall(tg_cands_(KB, LeafId, _, _, _, _)),
     compile_leaf(KB, Yes),
     compile_leaf(KB, No),
@@ -388,8 +419,8 @@ replace_leaf(node(Id, L, N, Y0, No0), LeafId, Leaf, Node, node(Id, L, N, Y, No))
     replace_leaf(Y0, LeafId, Leaf, Node, Y),
     replace_leaf(No0, LeafId, Leaf, Node, No).
 
-put_leaf(KB, Id, L) :-
-    leaves(KB, Leaves0),
+put_leaf(D, Id, L) :-
+    arg(2, D, Leaves0),
     functor(Leaves0, _, Cap),
     (   Id =< Cap
     ->  nb_setarg(Id, Leaves0, L)
@@ -400,9 +431,8 @@ put_leaf(KB, Id, L) :-
         maplist(=(free), More),
         append(Args0, More, Args),
         Leaves =.. [F|Args],
-        nb_setarg(Id, Leaves, L),
-        key(leaves, KB, K),
-        nb_setval(K, Leaves)
+        setarg(Id, Leaves, L),
+        nb_setarg(2, D, Leaves)
     ).
 
 % ---- explaining ----------------------------------------------------------------------------
@@ -416,7 +446,7 @@ put_leaf(KB, Id, L) :-
 %   the test introduced, from the first solution of the query that made it true.
 
 tg_explain(KB, Facts, N, tg(Ranked)) :-
-    tree(KB, tree(Root, _, _, _, Responses)),
+    tree(KB, tree(Root, _, _, Responses)),
     findall(NegQ-choice(A, Q, Leaf, Path),
             ( member(A, Responses),
               explain_path(Root, [], [], Facts, A, N, Path, Leaf),
@@ -466,7 +496,7 @@ binding_pair(Name=Value, Name-Value).
 
 tg_size(KB, size(Positions, [nodes=Nodes, tests=Tests, leaves=Leaves, entries=Leaves,
                              candidates=Cands, statistics=Stats])) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     tree_counts(Root, 0-0-0, Tests-Leaves-Cands),
     Nodes is Tests + Leaves,
     Positions is Nodes + Leaves,
@@ -486,7 +516,7 @@ tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
 %   Texts are the candidate tests of leaf LeafId, written with their variables named.
 
 tg_candidates(KB, LeafId, Texts) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     tree_leaf(Root, leaf(LeafId, _, Vars, Cands)),
     findall(Text, ( member(cand(Lits, New), Cands),
                     append(Vars, New, All),
@@ -507,7 +537,7 @@ tree_leaf(node(_, _, _, Y, N), L) :-
 %   Text draws the tree, one line per node, indented by depth.
 
 tg_text(KB, Text) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     with_output_to(string(Text), text_node(KB, Root, [], "", "")).
 
 text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
@@ -528,7 +558,7 @@ text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
 %   string), edge(From, To, yes) and edge(From, To, no).
 
 tg_graph(KB, graph(Nodes, Edges)) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     graph_node(KB, Root, [], Nodes, [], Edges, []).
 
 graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
@@ -560,7 +590,7 @@ named_rule(Rule-Names, Rule) :-
 
 %   Rule-Names for every leaf: the rule with its variables, and Name=Var for each.
 leaf_rules(KB, Rules) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
 
 leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
@@ -614,7 +644,7 @@ list_conj_([G|Gs], (G, C)) :- list_conj_(Gs, C).
 %   the leaves as q/3 rules (for a person, and for plain swipl).
 
 tg_save(KB, S) :-
-    tree(KB, tree(Root, _, _, _, _)),
+    tree(KB, tree(Root, _, _, _)),
     saved_tree(KB, Root, [], Saved, Vars),
     name_variables(Vars, Names),
     maplist([Name=V]>>(V = '$VAR'(Name)), Names),
@@ -662,7 +692,7 @@ tg_restore(KB, Terms) :-
     ->  true
     ;   existence_error(tg_tree, Terms)
     ),
-    tree(KB, tree(_, _, _, Bias, Responses)),
+    tree(KB, tree(_, _, Bias, Responses)),
     restored(Saved, Bias, [], [], Root, Stats),
     pairs_keys(Stats, Ids),
     (   sort(Ids, Unique), length(Unique, U), length(Ids, U)
@@ -670,14 +700,15 @@ tg_restore(KB, Terms) :-
     ;   domain_error(tg_tree_unique_ids, Ids)
     ),
     max_list(Ids, MaxId),
-    key(leaves, KB, LK),
     Cap is max(16, MaxId),
-    functor(Leaves, leaves, Cap),
-    forall(between(1, Cap, I), nb_setarg(I, Leaves, free)),
-    forall(member(Id-L, Stats), ( L == test -> true ; nb_setarg(Id, Leaves, L) )),
-    nb_setval(LK, Leaves),
+    empty_leaves(Cap, Leaves),
+    foldl(place_leaf(Leaves), Stats, _, _),
+    data(KB, D),
+    nb_setarg(2, D, Leaves),
+    nb_setarg(3, D, none),
+    arg(4, D, Version0), Version is Version0 + 1, nb_setarg(4, D, Version),
     Next is MaxId + 1,
-    set_tree(KB, tree(Root, Next, 0, Bias, Responses)),
+    set_tree(KB, tree(Root, Next, Bias, Responses)),
     retractall(tg_cands_(KB, _, _, _, _, _)),
     forall(tree_leaf(Root, Leaf), compile_leaf(KB, Leaf)),
     compile_tree(KB, Root),
@@ -707,6 +738,12 @@ restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN
 restored(Other, _, _, _, _, _) :-
     domain_error(tg_tree, Other).
 
+place_leaf(Leaves, Id-L, _, _) :-
+    (   L == test
+    ->  true
+    ;   setarg(Id, Leaves, L)
+    ).
+
 typed_var(V-T) :-
     var(V),
     atom(T).
@@ -734,3 +771,40 @@ same_rule(R, M) :-
 
 rule_parts((H :- B), H, B) :- !.
 rule_parts(H, H, true).
+
+% ---- the engine's hooks (see engine.pl) ----------------------------------------------------
+
+relrl_engine:learner(tg).
+
+relrl_engine:learner_init(tg, KB, Params) :-
+    tg_init(KB, Params).
+
+relrl_engine:learner_state(tg, KB, _Code, Facts) :-
+    tg_state(KB, Facts).
+
+relrl_engine:learner_choose(tg, KB, Facts, N, Allowed, Mode, Action) :-
+    tg_choose(KB, Facts, N, Allowed, Mode, Action).
+
+relrl_engine:learner_update(tg, KB, Transition) :-
+    tg_update(KB, Transition).
+
+relrl_engine:learner_explain(tg, KB, Facts, N, Explanation) :-
+    tg_explain(KB, Facts, N, Explanation).
+
+relrl_engine:learner_size(tg, KB, Size) :-
+    tg_size(KB, Size).
+
+relrl_engine:learner_save(tg, KB, Stream) :-
+    tg_save(KB, Stream).
+
+relrl_engine:learner_policy_term(tg, Term) :-
+    tg_policy_term(Term).
+
+relrl_engine:learner_restore(tg, KB, Terms) :-
+    tg_restore(KB, Terms).
+
+relrl_engine:learner_text(tg, KB, Text) :-
+    tg_text(KB, Text).
+
+relrl_engine:learner_graph(tg, KB, Graph) :-
+    tg_graph(KB, Graph).

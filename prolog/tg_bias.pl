@@ -1,6 +1,5 @@
 :- module(relrl_tg_bias,
-          [ relational_state/2,   % +KB, -Facts
-            tg_bias/2,            % +KB, -Bias
+          [ tg_bias/2,            % +KB, -Bias
             refinements/4,        % +Bias, +PathLits, +Vars, -Candidates
             root_refinements/2,   % +KB, -Texts
             literal_goal/6,       % +Literal, +Facts, +Action, +Necessity, +Last, -Goal
@@ -16,7 +15,7 @@
 :- use_module(library(pairs)).
 :- use_module(declarations).
 
-/** <module> The relational view and the language bias of the TG learner
+/** <module> The language bias of the TG learner
 
 **The relational view.** A domain declares relational percept predicates with relation/1,
 a template whose ground solutions, now, are the facts of the relational state:
@@ -24,9 +23,9 @@ a template whose ground solutions, now, are the facts of the relational state:
     relation(gaze(_Who, _Place)).        gaze(face, Place) :- ...   (from working memory)
     relation(toy_at(_Toy, _Place)).
 
-relational_state/2 collects them, sorted: the state TG learns from is a ground list such as
-[colour(toy, red), head_at(centre), gaze(face, left), ...]. The 2^x state code of the other
-learners is not touched.
+The engine collects them, sorted (engine_relational_state/2): the state TG learns from is a
+ground list such as [colour(toy, red), head_at(centre), gaze(face, left), ...]. The 2^x
+state code of the other learners is not touched.
 
 **The language bias**, in the style of TILDE/ACE rmode declarations, says which literals a
 test may hold:
@@ -51,22 +50,6 @@ Q-value by itself; action(look(P)), gaze(face, P) may). Candidates that the path
 implies are left out, and conjunctions that differ only in the order of their literals or
 the names of their variables are given once.
 */
-
-% ---- the relational view ------------------------------------------------------------------
-
-%!  relational_state(+KB, -Facts:list) is det.
-%
-%   Facts are the ground solutions, now, of the relation/1 templates of KB, sorted and
-%   without duplicates. A non-ground solution raises instantiation_error.
-
-relational_state(KB, Facts) :-
-    findall(F, ( declared(KB, relation(T)), copy_term(T, F), KB:F ), Facts0),
-    (   ground(Facts0)
-    ->  true
-    ;   member(F, Facts0), \+ ground(F)
-    ->  instantiation_error(F)
-    ),
-    sort(Facts0, Facts).
 
 % ---- the bias ------------------------------------------------------------------------------
 

@@ -95,11 +95,15 @@ split_f(s(N, S, SS), s(N1, S1, SS1), F, Dof) :-
 %!  f_significant(+F, +Dof:integer, +Level:float) is semidet.
 %
 %   F, with (1, Dof) degrees of freedom, is significant at Level: P(F(1, Dof) > F) < Level.
+%   F(1, d) is the square of Student's t, whose tails are heavier than the normal's: when
+%   the normal tail P(|Z| > sqrt(F)) = erfc(sqrt(F / 2)) is not below Level, neither is P,
+%   and the incomplete beta function is not needed.
 
 f_significant(F, Dof, Level) :-
     (   F == inf
     ->  true
     ;   F > 1.0,
+        erfc(sqrt(F / 2)) < Level,          % the normal limit: a lower bound of P
         f_p_value(F, 1, Dof, P),
         P < Level
     ).

@@ -22,7 +22,8 @@ gaze_kb(KB) :-
     tg_kb(KB, 'tests/data/tg_gaze.pl').
 
 params(Level, MinEx,
-       [alpha=0, gamma=0.9, epsilon=0, q_init=0, significance=Level, min_examples=MinEx]).
+       [alpha=0, gamma=0.9, epsilon=0, temperature=0, q_init=0, significance=Level,
+        min_examples=MinEx]).
 
 fresh_learner(KB, Level, MinEx) :-
     gaze_kb(KB),
@@ -40,7 +41,7 @@ feed(KB, Places, Rounds) :-
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )).
 
 root(KB, Root) :-
-    relrl_tg:tree(KB, tree(Root, _, _, _, _)).
+    relrl_tg:tree(KB, tree(Root, _, _, _)).
 
 :- begin_tests(tg_refinement).
 
@@ -162,8 +163,9 @@ test(splits_on_the_relational_test, [true(Lits =@= [gaze(face, X), action(look(X
     root(KB, node(_, Lits, _, _, _)).
 
 test(no_split_before_min_examples, [Root = leaf(_, _, _, _)]) :-
-    fresh_learner(KB, 0.001, 100),
-    feed(KB, [p1, p2, p3], 6),          % 54 examples
+    % 54 examples, 18 of which follow the gaze: fewer than 20 on that side
+    fresh_learner(KB, 0.001, 20),
+    feed(KB, [p1, p2, p3], 6),
     root(KB, Root).
 
 test(no_split_on_noise, [Root = leaf(_, _, _, _)]) :-
@@ -177,16 +179,16 @@ test(no_split_on_noise, [Root = leaf(_, _, _, _)]) :-
 test(children_start_from_partitions, [Q-N == 10.0-M]) :-
     % no wobble: targets are exactly 10 (gaze followed) and 0
     fresh_learner(KB, 0.001, 10),
-    forall(( between(1, 3, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
+    forall(( between(1, 4, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
            ( ( G == P -> T = 10 ; T = 0 ),
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
     relrl_tg:leaf_stats(KB, Yes, l(Q, N, _, _, _, _)),
-    M = 9.                               % 27 examples, one in three followed the gaze
+    M = 12.                              % 36 examples, one in three followed the gaze
 
 test(generalises_to_places_never_seen, [Q1-Q2 == 10.0-0.0]) :-
     fresh_learner(KB, 0.001, 10),
-    forall(( between(1, 3, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
+    forall(( between(1, 4, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
            ( ( G == P -> T = 10 ; T = 0 ),
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     tg_q(KB, [gaze(face, p4)], look(p4), curiosity, Q1),

@@ -1,0 +1,61 @@
+"""TG: a first-order incremental regression-tree Q-learner, held in Prolog (prolog/tg.pl).
+
+In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001): one regression tree over
+(relational state, action, necessity) examples whose tests are conjunctions of literals
+from the domain's language bias (``rmode/1``), split by an F-test on incremental statistics
+of the Q-targets. See docs/tg.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from relrl.errors import ConfigError
+from relrl.learners.base import Learner, register
+from relrl.terms import Term, format_term
+
+__all__ = ["TGLearner"]
+
+
+@register
+class TGLearner(Learner):
+    """A first-order Q-tree; choices, updates and splits run in Prolog (one call a step).
+
+    Parameters: alpha (0: a leaf's Q is the mean of its Q-targets; otherwise the step size
+    is max(1/n, alpha)), gamma, epsilon (with temperature 0: epsilon-greedy),
+    temperature (> 0: Boltzmann exploration, P(a) proportional to exp(Q(s, a) / T)),
+    q_init (Q of the first, empty leaf), significance (of the F-test, for the best of a
+    leaf's candidates, Bonferroni-corrected for their number), min_examples (before a leaf
+    may split).
+    """
+
+    name = "tg"
+    engine_name = "tg"
+    defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
+                "q_init": 30.0, "significance": 0.001, "min_examples": 30.0}
+
+    def _check_params(self) -> None:
+        super()._check_params()
+        p = self.params
+        if not 0.0 < p["significance"] < 1.0:
+            raise ConfigError(f"significance must be in (0, 1), not {p['significance']}")
+        if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
+            raise ConfigError(f"min_examples must be a whole number >= 3, not "
+                              f"{p['min_examples']}")
+        if p["temperature"] < 0:
+            raise ConfigError(f"temperature must be >= 0, not {p['temperature']}")
+
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """Every response's Q with its leaf and the path of first-order tests that led there
+        (with the bindings that made them true); ``path`` and ``leaf`` are the best's."""
+        _, choices = detail
+        ranked = []
+        for _, action, q, leaf, path in choices:
+            tests = [{"test": str(text), "holds": outcome == "true",
+                      "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
+                     for (_, _, text, outcome, bindings) in path]
+            ranked.append({"response": format_term(action), "q": q, "leaf": leaf,
+                           "path": tests})
+        best = ranked[0] if ranked else {"path": [], "leaf": None}
+        return {"state": [format_term(f) for f in state], "path": best["path"],
+                "leaf": best["leaf"], "ranked": ranked}
