@@ -283,7 +283,8 @@ bias_problem(KB, problem(File, Line, Msg)) :-
     member(M2-Ref2, Later),
     M2 =@= M,
     clause_where(Ref2, File, Line),
-    format(string(Msg), "rmode ~q is declared twice", [M]).
+    mode_text(M, MT),
+    format(string(Msg), "rmode ~w is declared twice", [MT]).
 
 relation_problem(T, Msg) :-
     (   \+ callable(T)
@@ -296,35 +297,40 @@ relation_problem(T, Msg) :-
     ).
 
 mode_problem(KB, M, Msg) :-
+    mode_text(M, MT),
     (   \+ callable(M)
-    ->  format(string(Msg), "rmode(~q): the mode must be a literal, e.g. \c
-                             rmode(gaze(#agent, -place))", [M])
+    ->  format(string(Msg), "rmode(~w): the mode must be a literal, e.g. \c
+                             rmode(gaze(#agent, -place))", [MT])
     ;   bad_mode_arg(M, Bad)
-    ->  format(string(Msg), "rmode ~q: bad argument ~q (use +Type, -Type, #Type, a \c
-                             constant or a term of these)", [M, Bad])
+    ->  format(string(Msg), "rmode ~w: bad argument ~q (use +Type, -Type, #Type, a \c
+                             constant or a term of these)", [MT, Bad])
     ;   M = action(A)
     ->  pattern(A, P),
         \+ ( kb_response(KB, R), \+ R \= P ),
-        format(string(Msg), "rmode ~q matches no declared response", [M])
+        format(string(Msg), "rmode ~w matches no declared response", [MT])
     ;   M = necessity(A)
     ->  \+ ( A = #(necessity) ; A = -(necessity) ; atomic(A) ),
-        format(string(Msg), "rmode ~q: use necessity(#necessity) or necessity(-necessity)",
-               [M])
+        format(string(Msg), "rmode ~w: use necessity(#necessity) or necessity(-necessity)",
+               [MT])
     ;   functor(M, Name, Arity),
         \+ ( declared(KB, relation(T)), callable(T), functor(T, Name, Arity) )
     ->  length(Us, Arity), U =.. [Name|Us], maplist(=('_'), Us),
-        format(string(Msg), "rmode ~q: ~q is not a declared relation (add relation(~w).)",
-               [M, Name/Arity, U])
+        format(string(Msg), "rmode ~w: ~q is not a declared relation (add relation(~w).)",
+               [MT, Name/Arity, U])
     ;   mode_type(M, #, T),
         T \== necessity,
         \+ declared(KB, rconst(T, _))
-    ->  format(string(Msg), "rmode ~q: no constants of type ~q (add rconst(~q, Value).)",
-               [M, T, T])
+    ->  format(string(Msg), "rmode ~w: no constants of type ~q (add rconst(~q, Value).)",
+               [MT, T, T])
     ;   mode_type(M, +, T),
         \+ ( declared(KB, rmode(M2)), mode_type(M2, -, T) )
-    ->  format(string(Msg), "rmode ~q: +~q can never be bound (no rmode introduces a \c
-                             variable of type ~q with -~q)", [M, T, T, T])
+    ->  format(string(Msg), "rmode ~w: +~q can never be bound (no rmode introduces a \c
+                             variable of type ~q with -~q)", [MT, T, T, T])
     ).
+
+%   A mode written with relrl's operators (#agent, not #(agent)).
+mode_text(M, Text) :-
+    format(string(Text), "~W", [M, [quoted(true), module(relrl)]]).
 
 bad_mode_arg(M, Bad) :-
     compound(M),
