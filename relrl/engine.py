@@ -75,6 +75,7 @@ GOALS: dict[str, str] = {
     "necessity_inputs": "relrl_declarations:necessity_inputs",
     "check_domain": "relrl_check:check_domain",
     "rule_listing": "relrl_check:rule_listing",
+    "bias_listing": "relrl_check:bias_listing",
     "findall": "relrl_gateway:gw_findall",
     "parse": "relrl_gateway:gw_parse",
 }
