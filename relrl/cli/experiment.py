@@ -7,7 +7,8 @@ import json
 import os
 from pathlib import Path
 
-HELP = "reproduce the paper's experiments (sis: Experiment 1, three learners in the simulator)"
+HELP = ("reproduce the paper's experiments (sis: Experiment 1, the paper's three learners and "
+        "tg in the simulator)")
 EXAMPLE = "relrl experiment sis --quick --out runs/exp1-quick"
 
 
@@ -33,11 +34,29 @@ def _caregiver_param(text: str) -> tuple[str, object]:
         return key, value
 
 
+def _places(option: str, text: str | None) -> list[str] | None:
+    """The toy places of ``--train-places`` / ``--eval-places`` (None when not given)."""
+    from relrl.errors import ConfigError
+    from relrl.sim.errors import did_you_mean
+    from relrl.sim.places import TOY_PLACES
+
+    if text is None:
+        return None
+    places = [p.strip() for p in text.split(",") if p.strip()]
+    if not places:
+        raise ConfigError(f"{option} needs at least one place ({', '.join(TOY_PLACES)})")
+    for p in places:
+        if p not in TOY_PLACES:
+            raise ConfigError(f"{option}: unknown toy place {p!r}{did_you_mean(p, TOY_PLACES)} "
+                              f"(places: {', '.join(TOY_PLACES)})")
+    return list(dict.fromkeys(places))
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl experiment``."""
     parser.add_argument("name", choices=["sis"], help="which experiment")
-    parser.add_argument("--learners", default="contingency,qlearning,etg",
-                        help="comma-separated learners (default: all three)")
+    parser.add_argument("--learners", default="contingency,qlearning,etg,tg",
+                        help="comma-separated learners (default: all four)")
     parser.add_argument("--points", type=int, default=None,
                         help="evaluation points after the first (default 20; --quick: 4)")
     parser.add_argument("--eval-runs", type=int, default=None,
@@ -56,6 +75,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eval-policy", choices=["behaviour", "greedy"], default="behaviour",
                         help="evaluate the robot's behaviour (exploration kept, the default) "
                              "or the greedy policy")
+    parser.add_argument("--train-places", default=None, metavar="P,P,...",
+                        help="toy places while learning, e.g. left,left_down,down (default: "
+                             "all); the others are held out")
+    parser.add_argument("--eval-places", default=None, metavar="P,P,...",
+                        help="toy places of the evaluation (default: all); with held-out "
+                             "places the CGI is reported for trained and held-out apart")
     parser.add_argument("--domain", default=None, help="domain file (default sis.pl)")
     parser.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
     parser.add_argument("--quick", action="store_true", help="a short run (under a minute)")
@@ -99,6 +124,8 @@ def build_config(args: argparse.Namespace):
 
     for learner in learners:
         make_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    config.train_places = _places("--train-places", args.train_places)
+    config.eval_places = _places("--eval-places", args.eval_places)
     if args.domain:
         if not Path(args.domain).exists():
             raise ConfigError(f"--domain {args.domain}: no such file")

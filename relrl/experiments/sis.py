@@ -1,5 +1,5 @@
 """Experiment 1 of da Silva & Romero (2012, section 5.1): contingency, Q-learning and ETG in
-the Social Interactive Simulator.
+the Social Interactive Simulator, and relrl's relational learner tg beside them.
 
 Protocol: a learner interacts with the caregiver; every ``block`` (500) learning time units
 learning stops for an evaluation of ``eval_runs`` (20) runs of ``eval_steps`` (500) time
@@ -8,6 +8,11 @@ the distractor at random. Each run's CGI (Eq. 5) is recorded; Fig. 5 plots their
 standard deviation per evaluation point. Fig. 4 counts the eye contacts the robot establishes
 in the first 125 opportunities of the interaction. The learner's memory is reported in the
 paper's positions.
+
+Held-out places (``train_places``/``eval_places``): while learning, toys appear (and the
+caregiver looks) only at the training places; evaluation puts targets and distractors at the
+evaluation places, and the CGI is also reported for the trained and the held-out places
+apart (``cgi_places`` at each point: pooled correct shifts over shifts).
 
 One *job* is one learner with one seed; jobs are independent and run in worker processes
 (each holds one Prolog engine).
@@ -42,7 +47,8 @@ PAPER: dict[str, Any] = {
 class SISConfig:
     """Everything that determines an Experiment 1 run (written into results.json)."""
 
-    learners: list[str] = field(default_factory=lambda: ["contingency", "qlearning", "etg"])
+    learners: list[str] = field(
+        default_factory=lambda: ["contingency", "qlearning", "etg", "tg"])
     seeds: list[int] = field(default_factory=lambda: [0])
     points: int = 20                 #: evaluation points after the first (point 0: no learning)
     block: int = 500                 #: learning time units between evaluations
@@ -59,6 +65,10 @@ class SISConfig:
     #: "behaviour": evaluate the robot as it behaves (its exploration kept, no learning);
     #: "greedy": the learners' greedy policy (contingency's roulette stays a roulette).
     eval_policy: str = "behaviour"
+    #: toy places used while learning (None: the caregiver's own placement).
+    train_places: list[str] | None = None
+    #: toy places of the evaluation's targets and distractors (None: all of them).
+    eval_places: list[str] | None = None
 
     def jobs(self) -> list[tuple[str, int]]:
         """Every (learner, seed) pair, learners first."""
@@ -71,6 +81,55 @@ class SISConfig:
 
 def _nan_to_zero(x: float) -> float:
     return 0.0 if math.isnan(x) else x
+
+
+class _PlaceShifts:
+    """Shifts from the human (as in the CGI) counted apart for groups of gazed places."""
+
+    def __init__(self, groups: dict[str, set[str]]) -> None:
+        self.groups = groups
+        self.counts = {g: [0, 0] for g in groups}   # correct, shifts
+        self._prev: Any = None
+
+    def add(self, rec: Any) -> None:
+        prev = self._prev
+        if (prev is not None and prev.focus == "centre" and prev.gaze != "frontal"
+                and rec.focus != "centre"):
+            for name, places in self.groups.items():
+                if prev.gaze in places:
+                    self.counts[name][1] += 1
+                    self.counts[name][0] += rec.focus == prev.gaze
+        self._prev = rec
+
+
+def _places_cgi(by_places: dict[str, list[list[int]]]) -> dict[str, Any]:
+    """Per place group: the runs' [correct, shifts] and the pooled CGI (None: no shift)."""
+    out = {}
+    for g, runs in by_places.items():
+        correct, shifts = sum(r[0] for r in runs), sum(r[1] for r in runs)
+        out[g] = {"cgi": correct / shifts if shifts else None, "runs": runs}
+    return out
+
+
+def _caregivers(config: SISConfig) -> tuple[Any, Any, dict[str, set[str]]]:
+    """The learning and evaluation caregivers, and the place groups reported apart."""
+    from relrl.sim.caregiver import EVALUATION_SEQUENCE, make_caregiver
+    from relrl.sim.places import TOY_PLACES
+
+    params = dict(config.caregiver_params)
+    if config.train_places:
+        params["placement"] = {p: 1.0 for p in config.train_places}
+    caregiver = make_caregiver(config.caregiver, params)
+    evaluation = caregiver.params.for_evaluation()
+    groups: dict[str, set[str]] = {}
+    if config.train_places or config.eval_places:
+        places = list(config.eval_places or TOY_PLACES)
+        sequence = tuple(p for p in EVALUATION_SEQUENCE if p in places)
+        evaluation = evaluation.replace(placement={p: 1.0 for p in places},
+                                        target_sequence=sequence)
+        trained = set(config.train_places or TOY_PLACES)
+        groups = {"trained": set(places) & trained, "held_out": set(places) - trained}
+    return caregiver, make_caregiver(config.caregiver, evaluation), groups
 
 
 def run_job(config: SISConfig, learner_name: str, seed: int,
@@ -94,7 +153,6 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
     from relrl.kb import KnowledgeBase, gateway_calls
     from relrl.learners import make_learner
     from relrl.loop import Agent, Interaction
-    from relrl.sim.caregiver import make_caregiver
     from relrl.sim.metrics import GazeMetrics
     from relrl.sim.sis import SharedAttentionEnv
 
@@ -104,10 +162,8 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
     try:
         learner = make_learner(learner_name, **config.learner_params.get(learner_name, {}))
         agent = Agent(kb, learner, seed=seed)
-        caregiver = make_caregiver(config.caregiver, config.caregiver_params)
+        caregiver, eval_caregiver, groups = _caregivers(config)
         train_env = SharedAttentionEnv(caregiver, max_steps=None, record_trace=False)
-        eval_caregiver = make_caregiver(config.caregiver,
-                                        caregiver.params.for_evaluation().to_dict())
         eval_env = SharedAttentionEnv(eval_caregiver, max_steps=config.eval_steps,
                                       record_trace=False)
         learning_metrics = GazeMetrics()
@@ -119,27 +175,36 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
         eval_states: set[int] = set()
         steps = 0
 
-        def evaluate() -> list[float]:
+        def evaluate() -> tuple[list[float], dict[str, list[list[int]]]]:
             nonlocal steps
             values = []
+            by_places: dict[str, list[list[int]]] = {g: [] for g in groups}
             saved = agent.save_random()
             before = set(agent.states)
             agent.states.clear()
             for run_seed in eval_seeds[start:stop]:
                 agent.reseed(int(run_seed))
                 metrics = GazeMetrics()
-                ev = Interaction(eval_env, agent,
-                                 on_step=lambda r, m=metrics: m.add(r.info["record"]))
+                shifts = _PlaceShifts(groups)
+
+                def on_step(r: Any, m: GazeMetrics = metrics, p: _PlaceShifts = shifts) -> None:
+                    m.add(r.info["record"])
+                    p.add(r.info["record"])
+
+                ev = Interaction(eval_env, agent, on_step=on_step if groups else
+                                 lambda r, m=metrics: m.add(r.info["record"]))
                 ev.reset(seed=int(run_seed))
                 ev.run(config.eval_steps, learning=False,
                        explore=config.eval_policy == "behaviour", keep=False)
                 steps += config.eval_steps
                 values.append(_nan_to_zero(metrics.cgi().value))
+                for g, counts in shifts.counts.items():
+                    by_places[g].append(list(counts))
             agent.end_episode()
             agent.restore_random(saved)
             eval_states.update(agent.states)
             agent.states = before
-            return values
+            return values, by_places
 
         curve = []
         for point in range(config.points + 1):
@@ -147,10 +212,12 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
                 learning.run(config.block, learning=True, keep=False)
                 learning_states |= agent.states
                 steps += config.block
-            values = evaluate()
+            values, by_places = evaluate()
             curve.append({"point": point, "learning_steps": point * config.block,
                           "cgi_mean": float(np.mean(values)), "cgi_std": float(np.std(values)),
-                          "cgi_runs": values})
+                          "cgi_runs": values, "memory": learner.size()})
+            if groups:
+                curve[-1]["cgi_places"] = _places_cgi(by_places)
             if progress is not None:
                 progress(learner_name, seed, point)
         contacts = learning_metrics.eye_contacts(config.opportunities)
@@ -199,7 +266,11 @@ def merge_parts(parts: list[dict[str, Any]]) -> dict[str, Any]:
         runs = [v for p in parts for v in p["curve"][i]["cgi_runs"]]
         job["curve"].append({"point": point["point"], "learning_steps": point["learning_steps"],
                              "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
-                             "cgi_runs": runs})
+                             "cgi_runs": runs, "memory": point["memory"]})
+        if "cgi_places" in point:
+            job["curve"][-1]["cgi_places"] = _places_cgi(
+                {g: [r for p in parts for r in p["curve"][i]["cgi_places"][g]["runs"]]
+                 for g in point["cgi_places"]})
     learning_states = first["states_met"]["learning"]
     eval_states = set().union(*(p["eval_states"] for p in parts))
     job["states_met"] = {"learning": learning_states, "evaluation": len(eval_states)}

@@ -20,6 +20,7 @@ def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
     assert main(["experiment", "sis", *SMALL, "--out", str(a), "--workers", "1"]) == 0
     out = capsys.readouterr().out
     assert "learner" in out and "etg" in out and "qlearning" in out and "contingency" in out
+    assert "tg" in out
     for name in ["results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
                  "memory.csv", "fig5_cgi.png", "fig4_eye_contacts.png"]:
         assert (a / name).exists(), name
@@ -29,14 +30,14 @@ def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
     results = json.loads((a / "results.json").read_text())
     assert results["config"]["points"] == 2 and results["seeds"] == [0]
     assert results["relrl_version"]
-    for name in ["contingency", "qlearning", "etg"]:
+    for name in ["contingency", "qlearning", "etg", "tg"]:
         s = results["summary"][name]
         assert len(s["curve"]) == 3
         assert s["memory"]["positions"] > 0
         assert s["states_met"] > 0
     lines = (a / "fig5_cgi.csv").read_text().splitlines()
     assert lines[0] == "learner,point,learning_steps,cgi_mean,cgi_std,n_runs"
-    assert len(lines) == 1 + 3 * 3
+    assert len(lines) == 1 + 3 * 4
 
 
 def test_another_seed_other_numbers(tmp_path: Path) -> None:
