@@ -7,6 +7,15 @@ stimulus(face).
 stimulus(treat).
 stimulus_property(treat, reinforcer).
 
+% The propositional view (the state code of contingency, Q-learning and ETG): one fact per
+% place the caregiver can look at.
+fact(looks(p1)).
+fact(looks(p2)).
+fact(looks(p3)).
+fact(looks(p4)).
+
+looks(Place) :- memory(pose(face, Place), 0).
+
 response(look(p1)).
 response(look(p2)).
 response(look(p3)).

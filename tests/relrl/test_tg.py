@@ -1,0 +1,148 @@
+"""The tg learner through the engine: it learns a small relational task and acts correctly,
+with no further learning, on places it never saw; save -> load -> same choices; same seed
+-> same trajectory; explanations with bindings; readable policies; bad biases."""
+
+from __future__ import annotations
+
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from relrl.cli import main
+from relrl.kb import KnowledgeBase
+from relrl.learners import make_learner
+from relrl.loop import Agent, run
+from tests.conftest import ROOT
+from tests.relrl.tasks import GazeTask
+
+GAZE = ROOT / "tests" / "data" / "tg_gaze.pl"
+TRAINED, NEW = ("p1", "p2"), ("p3", "p4")
+
+
+def trained(steps: int = 800, seed: int = 3, **params: float) -> Agent:
+    kb = KnowledgeBase(GAZE)
+    agent = Agent(kb, make_learner("tg", min_examples=10, **params), seed=seed)
+    run(GazeTask(TRAINED), agent, steps, seed=seed)
+    return agent
+
+
+def accuracy(agent: Agent, places: tuple[str, ...], steps: int = 200) -> float:
+    records = run(GazeTask(places), agent, steps, learning=False, seed=99)
+    return float(np.mean([r.info["fed"] for r in records]))
+
+
+def test_learns_and_generalises_to_places_never_seen() -> None:
+    agent = trained()
+    assert accuracy(agent, TRAINED) == 1.0
+    # p3 and p4 never appeared while learning; greedy choices, nothing learned meanwhile
+    size = agent.learner.size()
+    assert accuracy(agent, NEW) == 1.0
+    assert agent.learner.size() == size
+    # one test relates the action to the gaze: no place of its own
+    assert "gaze(face, P), action(look(P))" in agent.learner.tree()
+    agent.kb.close()
+
+
+def test_qlearning_does_not_generalise() -> None:
+    kb = KnowledgeBase(GAZE)
+    agent = Agent(kb, make_learner("qlearning", epsilon=0.2), seed=3)
+    run(GazeTask(TRAINED), agent, 800, seed=3)
+    assert accuracy(agent, TRAINED) == 1.0
+    assert accuracy(agent, NEW) < 0.5          # chance is 0.25
+    kb.close()
+
+
+def test_save_load_same_choices(tmp_path: Path) -> None:
+    agent = trained()
+    path = agent.learner.save(tmp_path / "tg.pl")
+    before = [r.out.action for r in run(GazeTask(), agent, 60, learning=False, seed=7)]
+    with KnowledgeBase(GAZE) as kb2:
+        fresh = Agent(kb2, make_learner("tg"), seed=agent.seed)
+        fresh.learner.load(path)
+        after = [r.out.action for r in run(GazeTask(), fresh, 60, learning=False, seed=7)]
+        assert after == before
+        assert fresh.learner.tree().splitlines()[0] == agent.learner.tree().splitlines()[0]
+    agent.kb.close()
+
+
+def test_same_seed_same_trajectory() -> None:
+    def trajectory(seed: int) -> list:
+        with KnowledgeBase(GAZE) as kb:
+            agent = Agent(kb, make_learner("tg", min_examples=10), seed=seed)
+            return [(r.out.action, r.out.reward) for r in run(GazeTask(), agent, 300, seed=seed)]
+    assert trajectory(5) == trajectory(5)
+    assert trajectory(5) != trajectory(6)
+
+
+def test_explanation_shows_the_tests_and_bindings() -> None:
+    agent = trained()
+    out = agent.step([("see", "face"), ("pose", "face", "p4")], learning=False,
+                     want=("explain",))
+    assert out.action == ("look", "p4")
+    exp = out.explanation
+    assert exp["learner"] == "tg"
+    assert "gaze(face,p4)" in exp["state"]
+    best = exp["ranked"][0]
+    assert best["response"] == "look(p4)"
+    assert {"test": "gaze(face, P), action(look(P))", "holds": True,
+            "bindings": {"P": "p4"}} in best["path"]
+    agent.kb.close()
+
+
+def test_policy_reads_as_rules_and_consults_in_plain_swipl(tmp_path: Path) -> None:
+    agent = trained()
+    path = agent.learner.save(tmp_path / "tg.pl")
+    text = path.read_text()
+    assert "q(look(P), _, " in text and ":-\n    gaze(face, P)." in text
+    # plain swipl: the domain, the policy; the rules answer for the state in memory
+    goal = ("remember([see(face), pose(face, p3)]), q(look(p3), curiosity, Q), "
+            "q(look(p1), curiosity, Q1), Q > Q1 + 50")
+    proc = subprocess.run(["swipl", "--on-warning=status", "-g", goal, "-t", "halt",
+                           str(ROOT / "prolog" / "relrl.pl"), str(GAZE), str(path)],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    agent.kb.close()
+
+
+def test_edited_policy_refused_with_file_and_line(tmp_path: Path) -> None:
+    from relrl.errors import PolicyError
+
+    agent = trained()
+    path = agent.learner.save(tmp_path / "tg.pl")
+    path.write_text(path.read_text() + "\nhalt_now :- halt.\n")
+    with KnowledgeBase(GAZE) as kb2:
+        fresh = Agent(kb2, make_learner("tg"), seed=0)
+        with pytest.raises(PolicyError, match=r"tg\.pl:\d+: \(:-\)/2 is not part of a tg "
+                                              r"policy"):
+            fresh.learner.load(path)
+    agent.kb.close()
+
+
+@pytest.mark.parametrize("text,line,message", [
+    ("response(look(a)).\nrmode(gaze(#agent, -place)).\n", 2,
+     "gaze/2 is not a declared relation"),
+    ("response(look(a)).\nrelation(seen(_)).\nseen(a).\nrmode(seen(#thing)).\n", 4,
+     "no constants of type thing"),
+    ("response(look(a)).\nrelation(seen(_)).\nseen(a).\nrmode(seen(+place)).\n", 4,
+     "+place can never be bound"),
+    ("response(look(a)).\nrmode(action(point(-place))).\n", 2,
+     "matches no declared response"),
+    ("response(look(a)).\nrelation(gaze(_, _)).\n", 2,
+     "relation/1 calls undefined predicate gaze/2"),
+])
+def test_bad_bias_one_line_with_file_and_line(text: str, line: int, message: str,
+                                              write_domain, capsys) -> None:
+    path = write_domain("stimulus(face).\n" + text)
+    assert main(["check", "-q", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and err[1] == "1 problem"
+    assert err[0].startswith(f"{path}:{line + 1}: ") and message in err[0]
+
+
+def test_check_lists_the_refinements(capsys) -> None:
+    assert main(["check", str(GAZE)]) == 0
+    out = capsys.readouterr().out
+    assert "relations (the relational view, learner tg):\n  gaze(_, _)\n  fed(_)" in out
+    assert "  gaze(face, P), action(look(P))\n" in out
