@@ -7,7 +7,8 @@
 * the perception pipeline's frames per second (perception.bench), optional.
 
 Targets (from the project's issues): ETG at most ~1.5 gateway calls per step and at least
-5,000 steps/s on one core.
+5,000 steps/s on one core; tg (issue 10) at most 1.5 calls per step and at least 3,000
+steps/s.
 """
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
                            "cpus": os.cpu_count()}
     out["gateway_call_us"] = measure_call_cost(5000) * 1e6
     out["learners"] = {name: bench_engine(name, steps) for name in
-                       ("etg", "contingency", "qlearning")}
+                       ("etg", "contingency", "qlearning", "tg")}
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
     if perception:
         try:
@@ -70,5 +71,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     out["targets"] = {
         "etg_calls_per_step<=1.5": etg["gateway_calls_per_step"] <= 1.5,
         "etg_steps_per_second>=5000": etg["steps_per_second"] >= 5000,
+        "tg_calls_per_step<=1.5": out["learners"]["tg"]["gateway_calls_per_step"] <= 1.5,
+        "tg_steps_per_second>=3000": out["learners"]["tg"]["steps_per_second"] >= 3000,
     }
     return out
