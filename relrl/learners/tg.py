@@ -21,18 +21,19 @@ __all__ = ["TGLearner"]
 class TGLearner(Learner):
     """A first-order Q-tree; choices, updates and splits run in Prolog (one call a step).
 
-    Parameters: alpha (0: a leaf's Q is the mean of its Q-targets; otherwise the step size
-    is max(1/n, alpha)), gamma, epsilon (with temperature 0: epsilon-greedy),
+    Parameters (defaults chosen by the sweep in docs/tg.md): alpha (0: a leaf's Q is the
+    mean of its Q-targets; otherwise the step size is max(1/n, alpha)), gamma,
     temperature (> 0: Boltzmann exploration, P(a) proportional to exp(Q(s, a) / T)),
-    q_init (Q of the first, empty leaf), significance (of the F-test, for the best of a
-    leaf's candidates, Bonferroni-corrected for their number), min_examples (before a leaf
-    may split).
+    epsilon (used only with temperature 0: epsilon-greedy), q_init (Q of the first, empty
+    leaf), significance (of the F-test of the best of a leaf's candidates,
+    Bonferroni-corrected for their number), min_examples (a split must leave at least
+    this many examples on each side).
     """
 
     name = "tg"
     engine_name = "tg"
     defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
-                "q_init": 30.0, "significance": 0.001, "min_examples": 30.0}
+                "q_init": 30.0, "significance": 0.001, "min_examples": 5.0}
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -46,16 +47,18 @@ class TGLearner(Learner):
             raise ConfigError(f"temperature must be >= 0, not {p['temperature']}")
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
-        """Every response's Q with its leaf and the path of first-order tests that led there
-        (with the bindings that made them true); ``path`` and ``leaf`` are the best's."""
+        """``ranked``: every response's Q and leaf, best first; ``paths``: for each, the
+        first-order tests from the root to its leaf, with the bindings that made them
+        true; ``path`` and ``leaf``: the best response's."""
         _, choices = detail
-        ranked = []
+        ranked, paths = [], {}
         for _, action, q, leaf, path in choices:
-            tests = [{"test": str(text), "holds": outcome == "true",
-                      "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
-                     for (_, _, text, outcome, bindings) in path]
-            ranked.append({"response": format_term(action), "q": q, "leaf": leaf,
-                           "path": tests})
-        best = ranked[0] if ranked else {"path": [], "leaf": None}
-        return {"state": [format_term(f) for f in state], "path": best["path"],
-                "leaf": best["leaf"], "ranked": ranked}
+            response = format_term(action)
+            ranked.append({"response": response, "q": q, "leaf": leaf})
+            paths[response] = [{"test": str(text), "holds": outcome == "true",
+                                "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
+                               for (_, _, text, outcome, bindings) in path]
+        best = ranked[0]["response"] if ranked else None
+        return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
+                "path": paths.get(best, []) if best else [],
+                "leaf": ranked[0]["leaf"] if ranked else None}
