@@ -42,9 +42,10 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
             curve.append({"point": p, "learning_steps": mine[0]["curve"][p]["learning_steps"],
                           "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
                           "n_runs": len(runs)})
-        flags = np.array([j["eye_contacts"]["per_opportunity"] for j in mine], dtype=float)
-        n_opp = min(len(f) for f in flags) if len(flags) else 0
-        cumulative = np.cumsum(flags[:, :n_opp], axis=1).mean(axis=0) if n_opp else np.zeros(0)
+        n_opp = min(len(j["eye_contacts"]["per_opportunity"]) for j in mine)
+        flags = np.array([j["eye_contacts"]["per_opportunity"][:n_opp] for j in mine],
+                         dtype=float).reshape(len(mine), n_opp)
+        cumulative = np.cumsum(flags, axis=1).mean(axis=0) if n_opp else np.zeros(0)
         established = [j["eye_contacts"]["established"] for j in mine]
         memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
         first = mine[0]["curve"][1] if points > 1 else None
