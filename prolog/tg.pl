@@ -55,8 +55,9 @@ Prolog over the example's own fact list (never a query of working memory). The n
 live in a global term per knowledge base and are updated in place (nb_setarg/3).
 
 Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise the rate
-is max(1/n, alpha)), gamma, epsilon, q_init (Q of the first, empty leaf), significance,
-min_examples, reward_positive, reward_negative.
+is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
+epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus
+(see tg_choose/6); the engine's reward_positive and reward_negative.
 */
 
 :- dynamic
@@ -71,13 +72,15 @@ min_examples, reward_positive, reward_negative.
 %                  changes, is explained, drawn or saved. Root is a leaf(Id, PathLits,
 %                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
 %                  along the path, as in the tree.
-%   '$tg:KB'       tg(Params, Leaves, Cache, Version), read in place on every step:
-%                  Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples);
-%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C) for leaf i (or
-%                  `free`): the Q estimate and the examples counted in it (its partition's
-%                  and its own), the count, sum and sum of squares of the Q-targets since
-%                  the leaf was made, and C = c(M1, S1, SS1, M2, ...) the same for each
-%                  candidate, in order; the numbers are updated with nb_setarg/3.
+%   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock), read in place on every step:
+%                  Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples, Kappa);
+%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last) for leaf i
+%                  (or `free`): the Q estimate and the examples counted in it (its
+%                  partition's and its own), the count, sum and sum of squares of the
+%                  Q-targets since the leaf was made, C = c(M1, S1, SS1, M2, ...) the same
+%                  for each candidate, in order, and the Clock (examples inserted in the
+%                  tree so far) when the leaf was last updated; the numbers are updated with
+%                  nb_setarg/3.
 %                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
 %                  sorted the next state's allowed actions, reused by the choice that
 %                  follows in the same step while the tree is unchanged (Version).
@@ -101,7 +104,7 @@ set_tree(KB, Tree) :-
     nb_setval(K, Tree).
 
 leaf_stats(KB, Id, L) :-
-    data(KB, tg(_, Leaves, _, _)),
+    data(KB, tg(_, Leaves, _, _, _)),
     arg(Id, Leaves, L).
 
 %!  tg_init(+KB, +Params:list) is det.
@@ -112,19 +115,20 @@ tg_init(KB, Params) :-
     must_be(atom, KB),
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
-                            min_examples],
-            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0]),
+                            min_examples, stale_bonus],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa]),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
-    new_stats(Qinit, 0, K, L),
+    new_stats(Qinit, 0, K, 0, L),
     empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
-    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx), Leaves0, none, 0)),
+    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa), Leaves0, none, 0,
+                     0)),
     set_tree(KB, tree(Root, 2, Bias, Responses)),
     retractall(tg_cands_(KB, _, _, _, _, _)),
     compile_leaf(KB, Root),
@@ -142,7 +146,7 @@ empty_leaves(Cap, Leaves) :-
     maplist(=(free), Free),
     Leaves =.. [leaves|Free].
 
-new_stats(Q, N, K, l(Q, N, 0, 0.0, 0.0, C)) :-
+new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock)) :-
     findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
     C =.. [c|Xs].
 
@@ -223,18 +227,26 @@ tg_q(KB, Facts, Action, N, Q) :-
 %   Action is one of the Allowed responses. With Mode learn or explore: with temperature
 %   T > 0, drawn with probability proportional to exp(Q / T) (Boltzmann exploration);
 %   with T = 0, a random one with probability epsilon and otherwise a greedy one. With
-%   Mode greedy, one with the largest Q. Ties are broken at random.
+%   Mode greedy, one with the largest Q. Ties are broken at random. While learning (Mode
+%   learn), the Q of a leaf that no example has reached for the last K examples inserted
+%   in the tree counts as Q + stale_bonus * sqrt(K): a part of the Q-function that went
+%   stale while the rest moved is tried again (the exploration bonus of Sutton's Dyna-Q+,
+%   here per leaf). Explore and greedy choices, and the Q-targets, never include it.
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     data(KB, D),
-    D = tg(p(_, _, Epsilon, Tau, _, _), Leaves, Cache, Version),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa), Leaves, Cache, Version, Clock),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
     ->  random_member(Action, Allowed)
     ;   (   Cache = last(F1, N1, A1, Ids, Version), F1 == Facts, N1 == N, A1 == Allowed
-        ->  maplist(leaf_q(Leaves), Ids, Qs)
-        ;   maplist(sorted_q(KB, Leaves, Facts, N), Allowed, Qs)
+        ->  true
+        ;   maplist(sorted_leaf(KB, Facts, N), Allowed, Ids)
+        ),
+        (   Mode == learn, Kappa > 0
+        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
+        ;   maplist(leaf_q(Leaves), Ids, Qs)
         ),
         max_list(Qs, Best),
         (   Mode \== greedy, Tau > 0
@@ -248,9 +260,11 @@ leaf_q(Leaves, Id, Q) :-
     arg(Id, Leaves, L),
     arg(1, L, Q).
 
-sorted_q(KB, Leaves, Facts, N, A, Q) :-
-    tg_sort_(KB, Facts, A, N, Leaf),
-    leaf_q(Leaves, Leaf, Q).
+bonus_q(Leaves, Kappa, Clock, Id, Q) :-
+    arg(Id, Leaves, L),
+    arg(1, L, Q0),
+    arg(7, L, Last),
+    Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
 
 ties([], [], _, []).
 ties([Q|Qs], [A|As], Best, Ties) :-
@@ -286,7 +300,7 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _), Leaves, _, Version),
+    D = tg(p(_, Gamma, _, _, _, _, _), Leaves, _, Version, _),
     (   Allowed1 == []
     ->  tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
@@ -312,17 +326,19 @@ tg_insert(KB, Facts, A, N, Target) :-
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx), Leaves, _, _),
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _), Leaves, _, _, Clock0),
+    Clock is Clock0 + 1,
+    nb_setarg(5, D, Clock),
     tg_sort_(KB, Facts, A, N, Leaf),
     arg(Leaf, Leaves, L),
-    L = l(Q0, N0, M0, S0, SS0, C),
+    L = l(Q0, N0, M0, S0, SS0, C, _),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
     M is M0 + 1,
     S is S0 + Target,
     SS is SS0 + Target * Target,
     nb_setarg(1, L, Q), nb_setarg(2, L, N1),
-    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
+    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS), nb_setarg(7, L, Clock),
     tg_cands_(KB, Leaf, Facts, A, N, Hits),
     count_hits(Hits, C, Target),
     (   M >= 2 * MinEx,
@@ -392,8 +408,9 @@ split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
     M2 is M - M1, S2 is S - S1,
     QYes is S1 / M1, QNo is S2 / M2,
     length(YesCands, KY), length(NoCands, KN),
-    new_stats(QYes, M1, KY, LYes),
-    new_stats(QNo, M2, KN, LNo),
+    arg(5, D, Clock),
+    new_stats(QYes, M1, KY, Clock, LYes),
+    new_stats(QNo, M2, KN, Clock, LNo),
     put_leaf(D, LeafId, free),
     put_leaf(D, YesId, LYes),
     put_leaf(D, NoId, LNo),
@@ -541,7 +558,7 @@ tg_text(KB, Text) :-
     with_output_to(string(Text), text_node(KB, Root, [], "", "")).
 
 text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _)),
+    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)),
     format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
 text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
     append(Vars, New, Vars1),
@@ -562,7 +579,7 @@ tg_graph(KB, graph(Nodes, Edges)) :-
     graph_node(KB, Root, [], Nodes, [], Edges, []).
 
 graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _)),
+    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)),
     format(string(Label), "Q=~2f (n=~d)", [Q, N]).
 graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
            [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
@@ -594,7 +611,7 @@ leaf_rules(KB, Rules) :-
     findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
 
 leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
-    leaf_stats(KB, Id, l(Q0, _, _, _, _, _)),
+    leaf_stats(KB, Id, l(Q0, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000,
     Head = q(Action, Necessity, Q),
     foldl(positive(Action, Necessity), Pos, Goals0, []),
@@ -658,7 +675,7 @@ tg_save(KB, S) :-
     forall(member(C, Clauses), portray_clause(S, C)).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _)).
+    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)).
 saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
     append(Vars, New, Vars1),
     saved_tree(KB, Y, Vars1, SY, AY),
@@ -707,6 +724,7 @@ tg_restore(KB, Terms) :-
     nb_setarg(2, D, Leaves),
     nb_setarg(3, D, none),
     arg(4, D, Version0), Version is Version0 + 1, nb_setarg(4, D, Version),
+    nb_setarg(5, D, 0),
     Next is MaxId + 1,
     set_tree(KB, tree(Root, Next, Bias, Responses)),
     retractall(tg_cands_(KB, _, _, _, _, _)),
@@ -722,7 +740,7 @@ restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) 
     ),
     refinements(Bias, Path, Vars, Cands),
     length(Cands, K),
-    new_stats(Q, N, K, L).
+    new_stats(Q, N, K, 0, L).
 restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
     !,
     (   integer(Id), Id > 0, is_list(Lits), Lits \== [], maplist(callable, Lits),

@@ -27,13 +27,16 @@ class TGLearner(Learner):
     epsilon (used only with temperature 0: epsilon-greedy), q_init (Q of the first, empty
     leaf), significance (of the F-test of the best of a leaf's candidates,
     Bonferroni-corrected for their number), min_examples (a split must leave at least
-    this many examples on each side).
+    this many examples on each side), stale_bonus (while learning, a leaf no example has
+    reached for the last k examples counts Q + stale_bonus * sqrt(k): Dyna-Q+'s
+    exploration bonus, per leaf; 0 turns it off).
     """
 
     name = "tg"
     engine_name = "tg"
     defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
-                "q_init": 30.0, "significance": 0.001, "min_examples": 5.0}
+                "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
+                "stale_bonus": 1.0}
 
     def _check_params(self) -> None:
         super()._check_params()

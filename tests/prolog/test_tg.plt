@@ -23,7 +23,7 @@ gaze_kb(KB) :-
 
 params(Level, MinEx,
        [alpha=0, gamma=0.9, epsilon=0, temperature=0, q_init=0, significance=Level,
-        min_examples=MinEx]).
+        min_examples=MinEx, stale_bonus=0]).
 
 fresh_learner(KB, Level, MinEx) :-
     gaze_kb(KB),
@@ -183,7 +183,7 @@ test(children_start_from_partitions, [Q-N == 10.0-M]) :-
            ( ( G == P -> T = 10 ; T = 0 ),
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
-    relrl_tg:leaf_stats(KB, Yes, l(Q, N, _, _, _, _)),
+    relrl_tg:leaf_stats(KB, Yes, l(Q, N, _, _, _, _, _)),
     M = 12.                              % 36 examples, one in three followed the gaze
 
 test(generalises_to_places_never_seen, [Q1-Q2 == 10.0-0.0]) :-
@@ -199,6 +199,32 @@ test(greedy_choice_follows_gaze, [A == look(p4)]) :-
     feed(KB, [p1, p2, p3], 6),
     tg_choose(KB, [gaze(face, p4)], curiosity,
               [look(p1), look(p2), look(p3), look(p4)], greedy, A).
+
+test(stale_leaf_tried_again_while_learning, [Learn-Greedy == look(p2)-look(p1)]) :-
+    % after the split, 200 examples reach only the gaze-following leaf (Q 10, no variance:
+    % no further split); the other leaf (Q 0) is 200 examples stale: 0 + 1 * sqrt(200) > 10
+    gaze_kb(KB),
+    params(0.001, 10, Params0),
+    selectchk(stale_bonus=_, Params0, stale_bonus=1, Params),
+    tg_init(KB, Params),
+    forall(( between(1, 4, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
+           ( ( G == P -> T = 10 ; T = 0 ),
+             tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
+    forall(between(1, 200, _), tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 10)),
+    tg_choose(KB, [gaze(face, p1)], curiosity, [look(p1), look(p2)], learn, Learn),
+    tg_choose(KB, [gaze(face, p1)], curiosity, [look(p1), look(p2)], greedy, Greedy).
+
+test(no_stale_bonus_at_first, [A == look(p1)]) :-
+    % the leaf just updated and a leaf 5 examples stale: sqrt(5) < 10
+    gaze_kb(KB),
+    params(0.001, 10, Params0),
+    selectchk(stale_bonus=_, Params0, stale_bonus=1, Params),
+    tg_init(KB, Params),
+    forall(( between(1, 4, _), member(G, [p1, p2, p3]), member(P, [p1, p2, p3]) ),
+           ( ( G == P -> T = 10 ; T = 0 ),
+             tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
+    forall(between(1, 5, _), tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 10)),
+    tg_choose(KB, [gaze(face, p1)], curiosity, [look(p1), look(p2)], learn, A).
 
 test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-
     % one leaf; Q(s', .) = 10 after the first example; target = 10 + 0.9 * 10

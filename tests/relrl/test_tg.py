@@ -84,10 +84,10 @@ def test_explanation_shows_the_tests_and_bindings() -> None:
     exp = out.explanation
     assert exp["learner"] == "tg"
     assert "gaze(face,p4)" in exp["state"]
-    best = exp["ranked"][0]
-    assert best["response"] == "look(p4)"
+    assert exp["ranked"][0]["response"] == "look(p4)"
     assert {"test": "gaze(face, P), action(look(P))", "holds": True,
-            "bindings": {"P": "p4"}} in best["path"]
+            "bindings": {"P": "p4"}} in exp["path"]
+    assert exp["paths"]["look(p1)"][0]["holds"] is False
     agent.kb.close()
 
 
