@@ -132,14 +132,19 @@ engine_learner(KB, Learner) :-
     run(KB, run(Learner, _, _, _, _, _, _, _)).
 
 %!  engine_param(+KB, ?Name, ?Value) is nondet.
+%!  engine_param(+KB, +Name, -Value) is semidet.
 %
 %   A parameter of KB's learner (alpha, gamma, epsilon, ...).
 
 engine_param(KB, Name, Value) :-
     run(KB, run(_, Params, _, _, _, _, _, _)),
-    member(Name=Value, Params).
+    (   atom(Name)
+    ->  memberchk(Name=Value, Params)
+    ;   member(Name=Value, Params)
+    ).
 
 %!  engine_config(+KB, ?Key, ?Value) is nondet.
+%!  engine_config(+KB, +Key, -Value) is semidet.
 %
 %   What the engine was configured with: learner, params, features (stimulus(S) and fact(F)
 %   in code order), responses (in declaration order), units, reinforcers, constraints
@@ -148,9 +153,13 @@ engine_param(KB, Name, Value) :-
 engine_config(KB, Key, Value) :-
     run(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
                 Necessities)),
-    member(Key-Value, [learner-Learner, params-Params, features-Features,
-                       responses-Responses, units-Units, reinforcers-Reinforcers,
-                       constraints-Constraints, necessities-Necessities]).
+    Config = [learner-Learner, params-Params, features-Features, responses-Responses,
+              units-Units, reinforcers-Reinforcers, constraints-Constraints,
+              necessities-Necessities],
+    (   atom(Key)
+    ->  memberchk(Key-Value, Config)
+    ;   member(Key-Value, Config)
+    ).
 
 %!  engine_responses(+KB, -Responses:list) is det.
 %

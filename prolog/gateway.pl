@@ -335,8 +335,9 @@ gw_load(File, Module, Limit, Problems) :-
                          note_exception(Key, Abs, Limit, E)),
                    retract(collecting(Key))),
                true, Result),
-        (   Result = error(halt_called(F:L), Msg)
-        ->  assertz(collected(Key, problem(error, F, L, Msg)))
+        (   Result = error(halt_called(F:L), _)
+        ->  assertz(collected(Key, problem(error, F, L, "halt/0,1 called while loading \c
+                                       (a loaded file cannot end relrl)")))
         ;   true
         ),
         findall(P, retract(collected(Key, P)), Problems0),

@@ -160,8 +160,16 @@ check_term(File, Learner, Line-T) :-
                      data and never runs anything)", [])
     ;   relrl_engine:learner_policy_term(Learner, T)
     ->  true
-    ;   functor(T, Name, Arity),
-        policy_error(File, Line, "~q is not part of a ~q policy (refused)", [Name/Arity, Learner])
+    ;   (   T = (Head :- _)
+        ->  true
+        ;   Head = T
+        ),
+        (   callable(Head)
+        ->  functor(Head, Name, Arity),
+            policy_error(File, Line, "~q is not part of a ~q policy (refused)",
+                         [Name/Arity, Learner])
+        ;   policy_error(File, Line, "~q is not part of a ~q policy (refused)", [Head, Learner])
+        )
     ).
 
 restore_error(File, Formal) :-

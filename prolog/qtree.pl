@@ -94,7 +94,10 @@ qtree_tests(Tree, Tests) :-
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
-    node_(Tree, Id, Node).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, Node))
+    ;   node_(Tree, Id, Node)
+    ).
 
 %!  test_holds(+Description, +Index) is semidet.
 
@@ -129,7 +132,7 @@ sort_from(Tree, Id, D, Where) :-
 
 %   Id is a test node; the state described by D takes its Branch (yes or no) to Next.
 step_down(Tree, Id, D, Goal, Branch, Next) :-
-    node_(Tree, Id, test(I, Goal, Yes, No)),
+    once(node_(Tree, Id, test(I, Goal, Yes, No))),
     (   test_holds(D, I)
     ->  Branch = yes, Next = Yes
     ;   Branch = no, Next = No
@@ -157,7 +160,10 @@ path_from(Tree, Id, D, Path) :-
 %!  qtree_leaf(+Tree, ?Id, -Rep, -Entries) is nondet.
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
-    node_(Tree, Id, leaf(Rep, Entries)).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, leaf(Rep, Entries)))
+    ;   node_(Tree, Id, leaf(Rep, Entries))
+    ).
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.
 
@@ -169,7 +175,7 @@ qtree_set_leaf(Tree, Id, _, _) :-
     existence_error(qtree_leaf, Tree-Id).
 
 new_id(Tree, Id) :-
-    retract(next_id_(Tree, Id)),
+    once(retract(next_id_(Tree, Id))),
     Id1 is Id + 1,
     assertz(next_id_(Tree, Id1)).
 
@@ -179,7 +185,7 @@ new_id(Tree, Id) :-
 
 qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
     must_be(oneof([yes, no]), Branch),
-    retract(node_(Tree, Parent, test(I, Goal, Yes, No))),
+    once(retract(node_(Tree, Parent, test(I, Goal, Yes, No)))),
     new_id(Tree, Id),
     (   Branch == yes
     ->  must_be(oneof([nil]), Yes), Node = test(I, Goal, Id, No)
@@ -194,7 +200,7 @@ qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
 %   representative takes; the other branch is empty (nil).
 
 qtree_split(Tree, LeafId, I) :-
-    retract(node_(Tree, LeafId, leaf(Rep, Entries))),
+    once(retract(node_(Tree, LeafId, leaf(Rep, Entries)))),
     tests_(Tree, Tests),
     nth0(I, Tests, Goal),
     new_id(Tree, Id),

@@ -178,10 +178,12 @@ class Interaction:
         return self.info
 
     def run(self, steps: int, *, learning: bool = True, explore: bool | None = None,
-            keep: bool = True) -> list[StepRecord]:
+            keep: bool = True, want: Iterable[str] = ()) -> list[StepRecord]:
         """Run ``steps`` time units; returns their records (none when ``keep`` is False).
 
-        ``learning`` and ``explore`` are as in :meth:`Agent.step`."""
+        ``learning``, ``explore`` and ``want`` are as in :meth:`Agent.step` (what ``want``
+        asks for arrives in each record's ``out`` from the step's one gateway call)."""
+        want = tuple(want)
         if self.info is None:
             self.reset()
         assert self.info is not None
@@ -190,7 +192,7 @@ class Interaction:
         info = self.info
         for _ in range(steps):
             percepts = info["percepts"]
-            out = agent.step(percepts, learning=learning, explore=explore)
+            out = agent.step(percepts, learning=learning, explore=explore, want=want)
             if actuator is not None and out.action is not None:
                 actuator.emit(out.action)
             _, env_reward, terminated, truncated, info = env.step(out.action)
