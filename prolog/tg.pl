@@ -20,6 +20,8 @@
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
 :- use_module(library(random)).
+:- use_module(library(aggregate)).
+:- use_module(library(occurs)).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(tg_bias).
@@ -596,14 +598,32 @@ graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], N
 %   swipl can run in the domain's knowledge base: Body holds the leaf's path query and, for
 %   each no-branch on the path, the negation of that test's query (a renamed copy: TILDE's
 %   semantics). action(T) becomes the head's action, necessity(T) its necessity; Q is
-%   rounded to three decimals. Variables are named by type (P for a place, T for a toy).
+%   rounded to three decimals. Inside a negation, what the clause already makes true is
+%   left out (an action the head fixes, a ground literal of the body), and a negated
+%   equality is written as X \= Y on the arguments that differ. Variables are named by
+%   type (P for a place, T for a toy), Action and Necessity in the head; a variable used
+%   once is written _.
 
 tg_leaf_clauses(KB, Clauses) :-
     leaf_rules(KB, Rules),
     maplist(named_rule, Rules, Clauses).
 
 named_rule(Rule-Names, Rule) :-
-    maplist([Name=V]>>(V = '$VAR'(Name)), Names).
+    term_variables(Rule, Vs),
+    foldl(occurrences(Rule), Vs, Counts, []),
+    maplist(name_var(Counts), Names).
+
+occurrences(Term, V, [V-N|Cs], Cs) :-
+    aggregate_all(count, ( sub_term(X, Term), X == V ), N).
+
+name_var(Counts, Name=V) :-
+    (   var(V)
+    ->  (   member(W-1, Counts), W == V
+        ->  V = '$VAR'('_')
+        ;   V = '$VAR'(Name)
+        )
+    ;   true
+    ).
 
 %   Rule-Names for every leaf: the rule with its variables, and Name=Var for each.
 leaf_rules(KB, Rules) :-
@@ -612,18 +632,15 @@ leaf_rules(KB, Rules) :-
 
 leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
     leaf_stats(KB, Id, l(Q0, _, _, _, _, _, _)),
-    Q is round(Q0 * 1000) / 1000,
+    Q is round(Q0 * 1000) / 1000.0,
     Head = q(Action, Necessity, Q),
     foldl(positive(Action, Necessity), Pos, Goals0, []),
     pairs_keys_values(Neg, NegTests, NegVars),
-    maplist(negative(Action, Necessity), NegTests, NegGoals),
+    maplist(negative(Action, Necessity, Goals0), NegTests, NegGoals),
     append(Goals0, NegGoals, Goals),
     append([Vars|NegVars], AllVars),
     name_variables(AllVars, Names0),
-    (   var(Action)
-    ->  Names = ['Action'=Action|Names0]
-    ;   Names = Names0
-    ),
+    Names = ['Action'=Action, 'Necessity'=Necessity|Names0],
     (   Goals == []
     ->  Clause = Head
     ;   list_conj_(Goals, Body),
@@ -642,13 +659,48 @@ positive(A, _, action(T), Gs, Gs) :- !, A = T.
 positive(_, N, necessity(T), Gs, Gs) :- !, N = T.
 positive(_, _, L, [L|Gs], Gs).
 
-negative(A, N, Lits, \+ Conj) :-
-    maplist(body_literal(A, N), Lits, Goals),
-    list_conj_(Goals, Conj).
+%   The negation of a test's query (run after the positive goals Known).
+negative(A, N, Known, Lits, Goal) :-
+    maplist(body_literal(A, N), Lits, Goals0),
+    exclude(known_true(Known), Goals0, Goals),
+    (   Goals == []
+    ->  Goal = fail                        % the query holds whenever Known does
+    ;   Goals = [X = Y]
+    ->  differing(X, Y, X1, Y1),
+        Goal = (X1 \= Y1)
+    ;   list_conj_(Goals, Conj),
+        Goal = (\+ Conj)
+    ).
 
 body_literal(A, _, action(T), A = T) :- !.
 body_literal(_, N, necessity(T), N = T) :- !.
 body_literal(_, _, L, L).
+
+known_true(_, X = Y) :-
+    X == Y,
+    !.
+known_true(Known, G) :-
+    ground(G),
+    member(K, Known),
+    K == G,
+    !.
+
+%   f(..., X, ...) \= f(..., Y, ...) is X \= Y when every other argument is the same.
+differing(X, Y, X1, Y1) :-
+    (   compound(X), compound(Y),
+        X =.. [F|As], Y =.. [F|Bs],
+        same_length(As, Bs),
+        one_differs(As, Bs, A, B)
+    ->  differing(A, B, X1, Y1)
+    ;   X1 = X, Y1 = Y
+    ).
+
+one_differs([A|As], [B|Bs], X, Y) :-
+    (   A == B
+    ->  one_differs(As, Bs, X, Y)
+    ;   As == Bs,
+        X = A, Y = B
+    ).
 
 list_conj_([G], G) :- !.
 list_conj_([G|Gs], (G, C)) :- list_conj_(Gs, C).

@@ -283,6 +283,21 @@ test(rules_are_readable, [Text == "q(look(P), _, 10.206) :-\n    gaze(face, P).\
     tg_leaf_clauses(KB, [Rule|_]),
     with_output_to(string(Text), portray_clause(Rule)).
 
+test(negations_read_simply,
+     [Texts == ["q(look(p1), _, 1.0).\n",
+                "q(look(P), _, 2.0) :-\n    gaze(face, P),\n    P\\=p1.\n",
+                "q(Action, _, 3.0) :-\n    Action\\=look(p1),\n    \\+ ( gaze(face, P),\n         Action=look(P)\n       ).\n"]]) :-
+    % the no-branch of action(look(p1)) under the gaze test is P \= p1, not
+    % \+ look(P) = look(p1); the last leaf negates both tests
+    fresh_learner(KB, 0.001, 10),
+    tg_restore(KB, [tg_tree(node(1, [action(look(p1))], [],
+                                 leaf(2, 1.0, 1),
+                                 node(3, [gaze(face, P), action(look(P))], [P-place],
+                                      leaf(4, 2.0, 1), leaf(5, 3.0, 1))))]),
+    tg_leaf_clauses(KB, Rules),
+    findall(T, ( member(R, Rules),
+                 with_output_to(string(T), portray_clause(R)) ), Texts).
+
 test(edited_rule_refused, [error(domain_error(tg_rules_match_tree, _))]) :-
     fresh_learner(KB, 0.001, 10),
     feed(KB, [p1, p2, p3], 6),
