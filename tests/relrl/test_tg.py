@@ -146,3 +146,43 @@ def test_check_lists_the_refinements(capsys) -> None:
     out = capsys.readouterr().out
     assert "relations (the relational view, learner tg):\n  gaze(_, _)\n  fed(_)" in out
     assert "  gaze(face, P), action(look(P))\n" in out
+
+
+def test_shell_loads_the_policy_acts_the_same_and_explains_with_bindings(tmp_path: Path) -> None:
+    import io
+
+    from relrl.policy import load_policy
+    from relrl.shell import Shell
+
+    agent = trained()
+    path = agent.learner.save(tmp_path / "tg.pl")
+    places = ("p1", "p2", "p3", "p4")
+    expected = [agent.step([("see", "face"), ("pose", "face", p)], learning=False).action
+                for p in places]
+    assert expected == [("look", p) for p in places]
+    with KnowledgeBase(GAZE) as kb2:
+        out = io.StringIO()
+        shell = Shell(kb2, out, timeout=5.0)
+        load_policy(shell, path)
+        shell.run_lines([f":step see(face), pose(face, {p})\n" for p in places])
+        assert [line for line in out.getvalue().splitlines() if line.startswith("response")] \
+            == [f"response: look({p})" for p in places]
+        shell.run_lines([":explain\n"])
+        assert "gaze(face, P), action(look(P)) -> yes  (P = p4)" in out.getvalue()
+    agent.kb.close()
+
+
+def test_graph_draws_the_tree() -> None:
+    agent = trained()
+    graph = agent.learner.graph()
+    size = agent.learner.size()
+    kinds = [n["kind"] for n in graph["nodes"]]
+    assert kinds.count("test") == size["tests"] and kinds.count("leaf") == size["leaves"]
+    assert len(graph["edges"]) == 2 * size["tests"]
+    ids = {n["id"] for n in graph["nodes"]}
+    assert all(e["from"] in ids and e["to"] in ids for e in graph["edges"])
+    root = graph["nodes"][0]
+    assert root == {"id": root["id"], "kind": "test", "label": "gaze(face, P), action(look(P))"}
+    assert sorted(e["branch"] for e in graph["edges"] if e["from"] == root["id"]) == ["no", "yes"]
+    assert all(n["label"].startswith("Q=") for n in graph["nodes"] if n["kind"] == "leaf")
+    agent.kb.close()
