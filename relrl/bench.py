@@ -20,9 +20,12 @@ __all__ = ["bench_engine", "bench_all"]
 
 
 def bench_engine(learner: str, steps: int = 5000, seed: int = 0) -> dict[str, float]:
-    """Steps/s and gateway calls per step of ``learner`` on the SIS, learning on."""
+    """Steps/s and gateway calls per step of ``learner`` on the SIS, learning on; also the
+    process's CPU time per step and the step's cost in gateway calls (µs per step over the
+    µs of one gateway call measured right after it): on a loaded machine wall-clock rates
+    fall, the ratio much less."""
     from relrl.experiments.sis import DEFAULT_DOMAIN
-    from relrl.kb import KnowledgeBase, gateway_calls
+    from relrl.kb import KnowledgeBase, gateway_calls, measure_call_cost
     from relrl.learners import make_learner
     from relrl.loop import Agent, Interaction
     from relrl.sim.caregiver import make_caregiver
@@ -36,12 +39,18 @@ def bench_engine(learner: str, steps: int = 5000, seed: int = 0) -> dict[str, fl
         interaction.reset(seed=seed)
         interaction.run(500, keep=False)            # warm up: the tree and tables exist
         calls0 = gateway_calls()
+        c0 = time.process_time()
         t0 = time.perf_counter()
         interaction.run(steps, keep=False)
         elapsed = time.perf_counter() - t0
+        cpu = time.process_time() - c0
         calls = gateway_calls() - calls0
-        return {"steps_per_second": steps / elapsed, "us_per_step": 1e6 * elapsed / steps,
-                "gateway_calls_per_step": calls / steps, "steps": steps}
+    call_us = measure_call_cost(2000) * 1e6
+    return {"steps_per_second": steps / elapsed, "us_per_step": 1e6 * elapsed / steps,
+            "cpu_us_per_step": 1e6 * cpu / steps,
+            "gateway_calls_per_step": calls / steps, "steps": steps,
+            "gateway_call_us": call_us,
+            "step_in_gateway_calls": 1e6 * elapsed / steps / call_us}
 
 
 def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True

@@ -17,6 +17,9 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
         learner = figures["learners"][name]
         assert learner["steps_per_second"] > 0
         assert 0.99 <= learner["gateway_calls_per_step"] <= 1.01
+        assert learner["cpu_us_per_step"] > 0 and learner["gateway_call_us"] > 0
+        assert learner["step_in_gateway_calls"] == \
+            learner["us_per_step"] / learner["gateway_call_us"]
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "tg_steps_per_second>=3000" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
