@@ -5,6 +5,7 @@ with no further learning, on places it never saw; save -> load -> same choices; 
 from __future__ import annotations
 
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -186,3 +187,14 @@ def test_graph_draws_the_tree() -> None:
     assert sorted(e["branch"] for e in graph["edges"] if e["from"] == root["id"]) == ["no", "yes"]
     assert all(n["label"].startswith("Q=") for n in graph["nodes"] if n["kind"] == "leaf")
     agent.kb.close()
+
+
+def test_example_learns_gaze_following_on_the_sis(tmp_path: Path) -> None:
+    proc = subprocess.run([sys.executable, str(ROOT / "examples" / "tg_gaze_following.py"),
+                           "--steps", "2000", "--policy", str(tmp_path / "tg.pl")],
+                          capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert proc.returncode == 0, proc.stderr
+    assert "gaze(face, P), action(look(P)) ?" in proc.stdout
+    for place in ("left", "left_down", "down", "right_down", "right"):
+        assert f"gaze {place:<10} -> look({place})" in proc.stdout
+    assert "q(look(P), _, " in (tmp_path / "tg.pl").read_text()
