@@ -5,27 +5,19 @@
             tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
-            tg_explain/4,         % +KB, +Facts, +Necessity, -Explanation
             tg_size/2,            % +KB, -Size
-            tg_save/2,            % +KB, +Stream
-            tg_policy_term/1,     % ?Term
-            tg_restore/2,         % +KB, +Terms
-            tg_graph/2,           % +KB, -Graph
-            tg_text/2,            % +KB, -Text
-            tg_leaf_clauses/2,    % +KB, -Clauses
             tg_candidates/3       % +KB, ?LeafId, -Texts
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
-:- use_module(library(pairs)).
 :- use_module(library(random)).
-:- use_module(library(aggregate)).
-:- use_module(library(occurs)).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(tg_bias).
 :- use_module(tg_stats).
+:- use_module(tg_tree).
+:- reexport(tg_knowledge).
 
 /** <module> TG: a first-order incremental regression-tree Q-learner
 
@@ -50,6 +42,9 @@ first-order regression tree over examples (State, Action, Necessity, Q-target):
 Q(s, a) for each allowed response comes from sorting (s, a) down the tree; each step one
 example with Q-target r + gamma * max_a' Q(s', a') is inserted (no table of examples).
 
+The learner's state and the compiled tree are kept by tg_tree.pl; explanations, drawings,
+rules and policy files are tg_knowledge.pl's (re-exported here).
+
 **Speed.** The hot path asserts nothing. The tree is compiled into one clause,
 tg_sort_/5, and each leaf's candidate tests into one clause, tg_cands_/6, whenever the tree
 changes (a split): sorting an example and testing every candidate are then compiled
@@ -62,52 +57,7 @@ epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_
 (see tg_choose/6); the engine's reward_positive and reward_negative.
 */
 
-:- dynamic
-    tg_sort_/5,      % KB, Facts, Action, Necessity, LeafId   (the compiled tree)
-    tg_cands_/6.     % KB, LeafId, Facts, Action, Necessity, Hits (a leaf's candidates)
-
-% ---- the learner's state -------------------------------------------------------------------
-
-%   Two global variables per knowledge base:
-%
-%   '$tg_tree:KB'  tree(Root, NextId, Bias, Responses), read (copied) only when the tree
-%                  changes, is explained, drawn or saved. Root is a leaf(Id, PathLits,
-%                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
-%                  along the path, as in the tree.
-%   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock), read in place on every step:
-%                  Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples, Kappa);
-%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last) for leaf i
-%                  (or `free`): the Q estimate and the examples counted in it (its
-%                  partition's and its own), the count, sum and sum of squares of the
-%                  Q-targets since the leaf was made, C = c(M1, S1, SS1, M2, ...) the same
-%                  for each candidate, in order, and the Clock (examples inserted in the
-%                  tree so far) when the leaf was last updated; the numbers are updated with
-%                  nb_setarg/3.
-%                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
-%                  sorted the next state's allowed actions, reused by the choice that
-%                  follows in the same step while the tree is unchanged (Version).
-
-data(KB, D) :-
-    atom_concat('$tg:', KB, K),
-    (   nb_current(K, D0)
-    ->  D = D0
-    ;   existence_error(tg_learner, KB)
-    ).
-
-tree(KB, Tree) :-
-    atom_concat('$tg_tree:', KB, K),
-    (   nb_current(K, Tree0)
-    ->  copy_term(Tree0, Tree)
-    ;   existence_error(tg_learner, KB)
-    ).
-
-set_tree(KB, Tree) :-
-    atom_concat('$tg_tree:', KB, K),
-    nb_setval(K, Tree).
-
-leaf_stats(KB, Id, L) :-
-    data(KB, tg(_, Leaves, _, _, _)),
-    arg(Id, Leaves, L).
+% ---- starting ------------------------------------------------------------------------------
 
 %!  tg_init(+KB, +Params:list) is det.
 %
@@ -125,16 +75,16 @@ tg_init(KB, Params) :-
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
-    new_stats(Qinit, 0, K, 0, L),
-    empty_leaves(16, Leaves0),
+    tg_new_stats(Qinit, 0, K, 0, L),
+    tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
     nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa), Leaves0, none, 0,
                      0)),
-    set_tree(KB, tree(Root, 2, Bias, Responses)),
-    retractall(tg_cands_(KB, _, _, _, _, _)),
-    compile_leaf(KB, Root),
-    compile_tree(KB, Root).
+    tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
+    tg_forget_leaves(KB),
+    tg_compile_leaf(KB, Root),
+    tg_compile_tree(KB, Root).
 
 param(Params, Name, Value) :-
     (   memberchk(Name=V, Params)
@@ -143,15 +93,6 @@ param(Params, Name, Value) :-
     ;   existence_error(tg_parameter, Name)
     ).
 
-empty_leaves(Cap, Leaves) :-
-    length(Free, Cap),
-    maplist(=(free), Free),
-    Leaves =.. [leaves|Free].
-
-new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock)) :-
-    findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
-    C =.. [c|Xs].
-
 %!  tg_state(+KB, -Facts:list) is det.
 %
 %   The relational view of KB now (sorted ground facts; engine_relational_state/2).
@@ -159,59 +100,6 @@ new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock)) :-
 tg_state(KB, Facts) :-
     engine_relational_state(KB, Facts).
 
-% ---- compiling the tree --------------------------------------------------------------------
-
-compile_tree(KB, Root) :-
-    copy_term(Root, Tree),
-    tree_goal(Tree, [], Facts, Action, N, Leaf, Body),
-    retractall(tg_sort_(KB, _, _, _, _)),
-    assertz((tg_sort_(KB, Facts, Action, N, Leaf) :- Body)).
-
-tree_goal(leaf(Id, _, _, _), _, _, _, _, Leaf, Leaf = Id).
-tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )) :-
-    append(Path, Lits, Path1),
-    copy_term(Path1, Test),
-    conj_goal(Test, F, A, N, last, Cond),
-    tree_goal(Yes, Path1, F, A, N, Leaf, GYes),
-    tree_goal(No, Path, F, A, N, Leaf, GNo).
-
-%   The clause testing every candidate of a leaf on an example: Hits lists the positions
-%   (from 1) of the candidates that succeed, in order.
-compile_leaf(KB, leaf(Id, PathLits0, _, Cands0)) :-
-    copy_term(PathLits0-Cands0, PathLits-Cands),
-    term_variables(PathLits, PV),
-    (   PV == []
-    ->  foldl(cand_goal(no_path, F, A, N), Cands, Goals, 1, _)
-    ;   conj_goal(PathLits, F, A, N, all, PathGoal),
-        V =.. [v|PV],
-        foldl(cand_goal(path(V, Sols), F, A, N), Cands, Goals0, 1, _),
-        Goals = [findall(V, PathGoal, Sols)|Goals0]
-    ),
-    hits_body(Goals, Hits, Body),
-    assertz((tg_cands_(KB, Id, F, A, N, Hits) :- Body)).
-
-%   A candidate that shares variables with the leaf's path query is tried with each
-%   solution of the path query (found once per example); one that does not, on its own.
-cand_goal(no_path, F, A, N, cand(Lits, _), hit(I, Goal), I, I1) :-
-    I1 is I + 1,
-    conj_goal(Lits, F, A, N, last, Goal).
-cand_goal(path(V, Sols), F, A, N, cand(Lits, _), hit(I, Goal), I, I1) :-
-    I1 is I + 1,
-    (   term_variables(Lits, LV),
-        term_variables(V, PV),
-        member(X, LV), member(Y, PV), X == Y
-    ->  copy_term(V-Lits, V1-Lits1),
-        conj_goal(Lits1, F, A, N, last, G),
-        Goal = ( member(V1, Sols), G )
-    ;   conj_goal(Lits, F, A, N, last, Goal)
-    ).
-
-hits_body([], [], true).
-hits_body([hit(I, G)|Gs], Hits, (( G -> Hits = [I|Hits1] ; Hits = Hits1 ), Body)) :-
-    !,
-    hits_body(Gs, Hits1, Body).
-hits_body([G|Gs], Hits, (G, Body)) :-
-    hits_body(Gs, Hits, Body).
 
 % ---- values and choices --------------------------------------------------------------------
 
@@ -221,7 +109,7 @@ hits_body([G|Gs], Hits, (G, Body)) :-
 
 tg_q(KB, Facts, Action, N, Q) :-
     tg_sort_(KB, Facts, Action, N, Leaf),
-    leaf_stats(KB, Leaf, L),
+    tg_leaf(KB, Leaf, L),
     arg(1, L, Q).
 
 %!  tg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
@@ -237,7 +125,7 @@ tg_q(KB, Facts, Action, N, Q) :-
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
-    data(KB, D),
+    tg_data(KB, D),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa), Leaves, Cache, Version, Clock),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
@@ -301,10 +189,10 @@ pick([W|Ws], [A|As], X, Action) :-
 %   Allowed1 (over every response when none is allowed).
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
-    data(KB, D),
+    tg_data(KB, D),
     D = tg(p(_, Gamma, _, _, _, _, _), Leaves, _, Version, _),
     (   Allowed1 == []
-    ->  tree(KB, tree(_, _, _, Next))
+    ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
     maplist(sorted_leaf(KB, S1, N1), Next, Ids),
@@ -324,7 +212,7 @@ sorted_leaf(KB, Facts, N, A, Leaf) :-
 %   and split the leaf when its best candidate is significant.
 
 tg_insert(KB, Facts, A, N, Target) :-
-    data(KB, D),
+    tg_data(KB, D),
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
@@ -394,7 +282,7 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
 % ---- splitting -----------------------------------------------------------------------------
 
 split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
-    tree(KB, tree(Root0, Next0, Bias, Responses)),
+    tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
     replace_leaf(Root0, LeafId, Leaf, Node, Root),
     Leaf = leaf(LeafId, Path, Vars, Cands),
@@ -411,19 +299,19 @@ split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
     QYes is S1 / M1, QNo is S2 / M2,
     length(YesCands, KY), length(NoCands, KN),
     arg(5, D, Clock),
-    new_stats(QYes, M1, KY, Clock, LYes),
-    new_stats(QNo, M2, KN, Clock, LNo),
+    tg_new_stats(QYes, M1, KY, Clock, LYes),
+    tg_new_stats(QNo, M2, KN, Clock, LNo),
     put_leaf(D, LeafId, free),
     put_leaf(D, YesId, LYes),
     put_leaf(D, NoId, LNo),
     arg(4, D, Version0),
     Version is Version0 + 1,
     nb_setarg(4, D, Version),
-    set_tree(KB, tree(Root, Next, Bias, Responses)),
-    retractall(tg_cands_(KB, LeafId, _, _, _, _)),
-    compile_leaf(KB, Yes),
-    compile_leaf(KB, No),
-    compile_tree(KB, Root).
+    tg_put_tree(KB, tree(Root, Next, Bias, Responses)),
+    tg_forget_leaf(KB, LeafId),
+    tg_compile_leaf(KB, Yes),
+    tg_compile_leaf(KB, No),
+    tg_compile_tree(KB, Root).
 
 %   The no-branch of a test never needs the test again.
 same_cand(Lits, cand(Lits1, _)) :-
@@ -454,55 +342,6 @@ put_leaf(D, Id, L) :-
         nb_setarg(2, D, Leaves)
     ).
 
-% ---- explaining ----------------------------------------------------------------------------
-
-%!  tg_explain(+KB, +Facts, +Necessity, -Explanation) is det.
-%
-%   Explanation is tg(Ranked): for every response, choice(Action, Q, Leaf, Path) in
-%   decreasing Q (ties in declaration order). Path lists the tests from the root to the
-%   action's leaf as test(Id, Text, Outcome, Bindings): Text the conjunction with its
-%   variables named, Outcome true or false, Bindings the Name=Value pairs of the variables
-%   the test introduced, from the first solution of the query that made it true.
-
-tg_explain(KB, Facts, N, tg(Ranked)) :-
-    tree(KB, tree(Root, _, _, Responses)),
-    findall(NegQ-choice(A, Q, Leaf, Path),
-            ( member(A, Responses),
-              explain_path(Root, [], [], Facts, A, N, Path, Leaf),
-              leaf_stats(KB, Leaf, L), arg(1, L, Q),
-              NegQ is -Q ),
-            Keyed),
-    keysort(Keyed, Sorted),
-    pairs_values(Sorted, Ranked).
-
-explain_path(leaf(Id, _, _, _), _, _, _, _, _, [], Id).
-explain_path(node(Id, Lits, New, Yes, No), Path, Vars, Facts, A, N, [Step|Steps], Leaf) :-
-    append(Path, Lits, Path1),
-    append(Vars, New, Vars1),
-    name_variables(Vars1, Names),
-    conj_text(Lits, Names, Text),
-    (   \+ \+ holds_all(Path1, Facts, A, N)
-    ->  copy_term(Path1-Names, Path2-Names2),
-        once(holds_all(Path2, Facts, A, N)),
-        include(introduced(New, Names), Names2, Bound0),
-        maplist(binding_pair, Bound0, Bound),
-        Step = test(Id, Text, true, Bound),
-        explain_path(Yes, Path1, Vars1, Facts, A, N, Steps, Leaf)
-    ;   Step = test(Id, Text, false, []),
-        explain_path(No, Path, Vars, Facts, A, N, Steps, Leaf)
-    ).
-
-holds_all(Lits, Facts, A, N) :-
-    maplist([L]>>literal_holds(L, Facts, A, N), Lits).
-
-introduced(New, Names, Name=_) :-
-    member(Name=V, Names),
-    member(W-_, New),
-    V == W,
-    !.
-
-binding_pair(Name=Value, Name-Value).
-
 % ---- size ----------------------------------------------------------------------------------
 
 %!  tg_size(+KB, -Size) is det.
@@ -515,7 +354,7 @@ binding_pair(Name=Value, Name-Value).
 
 tg_size(KB, size(Positions, [nodes=Nodes, tests=Tests, leaves=Leaves, entries=Leaves,
                              candidates=Cands, statistics=Stats])) :-
-    tree(KB, tree(Root, _, _, _)),
+    tg_get_tree(KB, tree(Root, _, _, _)),
     tree_counts(Root, 0-0-0, Tests-Leaves-Cands),
     Nodes is Tests + Leaves,
     Positions is Nodes + Leaves,
@@ -535,312 +374,12 @@ tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
 %   Texts are the candidate tests of leaf LeafId, written with their variables named.
 
 tg_candidates(KB, LeafId, Texts) :-
-    tree(KB, tree(Root, _, _, _)),
-    tree_leaf(Root, leaf(LeafId, _, Vars, Cands)),
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    tg_tree_leaf(Root, leaf(LeafId, _, Vars, Cands)),
     findall(Text, ( member(cand(Lits, New), Cands),
                     append(Vars, New, All),
                     name_variables(All, Names),
                     conj_text(Lits, Names, Text) ), Texts).
-
-tree_leaf(L, L) :-
-    L = leaf(_, _, _, _).
-tree_leaf(node(_, _, _, Y, N), L) :-
-    (   tree_leaf(Y, L)
-    ;   tree_leaf(N, L)
-    ).
-
-% ---- the tree as text, as a graph, as rules ------------------------------------------------
-
-%!  tg_text(+KB, -Text:string) is det.
-%
-%   Text draws the tree, one line per node, indented by depth.
-
-tg_text(KB, Text) :-
-    tree(KB, tree(Root, _, _, _)),
-    with_output_to(string(Text), text_node(KB, Root, [], "", "")).
-
-text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)),
-    format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
-text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
-    append(Vars, New, Vars1),
-    name_variables(Vars1, Names),
-    conj_text(Lits, Names, Text),
-    format("~w~w[~d] ~w ?~n", [Indent, Label, Id, Text]),
-    string_concat(Indent, "    ", Deeper),
-    text_node(KB, Yes, Vars1, Deeper, "yes: "),
-    text_node(KB, No, Vars, Deeper, "no:  ").
-
-%!  tg_graph(+KB, -Graph) is det.
-%
-%   Graph is graph(Nodes, Edges): node(Id, test, Label) and node(Id, leaf, Label) (Label a
-%   string), edge(From, To, yes) and edge(From, To, no).
-
-tg_graph(KB, graph(Nodes, Edges)) :-
-    tree(KB, tree(Root, _, _, _)),
-    graph_node(KB, Root, [], Nodes, [], Edges, []).
-
-graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)),
-    format(string(Label), "Q=~2f (n=~d)", [Q, N]).
-graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
-           [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
-    append(Vars, New, Vars1),
-    name_variables(Vars1, Names),
-    conj_text(Lits, Names, Text),
-    arg(1, Yes, YId), arg(1, No, NId),
-    graph_node(KB, Yes, Vars1, Ns0, Ns1, Es0, Es1),
-    graph_node(KB, No, Vars, Ns1, Ns, Es1, Es).
-
-%!  tg_leaf_clauses(+KB, -Clauses:list) is det.
-%
-%   One clause per leaf, q(Action, Necessity, Q) :- Body, that a person can read and plain
-%   swipl can run in the domain's knowledge base: Body holds the leaf's path query and, for
-%   each no-branch on the path, the negation of that test's query (a renamed copy: TILDE's
-%   semantics). action(T) becomes the head's action, necessity(T) its necessity; Q is
-%   rounded to three decimals. Inside a negation, what the clause already makes true is
-%   left out (an action the head fixes, a ground literal of the body), and a negated
-%   equality is written as X \= Y on the arguments that differ. Variables are named by
-%   type (P for a place, T for a toy), Action and Necessity in the head; a variable used
-%   once is written _.
-
-tg_leaf_clauses(KB, Clauses) :-
-    leaf_rules(KB, Rules),
-    maplist(named_rule, Rules, Clauses).
-
-named_rule(Rule-Names, Rule) :-
-    term_variables(Rule, Vs),
-    foldl(occurrences(Rule), Vs, Counts, []),
-    maplist(name_var(Counts), Names).
-
-occurrences(Term, V, [V-N|Cs], Cs) :-
-    aggregate_all(count, ( sub_term(X, Term), X == V ), N).
-
-name_var(Counts, Name=V) :-
-    (   var(V)
-    ->  (   member(W-1, Counts), W == V
-        ->  V = '$VAR'('_')
-        ;   V = '$VAR'(Name)
-        )
-    ;   true
-    ).
-
-%   Rule-Names for every leaf: the rule with its variables, and Name=Var for each.
-leaf_rules(KB, Rules) :-
-    tree(KB, tree(Root, _, _, _)),
-    findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
-
-leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
-    leaf_stats(KB, Id, l(Q0, _, _, _, _, _, _)),
-    Q is round(Q0 * 1000) / 1000.0,
-    Head = q(Action, Necessity, Q),
-    foldl(positive(Action, Necessity), Pos, Goals0, []),
-    pairs_keys_values(Neg, NegTests, NegVars),
-    maplist(negative(Action, Necessity, Goals0), NegTests, NegGoals),
-    append(Goals0, NegGoals, Goals),
-    append([Vars|NegVars], AllVars),
-    name_variables(AllVars, Names0),
-    Names = ['Action'=Action, 'Necessity'=Necessity|Names0],
-    (   Goals == []
-    ->  Clause = Head
-    ;   list_conj_(Goals, Body),
-        Clause = (Head :- Body)
-    ).
-leaf_clause(KB, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
-    append(Pos, Lits, Pos1),
-    append(Vars, New, Vars1),
-    (   leaf_clause(KB, Yes, Pos1, Neg, Vars1, Clause)
-    ;   copy_term(Pos1-Vars1, Test-TestVars),
-        append(Neg, [Test-TestVars], Neg1),
-        leaf_clause(KB, No, Pos, Neg1, Vars, Clause)
-    ).
-
-positive(A, _, action(T), Gs, Gs) :- !, A = T.
-positive(_, N, necessity(T), Gs, Gs) :- !, N = T.
-positive(_, _, L, [L|Gs], Gs).
-
-%   The negation of a test's query (run after the positive goals Known).
-negative(A, N, Known, Lits, Goal) :-
-    maplist(body_literal(A, N), Lits, Goals0),
-    exclude(known_true(Known), Goals0, Goals),
-    (   Goals == []
-    ->  Goal = fail                        % the query holds whenever Known does
-    ;   Goals = [X = Y]
-    ->  differing(X, Y, X1, Y1),
-        Goal = (X1 \= Y1)
-    ;   list_conj_(Goals, Conj),
-        Goal = (\+ Conj)
-    ).
-
-body_literal(A, _, action(T), A = T) :- !.
-body_literal(_, N, necessity(T), N = T) :- !.
-body_literal(_, _, L, L).
-
-known_true(_, X = Y) :-
-    X == Y,
-    !.
-known_true(Known, G) :-
-    ground(G),
-    member(K, Known),
-    K == G,
-    !.
-
-%   f(..., X, ...) \= f(..., Y, ...) is X \= Y when every other argument is the same.
-differing(X, Y, X1, Y1) :-
-    (   compound(X), compound(Y),
-        X =.. [F|As], Y =.. [F|Bs],
-        same_length(As, Bs),
-        one_differs(As, Bs, A, B)
-    ->  differing(A, B, X1, Y1)
-    ;   X1 = X, Y1 = Y
-    ).
-
-one_differs([A|As], [B|Bs], X, Y) :-
-    (   A == B
-    ->  one_differs(As, Bs, X, Y)
-    ;   As == Bs,
-        X = A, Y = B
-    ).
-
-list_conj_([G], G) :- !.
-list_conj_([G|Gs], (G, C)) :- list_conj_(Gs, C).
-
-% ---- saving and restoring ------------------------------------------------------------------
-
-%!  tg_save(+KB, +Stream) is det.
-%
-%   Write the learned tree to Stream: tg_tree/1 (the tree itself, read back by relrl) and
-%   the leaves as q/3 rules (for a person, and for plain swipl).
-
-tg_save(KB, S) :-
-    tree(KB, tree(Root, _, _, _)),
-    saved_tree(KB, Root, [], Saved, Vars),
-    name_variables(Vars, Names),
-    maplist([Name=V]>>(V = '$VAR'(Name)), Names),
-    format(S, "% The tree: tests (conjunctions; a variable is used only in the yes-branch of~n", []),
-    format(S, "% the test that introduces it) and leaves (Q estimate, examples counted).~n", []),
-    portray_clause(S, tg_tree(Saved)),
-    nl(S),
-    format(S, "% The same knowledge as rules: Q of an action in the state working memory~n", []),
-    format(S, "% holds now, under the active necessity (one clause per leaf).~n", []),
-    tg_leaf_clauses(KB, Clauses),
-    forall(member(C, Clauses), portray_clause(S, C)).
-
-saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
-    leaf_stats(KB, Id, l(Q, N, _, _, _, _, _)).
-saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
-    append(Vars, New, Vars1),
-    saved_tree(KB, Y, Vars1, SY, AY),
-    saved_tree(KB, N, Vars, SN, AN),
-    append([New, AY, AN], All).
-
-%!  tg_policy_term(?Term) is semidet.
-%
-%   Term may appear in a tg policy file: tg_tree/1 or a q/3 clause.
-
-tg_policy_term(Term) :-
-    nonvar(Term),
-    (   Term = tg_tree(_)
-    ->  true
-    ;   Term = (q(_, _, _) :- _)
-    ->  true
-    ;   Term = q(_, _, _)
-    ).
-
-%!  tg_restore(+KB, +Terms:list) is det.
-%
-%   Rebuild KB's tree from the terms of a policy file (tg_tree/1; the q/3 rules must be
-%   the ones the tree gives). Candidates and their statistics start afresh.
-%
-%   @error existence_error(tg_tree, Terms) if there is no tg_tree/1 term.
-%   @error domain_error(tg_tree, Node) for a malformed node.
-%   @error domain_error(tg_rules_match_tree, Clause) for a q/3 rule the tree does not give.
-
-tg_restore(KB, Terms) :-
-    (   memberchk(tg_tree(Saved), Terms)
-    ->  true
-    ;   existence_error(tg_tree, Terms)
-    ),
-    tree(KB, tree(_, _, Bias, Responses)),
-    restored(Saved, Bias, [], [], Root, Stats),
-    pairs_keys(Stats, Ids),
-    (   sort(Ids, Unique), length(Unique, U), length(Ids, U)
-    ->  true
-    ;   domain_error(tg_tree_unique_ids, Ids)
-    ),
-    max_list(Ids, MaxId),
-    Cap is max(16, MaxId),
-    empty_leaves(Cap, Leaves),
-    foldl(place_leaf(Leaves), Stats, _, _),
-    data(KB, D),
-    nb_setarg(2, D, Leaves),
-    nb_setarg(3, D, none),
-    arg(4, D, Version0), Version is Version0 + 1, nb_setarg(4, D, Version),
-    nb_setarg(5, D, 0),
-    Next is MaxId + 1,
-    set_tree(KB, tree(Root, Next, Bias, Responses)),
-    retractall(tg_cands_(KB, _, _, _, _, _)),
-    forall(tree_leaf(Root, Leaf), compile_leaf(KB, Leaf)),
-    compile_tree(KB, Root),
-    check_rules(KB, Terms).
-
-restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) :-
-    !,
-    (   integer(Id), Id > 0, number(Q), integer(N), N >= 0
-    ->  true
-    ;   domain_error(tg_tree, leaf(Id, Q, N))
-    ),
-    refinements(Bias, Path, Vars, Cands),
-    length(Cands, K),
-    new_stats(Q, N, K, 0, L).
-restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
-    !,
-    (   integer(Id), Id > 0, is_list(Lits), Lits \== [], maplist(callable, Lits),
-        is_list(New), maplist(typed_var, New)
-    ->  true
-    ;   domain_error(tg_tree, node(Id, Lits, New))
-    ),
-    append(Path, Lits, Path1),
-    append(Vars, New, Vars1),
-    restored(Y, Bias, Path1, Vars1, RY, SY),
-    restored(N, Bias, Path, Vars, RN, SN),
-    append([Id-test|SY], SN, Stats).
-restored(Other, _, _, _, _, _) :-
-    domain_error(tg_tree, Other).
-
-place_leaf(Leaves, Id-L, _, _) :-
-    (   L == test
-    ->  true
-    ;   setarg(Id, Leaves, L)
-    ).
-
-typed_var(V-T) :-
-    var(V),
-    atom(T).
-
-%   The q/3 rules of a policy are the tree written as rules: refuse a file whose rules
-%   say something else (an edited rule would otherwise be silently ignored).
-check_rules(KB, Terms) :-
-    leaf_rules(KB, Mine),
-    include(is_rule, Terms, Rules),
-    forall(member(R, Rules),
-           (   member(M-_, Mine), same_rule(R, M)
-           ->  true
-           ;   domain_error(tg_rules_match_tree, R)
-           )).
-
-is_rule((q(_, _, _) :- _)).
-is_rule(q(_, _, _)).
-
-same_rule(R, M) :-
-    rule_parts(R, q(A, N, Q), B),
-    rule_parts(M, q(A1, N1, Q1), B1),
-    number(Q),
-    abs(Q - Q1) =< 0.0011,
-    q(A, N)-B =@= q(A1, N1)-B1.
-
-rule_parts((H :- B), H, B) :- !.
-rule_parts(H, H, true).
 
 % ---- the engine's hooks (see engine.pl) ----------------------------------------------------
 

@@ -9,6 +9,7 @@
 :- use_module('../../prolog/tg').
 :- use_module('../../prolog/tg_bias').
 :- use_module('../../prolog/tg_stats').
+:- use_module('../../prolog/tg_tree').
 
 tg_kb(KB, File) :-
     relrl_gateway:gw_new_kb(KB),
@@ -41,7 +42,7 @@ feed(KB, Places, Rounds) :-
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )).
 
 root(KB, Root) :-
-    relrl_tg:tree(KB, tree(Root, _, _, _)).
+    relrl_tg_tree:tg_get_tree(KB, tree(Root, _, _, _)).
 
 :- begin_tests(tg_refinement).
 
@@ -183,7 +184,7 @@ test(children_start_from_partitions, [Q-N == 10.0-M]) :-
            ( ( G == P -> T = 10 ; T = 0 ),
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
-    relrl_tg:leaf_stats(KB, Yes, l(Q, N, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _)),
     M = 12.                              % 36 examples, one in three followed the gaze
 
 test(generalises_to_places_never_seen, [Q1-Q2 == 10.0-0.0]) :-
