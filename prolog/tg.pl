@@ -67,8 +67,8 @@ tg_init(KB, Params) :-
     must_be(atom, KB),
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
-                            min_examples, stale_bonus],
-            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa]),
+                            min_examples, stale_bonus, half_life],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0]),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
@@ -79,8 +79,9 @@ tg_init(KB, Params) :-
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
-    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa), Leaves0, none, 0,
-                     0)),
+    Half is max(0, round(Half0)),
+    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half), Leaves0, none,
+                     0, 0)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -126,7 +127,7 @@ tg_q(KB, Facts, Action, N, Q) :-
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     tg_data(KB, D),
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa), Leaves, Cache, Version, Clock),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _), Leaves, Cache, Version, Clock),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
     ->  random_member(Action, Allowed)
@@ -190,7 +191,7 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _), Leaves, _, Version, _),
+    D = tg(p(_, Gamma, _, _, _, _, _, _), Leaves, _, Version, _),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
@@ -216,40 +217,81 @@ tg_insert(KB, Facts, A, N, Target) :-
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _), Leaves, _, _, Clock0),
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half), Leaves, _, _, Clock0),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
     tg_sort_(KB, Facts, A, N, Leaf),
     arg(Leaf, Leaves, L),
-    L = l(Q0, N0, M0, S0, SS0, C, _),
+    L = l(Q0, N0, _, _, _, C, _, _),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
-    M is M0 + 1,
-    S is S0 + Target,
-    SS is SS0 + Target * Target,
-    nb_setarg(1, L, Q), nb_setarg(2, L, N1),
-    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS), nb_setarg(7, L, Clock),
+    nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
+    weight(L, Half, Clock, W),                      % (may rescale the sums)
+    arg(3, L, M0), arg(4, L, S0), arg(5, L, SS0),
+    M is M0 + W,
+    S is S0 + W * Target,
+    SS is SS0 + W * Target * Target,
+    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
     tg_cands_(KB, Leaf, Facts, A, N, Hits),
-    count_hits(Hits, C, Target),
-    (   M >= 2 * MinEx,
-        M /\ 3 =:= 0,                               % every fourth example
-        best_candidate(C, M, S, MinEx, Best),
-        Best = I-Yes,
-        split_f(s(M, S, SS), Yes, F, Dof),
+    count_hits(Hits, C, W, Target),
+    (   N1 /\ 3 =:= 0,                              % every fourth example
+        MinW is MinEx * W,                          % min_examples in stored units
+        M >= 2 * MinW,
+        best_candidate(C, M, S, MinW, I-s(M1, S1, SS1)),
+        F is 1 / W,                                 % stored sums -> today's weights
+        Mt is M * F, St is S * F, SSt is SS * F,
+        M1t is M1 * F, S1t is S1 * F, SS1t is SS1 * F,
+        split_f(s(Mt, St, SSt), s(M1t, S1t, SS1t), FStat, Dof),
         functor(C, _, Arity),
         Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
-        f_significant(F, Dof, Corrected)
-    ->  split(KB, D, Leaf, I, Yes, s(M, S, SS))
+        f_significant(FStat, Dof, Corrected)
+    ->  M2t is Mt - M1t,
+        QYes is S1 / M1, QNo is (S - S1) / (M - M1),
+        split(KB, D, Leaf, I, s(M1t, QYes), s(M2t, QNo))
     ;   true
     ).
 
-count_hits([], _, _).
-count_hits([I|Is], C, T) :-
+%   Forgetting (half_life H > 0): an example counts 2^(-k / H) in the split statistics
+%   once k more examples have been inserted in the tree. The Q-targets drift while the
+%   Q-function is learned: without forgetting, a leaf compares targets from long ago with
+%   today's, a test that merely tells early examples from later ones (a necessity active
+%   mostly at the start) looks significant, and its rarely visited side starts with an
+%   estimate from long ago. A leaf's sums are kept in units of the weight an example had
+%   when they were last rescaled (Base, the eighth argument of l/8): an example inserted
+%   now weighs W = 2^((Clock - Base) / H) there, and dividing by W gives today's weights.
+%   When W grows large the leaf's sums are rescaled (once every 64 half-lives at most).
+weight(L, Half, Clock, W) :-
+    (   Half =:= 0
+    ->  W = 1
+    ;   arg(8, L, Base),
+        E is (Clock - Base) / Half,
+        (   E > 64
+        ->  Scale is 2 ** (-E),
+            rescale(L, Scale),
+            nb_setarg(8, L, Clock),
+            W = 1.0
+        ;   W is 2 ** E
+        )
+    ).
+
+rescale(L, Scale) :-
+    forall(between(3, 5, I), scale_arg(L, Scale, I)),
+    arg(6, L, C),
+    functor(C, _, K),
+    forall(between(1, K, I), scale_arg(C, Scale, I)).
+
+scale_arg(T, Scale, I) :-
+    arg(I, T, X),
+    Y is X * Scale,
+    nb_setarg(I, T, Y).
+
+count_hits([], _, _, _).
+count_hits([I|Is], C, W, T) :-
     J is 3 * I - 2, J2 is J + 1, J3 is J + 2,
-    arg(J, C, M0), M is M0 + 1, nb_setarg(J, C, M),
-    arg(J2, C, S0), S is S0 + T, nb_setarg(J2, C, S),
-    arg(J3, C, SS0), SS is SS0 + T * T, nb_setarg(J3, C, SS),
-    count_hits(Is, C, T).
+    arg(J, C, M0), M is M0 + W, nb_setarg(J, C, M),
+    arg(J2, C, S0), S is S0 + W * T, nb_setarg(J2, C, S),
+    arg(J3, C, SS0), SS is SS0 + W * T * T, nb_setarg(J3, C, SS),
+    count_hits(Is, C, W, T).
 
 %   The candidate whose split explains the most variance, among those that leave at least
 %   MinEx examples on each side: for a fixed total, F grows with S1^2/M1 + S2^2/M2, so only
@@ -281,7 +323,9 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
 
 % ---- splitting -----------------------------------------------------------------------------
 
-split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
+%   Split leaf LeafId on its candidate I; the children start from their partitions:
+%   s(Weight, MeanQTarget) each (today's weights).
+split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
     replace_leaf(Root0, LeafId, Leaf, Node, Root),
@@ -295,12 +339,11 @@ split(KB, D, LeafId, I, s(M1, S1, _), s(M, S, _)) :-
     Yes = leaf(YesId, YesPath, YesVars, YesCands),
     No = leaf(NoId, Path, Vars, NoCands),
     Node = node(LeafId, Lits, New, Yes, No),
-    M2 is M - M1, S2 is S - S1,
-    QYes is S1 / M1, QNo is S2 / M2,
     length(YesCands, KY), length(NoCands, KN),
     arg(5, D, Clock),
-    tg_new_stats(QYes, M1, KY, Clock, LYes),
-    tg_new_stats(QNo, M2, KN, Clock, LNo),
+    NYes is max(1, round(M1)), NNo is max(1, round(M2)),
+    tg_new_stats(QYes, NYes, KY, Clock, LYes),
+    tg_new_stats(QNo, NNo, KN, Clock, LNo),
     put_leaf(D, LeafId, free),
     put_leaf(D, YesId, LYes),
     put_leaf(D, NoId, LNo),

@@ -83,7 +83,7 @@ tg_text(KB, Text) :-
     with_output_to(string(Text), text_node(KB, Root, [], "", "")).
 
 text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
     format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
 text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
     append(Vars, New, Vars1),
@@ -104,7 +104,7 @@ tg_graph(KB, graph(Nodes, Edges)) :-
     graph_node(KB, Root, [], Nodes, [], Edges, []).
 
 graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
     format(string(Label), "Q=~2f (n=~d)", [Q, N]).
 graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
            [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
@@ -154,7 +154,7 @@ leaf_rules(KB, Rules) :-
     findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
 
 leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
-    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000.0,
     Head = q(Action, Necessity, Q),
     foldl(positive(Action, Necessity), Pos, Goals0, []),
@@ -250,7 +250,7 @@ tg_save(KB, S) :-
     forall(member(C, Clauses), portray_clause(S, C)).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _)).
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)).
 saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
     append(Vars, New, Vars1),
     saved_tree(KB, Y, Vars1, SY, AY),

@@ -70,14 +70,15 @@ stats_sse(s(N, S, SS), SSE) :-
 %   F is the F statistic of splitting the values counted in Total into those counted in
 %   Yes and the rest; Dof = N - 2 its second degrees of freedom. Fails when a side is empty
 %   or Total has fewer than three values. A split that explains all the variance has
-%   F = inf (when there was variance to explain) or 0.0 (when there was none).
+%   F = inf (when there was variance to explain) or 0.0 (when there was none). Counts may
+%   be weights (a learner that forgets halves them): Dof is then the whole part of N - 2.
 
 split_f(s(N, S, SS), s(N1, S1, SS1), F, Dof) :-
     N1 > 0,
     N2 is N - N1,
     N2 > 0,
-    N > 2,
-    Dof is N - 2,
+    N >= 3,
+    Dof is truncate(N) - 2,
     stats_sse(s(N, S, SS), Total),
     S2 is S - S1, SS2 is SS - SS1,
     stats_sse(s(N1, S1, SS1), E1),

@@ -40,14 +40,16 @@ explains, draws, saves and restores them.
 %                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
 %                  along the path, as in the tree.
 %   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock), read in place on every step:
-%                  Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples, Kappa);
-%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last) for leaf i
-%                  (or `free`): the Q estimate and the examples counted in it (its
-%                  partition's and its own), the count, sum and sum of squares of the
+%                  Params below;
+%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last, Base)
+%                  for leaf i (or `free`): the Q estimate and the examples counted in it
+%                  (its partition's and its own), the count, sum and sum of squares of the
 %                  Q-targets since the leaf was made, C = c(M1, S1, SS1, M2, ...) the same
-%                  for each candidate, in order, and the Clock (examples inserted in the
-%                  tree so far) when the leaf was last updated; the numbers are updated with
-%                  nb_setarg/3.
+%                  for each candidate, in order, the Clock (examples inserted in the tree so
+%                  far) when the leaf was last updated, and the Clock its sums are weighed
+%                  from (forgetting, tg.pl's weight/4); the numbers are updated with
+%                  nb_setarg/3. Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples,
+%                  Kappa, HalfLife).
 %                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
 %                  sorted the next state's allowed actions, reused by the choice that
 %                  follows in the same step while the tree is unchanged (Version).
@@ -86,7 +88,7 @@ tg_put_tree(KB, Tree) :-
 
 %!  tg_leaf(+KB, +LeafId, -Stats) is det.
 %
-%   Stats is the live l/7 term of leaf LeafId (above).
+%   Stats is the live l/8 term of leaf LeafId (above).
 
 tg_leaf(KB, Id, L) :-
     tg_data(KB, tg(_, Leaves, _, _, _)),
@@ -103,10 +105,11 @@ tg_empty_leaves(Cap, Leaves) :-
 
 %!  tg_new_stats(+Q, +N, +K, +Clock, -Stats) is det.
 %
-%   Stats is a new leaf's l/7 term: estimate Q from N examples, no examples of its own
-%   yet, K candidates with empty statistics, last updated at Clock.
+%   Stats is a new leaf's l/8 term: estimate Q from N examples, no examples of its own
+%   yet, K candidates with empty statistics, last updated at Clock, sums in units of
+%   Clock's weight.
 
-tg_new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock)) :-
+tg_new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock)) :-
     findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
     C =.. [c|Xs].
 

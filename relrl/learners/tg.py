@@ -29,14 +29,15 @@ class TGLearner(Learner):
     Bonferroni-corrected for their number), min_examples (a split must leave at least
     this many examples on each side), stale_bonus (while learning, a leaf no example has
     reached for the last k examples counts Q + stale_bonus * sqrt(k): Dyna-Q+'s
-    exploration bonus, per leaf; 0 turns it off).
+    exploration bonus, per leaf; 0 turns it off), half_life (an example counts half in the
+    split statistics once this many more examples have been inserted; 0: never forget).
     """
 
     name = "tg"
     engine_name = "tg"
     defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
                 "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
-                "stale_bonus": 1.0}
+                "stale_bonus": 1.0, "half_life": 1000.0}
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -46,8 +47,9 @@ class TGLearner(Learner):
         if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
             raise ConfigError(f"min_examples must be a whole number >= 3, not "
                               f"{p['min_examples']}")
-        if p["temperature"] < 0:
-            raise ConfigError(f"temperature must be >= 0, not {p['temperature']}")
+        for key in ("temperature", "stale_bonus", "half_life"):
+            if p[key] < 0:
+                raise ConfigError(f"{key} must be >= 0, not {p[key]}")
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
         """``ranked``: every response's Q and leaf, best first; ``paths``: for each, the

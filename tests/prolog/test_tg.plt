@@ -24,7 +24,7 @@ gaze_kb(KB) :-
 
 params(Level, MinEx,
        [alpha=0, gamma=0.9, epsilon=0, temperature=0, q_init=0, significance=Level,
-        min_examples=MinEx, stale_bonus=0]).
+        min_examples=MinEx, stale_bonus=0, half_life=0]).
 
 fresh_learner(KB, Level, MinEx) :-
     gaze_kb(KB),
@@ -184,7 +184,7 @@ test(children_start_from_partitions, [Q-N == 10.0-M]) :-
            ( ( G == P -> T = 10 ; T = 0 ),
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
-    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _, _)),
     M = 12.                              % 36 examples, one in three followed the gaze
 
 test(generalises_to_places_never_seen, [Q1-Q2 == 10.0-0.0]) :-
@@ -226,6 +226,51 @@ test(no_stale_bonus_at_first, [A == look(p1)]) :-
              tg_insert(KB, [gaze(face, G)], look(P), curiosity, T) )),
     forall(between(1, 5, _), tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 10)),
     tg_choose(KB, [gaze(face, p1)], curiosity, [look(p1), look(p2)], learn, A).
+
+%   An old era: 12 examples with fed(treat) and 100 without, all with targets near 0; then
+%   200 without it near 10. Only fed(treat) tells examples apart, and only by when they came.
+era_stream(KB) :-
+    forall(between(1, 312, K),
+           ( ( K =< 12 -> Facts = [fed(treat), gaze(face, p1)] ; Facts = [gaze(face, p1)] ),
+             ( K =< 112 -> T0 = 0 ; T0 = 10 ),
+             T is T0 + (K mod 7) / 2,
+             tg_insert(KB, Facts, look(p1), curiosity, T) )).
+
+learner_with(KB, Extra) :-
+    gaze_kb(KB),
+    params(0.001, 10, Params0),
+    foldl([K=V, P0, P]>>selectchk(K=_, P0, K=V, P), Extra, Params0, Params),
+    tg_init(KB, Params).
+
+test(without_forgetting_splits_on_an_old_era,
+     [true(Lits =@= [fed(treat)])]) :-
+    learner_with(KB, []),
+    era_stream(KB),
+    root(KB, node(_, Lits, _, _, _)).
+
+test(forgetting_does_not, [Root = leaf(_, _, _, _)]) :-
+    learner_with(KB, [half_life=20]),
+    era_stream(KB),
+    root(KB, Root).
+
+test(forgetting_weights, [true(abs(Today - Expected) < 1.0e-9)]) :-
+    % 10 examples, half-life 10: today they weigh 2^(-j/10), j = 0..9
+    learner_with(KB, [half_life=10]),
+    forall(between(1, 10, _), tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 1)),
+    today_weight(KB, Today),
+    aggregate_all(sum(X), ( between(0, 9, J), X is 2 ** (-J / 10) ), Expected).
+
+test(forgetting_rescales, [true(abs(Today - Expected) < 1.0e-9)]) :-
+    % half-life 1: past 64 half-lives the sums are rescaled; today's weights are unchanged
+    learner_with(KB, [half_life=1]),
+    forall(between(1, 100, _), tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 1)),
+    today_weight(KB, Today),
+    aggregate_all(sum(X), ( between(0, 99, J), X is 2 ** (-J) ), Expected).
+
+today_weight(KB, Today) :-
+    relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base)),
+    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H), _, _, _, Clock)),
+    Today is M / 2 ** ((Clock - Base) / H).
 
 test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-
     % one leaf; Q(s', .) = 10 after the first example; target = 10 + 0.9 * 10

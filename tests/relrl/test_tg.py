@@ -198,3 +198,24 @@ def test_example_learns_gaze_following_on_the_sis(tmp_path: Path) -> None:
     for place in ("left", "left_down", "down", "right_down", "right"):
         assert f"gaze {place:<10} -> look({place})" in proc.stdout
     assert "q(look(P), _, " in (tmp_path / "tg.pl").read_text()
+
+
+@pytest.mark.parametrize("params,message", [
+    ({"significance": 0.0}, "significance must be in"),
+    ({"min_examples": 2}, "min_examples must be a whole number >= 3"),
+    ({"min_examples": 4.5}, "min_examples must be a whole number >= 3"),
+    ({"temperature": -1}, "temperature must be >= 0"),
+    ({"stale_bonus": -0.5}, "stale_bonus must be >= 0"),
+    ({"half_life": -10}, "half_life must be >= 0"),
+])
+def test_bad_parameters(params: dict, message: str) -> None:
+    from relrl.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=message):
+        make_learner("tg", **params)
+
+
+def test_bad_parameter_on_the_command_line(capsys) -> None:
+    assert main(["experiment", "sis", "--learners", "tg", "--param", "tg.half_life=-1",
+                 "--quick", "--out", "/nonexistent/never-written"]) == 2
+    assert "half_life must be >= 0" in capsys.readouterr().err
