@@ -35,11 +35,13 @@ import tempfile
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from importlib.resources import files
 from pathlib import Path
 from typing import Any, NoReturn
 
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
 from head.scripts import MotorScript, normalise_response, parse_scripts
+from perception.vocabulary import PLACES
 
 __all__ = [
     "DEFAULT_CALIBRATION",
@@ -52,16 +54,18 @@ __all__ = [
     "save_calibration",
 ]
 
-#: the six directions of the paper's head; ``centre`` looks forward, at the caregiver.
-DIRECTIONS: tuple[str, ...] = ("left", "left_down", "down", "right_down", "right", "centre")
+#: the six directions of the paper's head (the shared vocabulary's places); ``centre`` looks
+#: forward, at the caregiver.
+DIRECTIONS: tuple[str, ...] = PLACES
 #: the absolute range of pulse widths any hobby servo accepts, in microseconds.
 PULSE_RANGE: tuple[int, int] = (500, 2500)
 #: the fastest a servo may be calibrated to move, in microseconds per second.
 MAX_SPEED = 20_000.0
 #: the slowest speed, microseconds per second (one unit of the Maestro's speed setting).
 MIN_SPEED = 25.0
-#: the calibration used when none is given.
-DEFAULT_CALIBRATION = Path(__file__).resolve().parent.parent / "examples/heads/wha8030.toml"
+#: the calibration used when none is given: package data of ``head`` (in the source tree
+#: ``head/calibrations`` links to ``examples/heads``).
+DEFAULT_CALIBRATION = Path(str(files("head") / "calibrations" / "wha8030.toml"))
 
 _NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 _HEAD_KEYS = frozenset({"name", "protocol", "baudrate", "tolerance_us", "scripts"})
@@ -264,6 +268,9 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise CalibrationError(f"{path}: no such calibration file") from None
     except tomllib.TOMLDecodeError as exc:
         raise CalibrationError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not a calibration file: byte {exc.start} is not UTF-8 "
+                               "text (a binary file?)") from None
     except OSError as exc:
         raise CalibrationError(f"{path}: cannot read: {exc.strerror}") from None
 
@@ -400,19 +407,36 @@ def save_calibration(cal: Calibration, path: str | Path) -> Path:
 
     Returns:
         The path written.
+
+    Raises:
+        CalibrationError: the file cannot be written (a folder, a missing folder, no
+            permission); nothing is left behind.
     """
     path = Path(path)
     text = dump_calibration(cal)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    if path.exists() and not path.is_file():  # a folder, or a device such as /dev/null
+        raise CalibrationError(f"cannot write the calibration to {path}: not a regular file")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
+                                   dir=path.parent or ".")
+    except OSError as exc:
+        raise CalibrationError(f"cannot write the calibration to {path}: "
+                               f"{exc.strerror or exc}") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
         load_calibration(tmp)
+        mask = os.umask(0o022)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # readable like any file the user writes (0644)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise CalibrationError(f"cannot write the calibration to {path}: "
+                                   f"{exc.strerror or exc}") from None
         raise
     return path

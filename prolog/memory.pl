@@ -113,12 +113,13 @@ wm_clock(KB, Clock) :-
 %   @error instantiation_error if an element is not ground.
 
 wm_insert(KB, New) :-
-    must_be(atom, KB),
-    must_be(list, New),
-    (   ground(New)
+    (   atom(KB), is_list(New), ground(New)
     ->  true
-    ;   member(E, New), \+ ground(E)
+    ;   must_be(atom, KB),
+        must_be(list, New),
+        member(E, New), \+ ground(E)
     ->  instantiation_error(E)
+    ;   true
     ),
     get(KB, wm(Clock0, Span0, Old)),
     (   Span0 == default

@@ -19,12 +19,14 @@
             allowed_responses/1,  % -Responses
             op(200, fy, #)        % #Type: a constant of Type in a language bias (rmode/1)
           ]).
+:- use_module(library(arithmetic)).   % the same arithmetic checks for every load
 :- use_module(memory).
 :- use_module(declarations).
 :- use_module(perception).
 :- use_module(state).
 :- use_module(responses).
 :- use_module(check).
+:- use_module(percepts).
 :- use_module(engine).
 :- use_module(learners).
 :- use_module(policy).

@@ -9,9 +9,3 @@ from __future__ import annotations
 __version__ = "0.1.0"
 
 __all__ = ["__version__"]
-
-# The Social Interactive Simulator as a Gymnasium environment (entry point loaded on make).
-import gymnasium as _gym
-
-if "relrl/SharedAttention-v0" not in _gym.registry:
-    _gym.register(id="relrl/SharedAttention-v0", entry_point="relrl.sim.sis:SharedAttentionEnv")

@@ -41,13 +41,13 @@ from relrl.errors import (
     RelrlError,
     RuleError,
 )
+from relrl.resources import prolog_dir
 from relrl.terms import Term, Var
 
 __all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
 
-#: Where the knowledge layer's .pl files live (override with RELRL_PROLOG_DIR).
-PROLOG_DIR = Path(os.environ.get("RELRL_PROLOG_DIR",
-                                 Path(__file__).resolve().parent.parent / "prolog"))
+#: Where the knowledge layer's .pl files live: package data (override with RELRL_PROLOG_DIR).
+PROLOG_DIR = prolog_dir()
 
 #: Seconds a single gateway call may run before it raises QueryTimeout.
 DEFAULT_TIMEOUT = 10.0
@@ -530,8 +530,8 @@ class KnowledgeBase:
                                   "abort/0 called while loading") from exc
         problems = [Problem(kind, str(f) if f else str(p), line or None, msg)
                     for (_, kind, f, line, msg) in out[0]]  # type: ignore[index]
-        problems = [Problem(pr.kind, _display_path(pr.path), pr.line, pr.message)
-                    for pr in problems]
+        problems = [Problem(pr.kind, _display_path(pr.path), pr.line,
+                            _KB_MODULE.sub("", pr.message)) for pr in problems]
         errors = [pr for pr in problems if pr.kind == "error" or strict]
         if errors:
             first = errors[0]
@@ -587,6 +587,22 @@ class KnowledgeBase:
         _, solutions, more = result
         return ([[(name, value, printed) for (_, (_, name, value), printed) in sol]
                  for sol in solutions], more == "true")
+
+    def open_query(self, text: str, *, timeout: float | None = None,
+                   mode: str = "print") -> Any:
+        """Open a query typed by a user (Prolog syntax) to take its answers one at a time,
+        as swipl's toplevel does (``relrl shell``). Close it, or use it as a context manager.
+
+        Args:
+            text: the query, with or without its final full stop.
+            timeout: seconds each answer may take (the clock stops between answers);
+                default: this knowledge base's time limit. It must be positive: a user's
+                query is always bounded.
+            mode: ``"print"`` writes terms to depth 10 (swipl's default), ``"write"`` whole.
+        """
+        from relrl.query import OpenQuery
+
+        return OpenQuery(self, text, self.timeout if timeout is None else timeout, mode)
 
     # -- the knowledge layer ---------------------------------------------------------------
 

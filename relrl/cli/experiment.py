@@ -7,6 +7,8 @@ import json
 import os
 from pathlib import Path
 
+from relrl.outdir import add_out_options
+
 HELP = ("reproduce the paper's experiments (sis: Experiment 1, the paper's three learners and "
         "tg in the simulator)")
 EXAMPLE = "relrl experiment sis --quick --out runs/exp1-quick"
@@ -82,7 +84,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="toy places of the evaluation (default: all); with held-out "
                              "places the CGI is reported for trained and held-out apart")
     parser.add_argument("--domain", default=None, help="domain file (default sis.pl)")
-    parser.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
+    add_out_options(parser, default="runs/exp1",
+                    what="output folder: results.json, CSVs, figures")
     parser.add_argument("--quick", action="store_true", help="a short run (under a minute)")
 
 
@@ -103,6 +106,9 @@ def build_config(args: argparse.Namespace):
     except ValueError:
         raise ConfigError(f"--seeds must be comma-separated integers, not {args.seeds!r}") \
             from None
+    for seed in seeds:
+        if seed < 0:
+            raise ConfigError(f"--seeds: {seed} is negative; seeds are integers >= 0")
     config = SISConfig(learners=learners, seeds=seeds)
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
@@ -139,11 +145,15 @@ def run(args: argparse.Namespace) -> int:
     """Run the experiment, write the outputs, print the summary."""
     from relrl.experiments.main import run_sis
     from relrl.experiments.report import summary_table
+    from relrl.outdir import OutDir
 
     config = build_config(args)
-    results, files = run_sis(config, args.out, workers=args.workers)
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      default="runs/exp1") as out:
+        results, files = run_sis(config, out.path, workers=args.workers)
+        out.status = "complete"
     print(summary_table(results["summary"]))
-    print(f"\nwrote {len(files)} files to {args.out}/:")
+    print(f"\nwrote {len(files)} files to {out.path}/:")
     for f in files:
         print(f"  {f}")
     return 0

@@ -38,10 +38,10 @@ def _call(job: Callable[..., dict[str, Any]], args: tuple) -> dict[str, Any]:
 class ProgressBar:
     """A one-line progress bar on a terminal; silent otherwise."""
 
-    def __init__(self, total: int, stream: Any = sys.stderr) -> None:
+    def __init__(self, total: int, stream: Any = None) -> None:
         self.total = total
         self.done = 0
-        self.stream = stream
+        self.stream = sys.stderr if stream is None else stream  # the stderr of now
         self.active = bool(getattr(stream, "isatty", lambda: False)())
 
     def update(self, label: str) -> None:

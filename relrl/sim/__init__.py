@@ -11,6 +11,7 @@ See ``docs/simulator.md``. Quick start::
 
 from __future__ import annotations
 
+from relrl.envs import register_envs
 from relrl.sim.caregiver import (
     EVALUATION_SEQUENCE,
     Caregiver,
@@ -32,6 +33,10 @@ from relrl.sim.metrics import (
 )
 from relrl.sim.places import PLACES, TOY_PLACES
 from relrl.sim.sis import ENV_ID, RESPONSES, SharedAttentionEnv
+
+# Gymnasium 1.x does not read the gymnasium.envs entry point: importing the simulator
+# registers its environments (relrl.envs).
+register_envs()
 
 __all__ = [
     "CGI",

@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import math
 
+from perception.vocabulary import OBJECT_PLACES, PLACES
+
 __all__ = [
     "ANGLE_BETWEEN",
     "CAREGIVER_PAN_TILT",
@@ -40,10 +42,9 @@ __all__ = [
     "place_index",
 ]
 
-#: the places, robot's view; index 0 is the caregiver's face.
-PLACES: tuple[str, ...] = ("centre", "left", "left_down", "down", "right_down", "right")
+# PLACES (the robot's view; index 0 is the caregiver's face) come from the shared vocabulary.
 #: the places a toy can be put at (every place but the caregiver).
-TOY_PLACES: tuple[str, ...] = PLACES[1:]
+TOY_PLACES: tuple[str, ...] = OBJECT_PLACES
 #: index of ``centre`` in :data:`PLACES`.
 CENTRE = 0
 #: distance between the robot's and the caregiver's eyes, in centimetres.

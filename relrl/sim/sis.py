@@ -35,6 +35,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from perception.vocabulary import SIS_POSES
 from relrl.interfaces import Environment
 from relrl.sim.caregiver import Caregiver, CaregiverParams, make_caregiver
 from relrl.sim.errors import InvalidResponse, SimError, did_you_mean
@@ -48,8 +49,9 @@ __all__ = ["ENV_ID", "OBSERVATION_FIELDS", "POSES", "RESPONSES", "SharedAttentio
 ENV_ID = "relrl/SharedAttention-v0"
 #: action index -> response term.
 RESPONSES: tuple[tuple[str, str], ...] = tuple(("look", p) for p in PLACES)
-#: caregiver gaze (place index) -> the face's pose as the robot perceives it.
-POSES: tuple[str, ...] = ("frontal",) + PLACES[1:]
+#: caregiver gaze (place index) -> the face's pose as the robot perceives it (the SIS world's
+#: vocabulary: the place looked at, ``frontal`` for the robot).
+POSES: tuple[str, ...] = SIS_POSES
 #: the observation vector, field by field.
 OBSERVATION_FIELDS: tuple[tuple[str, str], ...] = (
     ("head_at", "where the robot's head points: index into PLACES (0 = centre)"),
