@@ -77,6 +77,28 @@ def test_same_seed_same_trajectory() -> None:
     assert trajectory(5) != trajectory(6)
 
 
+def test_two_agents_in_one_process_interleaved_as_alone() -> None:
+    from relrl.loop import Interaction
+
+    def alone(seed: int) -> list:
+        with KnowledgeBase(GAZE) as kb:
+            agent = Agent(kb, make_learner("tg", min_examples=10), seed=seed)
+            return [r.out.action for r in run(GazeTask(), agent, 300, seed=seed)]
+
+    with KnowledgeBase(GAZE) as kb1, KnowledgeBase(GAZE) as kb2:
+        runs = []
+        for kb, seed in ((kb1, 5), (kb2, 6)):
+            it = Interaction(GazeTask(), Agent(kb, make_learner("tg", min_examples=10),
+                                               seed=seed))
+            it.reset(seed=seed)
+            runs.append(it)
+        both: list[list] = [[], []]
+        for _ in range(300):                    # one step of each in turn
+            for i, it in enumerate(runs):
+                both[i] += [r.out.action for r in it.run(1)]
+    assert both == [alone(5), alone(6)]
+
+
 def test_explanation_shows_the_tests_and_bindings() -> None:
     agent = trained()
     out = agent.step([("see", "face"), ("pose", "face", "p4")], learning=False,
