@@ -153,7 +153,8 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
 
 
 def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
-    """Fig. 4 and Fig. 5 as PNG files; nothing (and a note) without matplotlib."""
+    """Fig. 4 and Fig. 5 as PNG files (and, with held-out places, the CGI on trained and
+    held-out places); nothing (and a note) without matplotlib."""
     try:
         import matplotlib
 
@@ -198,4 +199,18 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     files.append(finish(fig, ax, "fig4_eye_contacts.png", "eye-contact opportunity",
                         "eye contacts established (cumulative)",
                         "Fig. 4 — capacity of attention (first opportunities)"))
+    if any("cgi_places" in s for s in summary.values()):
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for i, (name, s) in enumerate(summary.items()):
+            groups = s.get("cgi_places", {})
+            for group, style in (("trained", "-"), ("held_out", "--")):
+                values = groups.get(group, [])
+                points = [p for p, v in enumerate(values) if v is not None]
+                ax.plot(points, [values[p] for p in points], style, marker="o", ms=3,
+                        color=f"C{i}", label=f"{name}, {group.replace('_', '-')} places")
+        ax.set_ylim(-0.05, 1.05)
+        files.append(finish(fig, ax, "cgi_places.png",
+                            "run (evaluation point; 500 learning time units each)",
+                            "CGI (pooled shifts)",
+                            "Gaze following on trained and held-out places"))
     return files

@@ -59,6 +59,7 @@ def test_held_out_places_reported_apart(tmp_path: Path, capsys) -> None:
         rows = list(csv.reader(fh))
     assert rows[0] == ["learner", "point", "cgi_trained", "cgi_held_out"]
     assert len(rows) == 1 + 2 * 2
+    assert (out / "cgi_places.png").stat().st_size > 1000
 
 
 @pytest.mark.parametrize("args,message", [
