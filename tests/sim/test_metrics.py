@@ -97,8 +97,9 @@ def test_streaming_equals_batch() -> None:
     assert m.cgi() == cgi(tr)
     assert m.mutual_gaze_events == mutual_gaze_events(tr) == 1
     assert m.eye_contacts() == eye_contacts(tr)
-    assert summarize(tr) == {"cgi": 1.0, "correct_shifts": 1, "shifts": 1,
-                             "mutual_gaze_events": 1, "eye_contacts": 1, "opportunities": 1}
+    assert summarize(tr) == {"cgi": 1.0, "cgi_literal": 1.0, "correct_shifts": 1,
+                             "shifts": 1, "all_shifts": 1, "mutual_gaze_events": 1,
+                             "eye_contacts": 1, "opportunities": 1}
 
 
 def test_hold_must_be_positive() -> None:
