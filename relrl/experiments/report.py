@@ -25,54 +25,68 @@ def write_json_atomic(path: Path, data: Any) -> None:
     with os.fdopen(fd, "w") as fh:
         json.dump(data, fh, indent=1, sort_keys=True)
         fh.write("\n")
+    os.chmod(tmp, 0o644)  # mkstemp makes it private; results are for sharing
     os.replace(tmp, path)
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
-    """Per learner: the CGI curve pooled over seeds, eye contacts, memory, states met."""
+    """Per learner: the CGI curves (relrl's and literal) pooled over seeds, eye contacts,
+    memory, states met. Jobs stopped part-way contribute the points they finished."""
     out: dict[str, Any] = {}
     for name in learners:
         mine = sorted((j for j in jobs if j["learner"] == name), key=lambda j: j["seed"])
         if not mine:
             continue
-        points = len(mine[0]["curve"])
+        points = max(len(j["curve"]) for j in mine)
         curve = []
         for p in range(points):
-            runs = [v for j in mine for v in j["curve"][p]["cgi_runs"]]
-            curve.append({"point": p, "learning_steps": mine[0]["curve"][p]["learning_steps"],
+            have = [j["curve"][p] for j in mine if len(j["curve"]) > p]
+            runs = [v for c in have for v in c["cgi_runs"]]
+            literal = [v for c in have for v in c["cgi_literal_runs"]]
+            curve.append({"point": p, "learning_steps": have[0]["learning_steps"],
                           "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
+                          "cgi_literal_mean": float(np.mean(literal)),
+                          "cgi_literal_std": float(np.std(literal)),
                           "n_runs": len(runs)})
-        flags = np.array([j["eye_contacts"]["per_opportunity"] for j in mine], dtype=float)
-        n_opp = min(len(f) for f in flags) if len(flags) else 0
-        cumulative = np.cumsum(flags[:, :n_opp], axis=1).mean(axis=0) if n_opp else np.zeros(0)
+        n_opp = min(len(j["eye_contacts"]["per_opportunity"]) for j in mine)
+        flags = np.array([j["eye_contacts"]["per_opportunity"][:n_opp] for j in mine],
+                         dtype=float).reshape(len(mine), n_opp)
+        cumulative = np.cumsum(flags, axis=1).mean(axis=0) if n_opp else np.zeros(0)
         established = [j["eye_contacts"]["established"] for j in mine]
         memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
+        evaluation = [j["states_met"]["evaluation"] for j in mine
+                      if j["states_met"]["evaluation"] is not None]
         out[name] = {
             "curve": curve,
             "cgi_after_first_run": curve[1]["cgi_mean"] if points > 1 else None,
             "cgi_final": curve[-1]["cgi_mean"],
+            "cgi_literal_after_first_run": curve[1]["cgi_literal_mean"] if points > 1 else None,
+            "cgi_literal_final": curve[-1]["cgi_literal_mean"],
             "eye_contacts": {"mean": float(np.mean(established)),
                              "std": float(np.std(established)),
                              "opportunities": n_opp,
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
             "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
-            "states_met_evaluation": float(np.mean([j["states_met"]["evaluation"]
-                                                    for j in mine])),
+            "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
+            "partial": any(j.get("partial", False) for j in mine),
         }
     return out
 
 
 def summary_table(summary: dict[str, Any]) -> str:
     """The results as a fixed-width text table."""
-    lines = [f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'eye contacts':>13} "
-             f"{'memory':>8} {'states':>7}"]
+    nan = float("nan")
+    lines = [f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'literal':>8} "
+             f"{'eye contacts':>13} {'memory':>8} {'states':>7}"]
     for name, s in summary.items():
         ec = s["eye_contacts"]
         first = s["cgi_after_first_run"]
-        lines.append(f"{name:<12} {first if first is not None else float('nan'):>9.3f} "
-                     f"{s['cgi_final']:>9.3f} {ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
-                     f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+        lines.append(f"{name:<12} {first if first is not None else nan:>9.3f} "
+                     f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
+                     f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
+                     f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}"
+                     + ("  (partial)" if s.get("partial") else ""))
     return "\n".join(lines)
 
 
@@ -89,11 +103,13 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
     fig5 = out_dir / "fig5_cgi.csv"
     with open(fig5, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "n_runs"])
+        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std",
+                    "cgi_literal_mean", "cgi_literal_std", "n_runs"])
         for name, s in summary.items():
             for c in s["curve"]:
                 w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
-                            f"{c['cgi_std']:.6f}", c["n_runs"]])
+                            f"{c['cgi_std']:.6f}", f"{c['cgi_literal_mean']:.6f}",
+                            f"{c['cgi_literal_std']:.6f}", c["n_runs"]])
     fig4 = out_dir / "fig4_eye_contacts.csv"
     with open(fig4, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -142,9 +158,11 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, s in summary.items():
         steps = [c["point"] for c in s["curve"]]
-        ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
-                    yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3, capsize=3,
-                    label=name)
+        bars = ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
+                           yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3,
+                           capsize=3, label=name)
+        ax.plot(steps, [c["cgi_literal_mean"] for c in s["curve"]], ls="--", lw=1,
+                color=bars[0].get_color(), label=f"{name} (Eq. 5 literally)")
     ax.set_ylim(-0.05, 1.05)
     files.append(finish(fig, ax, "fig5_cgi.png",
                         "run (evaluation point; 500 learning time units each)",

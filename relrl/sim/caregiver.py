@@ -11,9 +11,9 @@ cycle of three phases:
     The caregiver looks at the robot (its face is ``frontal`` to the robot) and waits for eye
     contact: the robot's focus on the caregiver's face for ``contact_hold`` (3) consecutive
     time units. Each entry into this phase is one *eye-contact opportunity*. The caregiver
-    gives attention **at most once per opportunity**: in the first time unit the robot looks
-    at its face (``attention_during_gaze``, the default), or else when eye contact is
-    established (``attention_on_contact``). If eye contact is not established within
+    gives attention **at most once per opportunity**: when eye contact is established
+    (``attention_on_contact``, the default), or already in the first time unit the robot
+    looks at its face (``attention_during_gaze``). If eye contact is not established within
     ``contact_timeout`` time units the opportunity is missed and a new one starts (the
     caregiver keeps looking at the robot; toys only come after eye contact).
 ``present``
@@ -128,10 +128,10 @@ class CaregiverParams:
             a new one starts; ``None`` waits for ever.
         attention_on_contact: give attention in the time unit eye contact is established
             (unless it was given already in this opportunity).
-        attention_during_gaze: give attention in the first time unit of mutual gaze of each
-            opportunity (the robot on the caregiver's face, the caregiver looking at the
-            robot), as Triesch et al.'s caregiver rewards looking at its face. Either way the
-            caregiver attends at most once per opportunity: looking away and back cannot
+        attention_during_gaze: give attention already in the first time unit of mutual gaze
+            of each opportunity (the robot on the caregiver's face, the caregiver looking at
+            the robot), as Triesch et al.'s caregiver rewards looking at its face. Either way
+            the caregiver attends at most once per opportunity: looking away and back cannot
             farm attention.
         single_look: end a trial (no attention) at the robot's first look, after the turn, at
             anything but the face or the target — one try per trial, as the paper's
@@ -152,7 +152,7 @@ class CaregiverParams:
     contact_hold: int = 3
     contact_timeout: int | None = 10
     attention_on_contact: bool = True
-    attention_during_gaze: bool = True
+    attention_during_gaze: bool = False
     single_look: bool = False
     target_sequence: tuple[str, ...] | None = None
 

@@ -6,6 +6,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from relrl.cli import main
@@ -35,7 +36,8 @@ def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
         assert s["memory"]["positions"] > 0
         assert s["states_met"] > 0
     lines = (a / "fig5_cgi.csv").read_text().splitlines()
-    assert lines[0] == "learner,point,learning_steps,cgi_mean,cgi_std,n_runs"
+    assert lines[0] == ("learner,point,learning_steps,cgi_mean,cgi_std,cgi_literal_mean,"
+                        "cgi_literal_std,n_runs")
     assert len(lines) == 1 + 3 * 3
 
 
@@ -46,11 +48,11 @@ def test_another_seed_other_numbers(tmp_path: Path) -> None:
     assert r0 != r1
 
 
-@pytest.mark.parametrize("learner", ["etg", "qlearning", "contingency"])
+@pytest.mark.parametrize("learner", ["etg", "qlearning"])
 def test_learning_improves_gaze_following(learner: str) -> None:
-    cfg = SISConfig(learners=[learner], points=2, eval_runs=3, eval_steps=300, block=500)
+    cfg = SISConfig(learners=[learner], points=2, eval_runs=3, eval_steps=300, block=1000)
     result = run_job(cfg, learner, 0)
-    curve = [c["cgi_mean"] for c in result["curve"]]
+    curve = [float(np.mean(c["cgi_runs"])) for c in result["curve"]]
     assert curve[0] < 0.5            # no knowledge yet (chance is about 0.2)
     assert curve[-1] > curve[0] + 0.3
     # one call per step, plus a few per evaluation run (seeding, saving random streams)

@@ -96,7 +96,7 @@ def test_evaluation_sequence_is_balanced_without_repeats() -> None:
 # ---- the protocol, time unit by time unit --------------------------------------------------------
 
 def test_eye_contact_after_three_time_units_gives_attention_then_toys_and_turn() -> None:
-    cg = start(CaregiverParams(attention_during_gaze=False), focus=C)   # t=0 on the face: 1
+    cg = start(focus=C)                 # t=0 on the face: 1
     assert (cg.phase, cg.gaze, cg.toys, cg.opportunity) == (ENGAGE, C, (), 0)
     cg.update(C)                        # 2
     assert not cg.contact and not cg.attention
@@ -113,8 +113,9 @@ def test_eye_contact_after_three_time_units_gives_attention_then_toys_and_turn()
     assert not cg.attention
 
 
-def test_default_attends_the_first_look_at_the_face_once_per_opportunity() -> None:
-    cg = start(focus=1)
+def test_attention_during_gaze_attends_the_first_look_at_the_face_once_per_opportunity(
+        ) -> None:
+    cg = start(CaregiverParams(attention_during_gaze=True), focus=1)
     cg.update(C)                        # first mutual gaze of opportunity 0: attention
     assert cg.attention and not cg.contact
     cg.update(2)
@@ -130,16 +131,18 @@ def test_default_attends_the_first_look_at_the_face_once_per_opportunity() -> No
     assert cg.opportunity == 1 and cg.attention
 
 
-def test_looking_away_and_back_cannot_farm_attention() -> None:
+@pytest.mark.parametrize("during_gaze", [False, True])
+def test_looking_away_and_back_cannot_farm_attention(during_gaze: bool) -> None:
     """The loophole an outside tabular agent found: look(centre), look(down) alternately."""
-    cg = start(focus=1)
+    cg = start(CaregiverParams(attention_during_gaze=during_gaze), focus=1)
     attended = []
     for t in range(200):
         cg.update(C if t % 2 == 0 else 3)
         attended.append((cg.opportunity, cg.attention))
     per_opportunity = Counter(opp for opp, a in attended if a)
-    assert per_opportunity and max(per_opportunity.values()) == 1
+    assert not per_opportunity or max(per_opportunity.values()) == 1
     assert sum(per_opportunity.values()) <= 200 // cg.params.contact_timeout + 1
+    assert bool(per_opportunity) == during_gaze   # without it, no eye contact: no attention
 
 
 def test_looking_away_breaks_the_streak() -> None:

@@ -84,7 +84,7 @@ def test_percept_vocabulary_matches_the_sis_domain() -> None:
 
 
 def test_percepts_show_only_the_focus() -> None:
-    env = SharedAttentionEnv(caregiver_params={"attention_during_gaze": False})
+    env = SharedAttentionEnv()
     info = to_contact(env)
     assert ("hear", "attention") in info["percepts"]          # eye contact rewarded
     _, _, _, _, info = env.step(("look", "centre"))           # the caregiver has turned
@@ -170,8 +170,8 @@ def test_bad_construction_and_order() -> None:
 
 def test_rewards_are_configurable() -> None:
     env = SharedAttentionEnv(reward_attention=1.0, reward_other=0.0)
-    env.reset(seed=0, options={"focus": "left"})
-    assert [env.step(0)[1] for _ in range(3)] == [1.0, 0.0, 0.0]
+    env.reset(seed=0, options={"focus": "centre"})
+    assert [env.step(0)[1] for _ in range(2)] == [0.0, 1.0]
 
 
 def test_toy_angles_are_the_head_turns_to_each_toy() -> None:
@@ -202,8 +202,7 @@ def test_trace_has_one_record_per_time_unit_and_can_be_turned_off() -> None:
 
 
 def test_renders_text_and_a_top_view() -> None:
-    env = SharedAttentionEnv(caregiver_params={"attention_during_gaze": False},
-                             render_mode="ansi")
+    env = SharedAttentionEnv(render_mode="ansi")
     to_contact(env)
     text = env.render()
     assert "EYE CONTACT" in text and "ATTENTION" in text and "robot looks at centre" in text
