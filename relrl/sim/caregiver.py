@@ -66,12 +66,13 @@ __all__ = [
 ENGAGE, PRESENT, ATTEND = "engage", "present", "attend"
 
 #: a fixed, balanced sequence of target places for evaluation runs: each toy place four
-#: times, never twice in a row (the paper's "pre-established sequence"; its own is unknown).
+#: times, never twice in a row, also across the wrap from the end to the start (the paper's
+#: "pre-established sequence"; its own is unknown).
 EVALUATION_SEQUENCE: tuple[str, ...] = (
     "left", "down", "right_down", "left_down", "right",
     "down", "left_down", "right", "left", "right_down",
     "right", "left", "left_down", "down", "right_down",
-    "left_down", "right_down", "down", "right", "left",
+    "left_down", "right_down", "down", "left", "right",
 )
 
 
