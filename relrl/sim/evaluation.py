@@ -93,7 +93,7 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
              steps: int = 500, seed: int = 0, sequence: Sequence[str] | None = None,
              which: tuple[int, int] | None = None,
              on_run: Callable[[int, int], None] | None = None,
-             env: Any = None) -> Evaluation:
+             env: Any = None, observation: int = 0) -> Evaluation:
     """Evaluate a policy by the paper's protocol.
 
     Args:
@@ -112,6 +112,7 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
         on_run: called as ``on_run(k, run_seed)`` before run *k* starts (e.g. to reseed an
             agent's random streams and clear its working memory).
         env: an evaluation environment built by :func:`evaluation_env` (saves building one).
+        observation: the observation version the policy reads (0: ``-v0``, 1: ``-v1``).
 
     Returns:
         An :class:`Evaluation` with one metrics dict per run.
@@ -122,7 +123,8 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
         raise SimError(f"runs={runs!r}, steps={steps!r}: use whole numbers >= 1")
     if env is None:
         env = evaluation_env(world=world, caregiver=caregiver,
-                             caregiver_params=caregiver_params, steps=steps, sequence=sequence)
+                             caregiver_params=caregiver_params, steps=steps, sequence=sequence,
+                             observation=observation)
     seq_len = len(env.caregiver.params.target_sequence)
     seeds = evaluation_seeds(seed, runs)
     start, stop = which if which is not None else (0, runs)
