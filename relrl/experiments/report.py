@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "write_outputs", "summary_table", "write_json_atomic"]
+__all__ = ["aggregate", "skip_plots", "summary_table", "write_json_atomic", "write_outputs"]
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -125,8 +125,17 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
             detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
             w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
     written += [fig5, fig4, memory]
-    written += plot(out_dir, summary)
+    written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
+
+
+def skip_plots(out_dir: Path) -> list[Path]:
+    """A note in place of the figures of an interrupted run (drawing them would delay the
+    stop by seconds; the numbers are in results.json and the CSVs)."""
+    note = out_dir / "PLOTS.txt"
+    note.write_text("The run was interrupted, so no figures were drawn (to stop at once); "
+                    "every finished point is in results.json and the CSV files.\n")
+    return [note]
 
 
 def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:

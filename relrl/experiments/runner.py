@@ -76,10 +76,10 @@ class Outcome:
 class ProgressBar:
     """A one-line progress bar on a terminal; silent otherwise."""
 
-    def __init__(self, total: int, stream: Any = sys.stderr) -> None:
+    def __init__(self, total: int, stream: Any = None) -> None:
         self.total = total
         self.done = 0
-        self.stream = stream
+        self.stream = stream = sys.stderr if stream is None else stream
         self.active = bool(getattr(stream, "isatty", lambda: False)())
         self._start = time.perf_counter()
 

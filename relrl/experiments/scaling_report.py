@@ -14,7 +14,7 @@ import platform
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import write_json_atomic
+from relrl.experiments.report import skip_plots, write_json_atomic
 from relrl.experiments.runner import run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
 
@@ -110,7 +110,7 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                         "steps_per_second", "gateway_calls_per_step"],
           [[t["learner"], t["size"], t["seed"], t["kind"], t["learning_steps_per_second"],
             t["steps_per_second"], t["gateway_calls_per_step"]] for t in timing["jobs"]])
-    files += plot(out, results)
+    files += plot(out, results) if not results.get("partial") else skip_plots(out)
     return files
 
 

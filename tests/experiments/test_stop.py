@@ -1,0 +1,100 @@
+"""Stopping ``relrl experiment``: Ctrl-C and SIGTERM end it and its workers within 2 s,
+keeping every finished point; a misbehaving domain stops the run with one line."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from relrl.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+SIS = ROOT / "examples" / "domains" / "sis.pl"
+LONG = ["--seeds", "0", "--learners", "qlearning,etg", "--points", "500", "--eval-runs", "2",
+        "--eval-steps", "100", "--block", "200", "--workers", "2"]
+
+
+def group(pgid: int) -> list[int]:
+    """Processes in a process group (from /proc)."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            fields = stat[stat.rindex(")") + 2:].split()
+            if int(fields[2]) == pgid and fields[0] != "Z":
+                out.append(int(entry))
+    return out
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_stops_the_run_and_its_workers_within_2_s_keeping_points(sig, tmp_path):
+    out = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-m", "relrl", "experiment", "sis", *LONG,
+                             "--out", str(out)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True, cwd=ROOT)
+    try:
+        deadline = time.monotonic() + 60
+        # the parent, multiprocessing's resource tracker and the two workers
+        while len(group(proc.pid)) < 4 and time.monotonic() < deadline:
+            time.sleep(0.1)
+        time.sleep(6.0)                                                    # some points done
+        assert proc.poll() is None, proc.stderr.read()
+        t0 = time.monotonic()
+        proc.send_signal(sig)
+        proc.wait(timeout=10)
+        elapsed = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    stdout, stderr = proc.communicate()
+    assert elapsed < 2.0, elapsed
+    assert proc.returncode == 128 + sig, stderr
+    assert b"Traceback" not in stderr and stderr.strip() == b"", stderr
+    time.sleep(0.2)
+    assert group(proc.pid) == []                                           # no worker left
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] is True and results["interrupted_by"] == sig.name
+    points = [len(j["curve"]) for j in results["jobs"]]
+    assert points and min(points) >= 1 and max(points) < 501
+    assert all(j.get("partial") for j in results["jobs"])
+    assert (out / "fig5_cgi.csv").exists() and b"partial" in stdout
+
+
+def _domain(tmp_path: Path, extra: str, after: str = "") -> Path:
+    text = SIS.read_text()
+    if after:
+        text = text.replace("fact(green_toy(toy)).", "fact(green_toy(toy)).\n" + after)
+    path = tmp_path / "bad.pl"
+    path.write_text(text + extra)
+    return path
+
+
+@pytest.mark.parametrize(("extra", "after", "message"), [
+    ("oops(:- .\n", "", r"bad\.pl:\d+: Syntax error"),
+    (":- halt.\n", "", "ended without a result"),
+    ("deep(face) :- deeper(face).\ndeeper(X) :- deeper(X), true.\n", "fact(deep(face)).",
+     "Stack limit"),
+])
+def test_a_misbehaving_domain_stops_the_run_with_one_line(extra, after, message, tmp_path,
+                                                          capsys) -> None:
+    domain = _domain(tmp_path, extra, after)
+    code = main(["experiment", "sis", "--domain", str(domain), "--learners", "etg",
+                 "--points", "1", "--eval-runs", "1", "--eval-steps", "50", "--block", "50",
+                 "--workers", "1", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err and "BrokenProcessPool" not in err
+    import re
+
+    assert re.search(message, err), err
