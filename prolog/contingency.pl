@@ -13,6 +13,8 @@
 :- use_module(library(random)).
 :- use_module(library(pairs)).
 :- use_module(declarations).
+:- use_module(engine).
+:- use_module(rules).
 
 /** <module> Contingency learning
 
@@ -85,7 +87,7 @@ matching_rule(KB, Code, N, R, learned(Code, N, R), F) :-
 matching_rule(KB, _, N, R, authored(Id), F) :-
     authored_(KB, Id, Antecedent, R, N1-F),
     N1 == N,
-    catch(once(KB:Antecedent), _, fail).
+    rule_holds(KB, Antecedent).
 
 sum_list_of(Slices, Total) :-
     foldl(add_slice, Slices, 0, Total).
@@ -187,3 +189,72 @@ contingency_size(KB, size(Rules, Rules)) :-
     aggregate_all(count, learned_(KB, _, _, _, _), L),
     aggregate_all(count, authored_(KB, _, _, _, _), A),
     Rules is L + A.
+
+%   ---- The engine's hooks (see engine.pl) ------------------------------------------------
+
+relrl_engine:learner(contingency).
+
+relrl_engine:learner_init(contingency, KB, _Params) :-
+    contingency_init(KB).
+
+relrl_engine:learner_choose(contingency, KB, Code, N, Allowed, _Mode, Action) :-
+    engine_config(KB, params, Params),
+    contingency_choose(KB, Code, N, Allowed, Params, Action).
+
+relrl_engine:learner_update(contingency, KB, transition(Code0, A0, N0, _, Reinforced, _, _, _)) :-
+    engine_config(KB, params, Params),
+    contingency_update(KB, Code0, A0, N0, Reinforced, Params).
+
+relrl_engine:learner_explain(contingency, KB, Code, N, contingency(Ranked)) :-
+    contingency_explain(KB, Code, N, Ranked).
+
+relrl_engine:learner_size(contingency, KB, size(Positions, [rules=Rules])) :-
+    contingency_size(KB, size(Rules, Positions)).
+
+relrl_engine:learner_text(contingency, KB, Text) :-
+    contingency_rules(KB, Rules),
+    with_output_to(string(Text),
+                   forall(member(behaviour(A, R, N, F), Rules),
+                          format("~q -> ~q [~q] fitness ~4f~n", [A, R, N, F]))).
+
+relrl_engine:learner_knowledge(contingency, KB, Rules) :-
+    contingency_rules(KB, Rules).
+
+relrl_engine:learner_save(contingency, KB, S) :-
+    contingency_rules(KB, Rules),
+    forall(member(behaviour(A, R, N, F), Rules),
+           portray_clause(S, learned_behaviour(A, R, N, F))).
+
+relrl_engine:learner_policy_term(contingency, learned_behaviour(_, _, _, _)).
+
+%   Rebuild the rules from policy terms read as data. A learned rule's antecedent is
+%   state(Code); any other antecedent must be one the domain itself authored (a policy file
+%   never brings a goal of its own to run).
+relrl_engine:learner_restore(contingency, KB, Terms) :-
+    findall(behaviour(A, R, N, F), member(learned_behaviour(A, R, N, F), Terms), Rules),
+    maplist(check_rule(KB), Rules),
+    contingency_restore(KB, Rules).
+
+check_rule(KB, behaviour(A, R, N, F)) :-
+    (   A = state(Code)
+    ->  must_be(nonneg, Code)
+    ;   behaviour_rule(KB, A0, R0, N0, _), A0 =@= A, R0 =@= R, N0 =@= N
+    ->  true
+    ;   domain_error(authored_behaviour_rule, behaviour(A, R, N))
+    ),
+    (   kb_response(KB, R0), R0 =@= R
+    ->  true
+    ;   domain_error(response, R)
+    ),
+    must_be(atom, N),
+    must_be(number, F).
+
+relrl_engine:learner_snapshot(contingency, KB, matched(Matches)) :-
+    (   matched_(KB, Matches0)
+    ->  Matches = Matches0
+    ;   Matches = []
+    ).
+
+relrl_engine:learner_resume(contingency, KB, matched(Matches)) :-
+    retractall(matched_(KB, _)),
+    assertz(matched_(KB, Matches)).

@@ -1,18 +1,26 @@
 :- module(relrl_engine,
-          [ engine_configure/4,   % +KB, +Learner, +Params, +Seed
-            engine_step/5,        % +KB, +Percepts, +Emitted, +Learning, -Out
-            engine_end_episode/1, % +KB
-            engine_explain/2,     % +KB, -Explanation
-            engine_explain_now/2, % +KB, -Explanation
-            engine_tree/2,        % +KB, -Text
-            engine_size/2,        % +KB, -Size
-            engine_save/3,        % +KB, +File, +Header
-            engine_adopt/1,       % +KB
-            engine_param/3,       % +KB, ?Name, ?Value
-            engine_responses/2,   % +KB, -Responses
-            engine_save_random/1, % +Slot
-            engine_restore_random/1, % +Slot
-            engine_set_random/1   % +SeedSpec
+          [ engine_configure/4,       % +KB, +Learner, +Params, +Seed
+            engine_step/6,            % +KB, +Percepts, +Emitted, +Mode, +Want, -Out
+            engine_end_episode/1,     % +KB
+            engine_explain/3,         % +KB, +When, -Explanation
+            engine_text/2,            % +KB, -Text
+            engine_graph/2,           % +KB, -Graph
+            engine_knowledge/2,       % +KB, -Terms
+            engine_size/2,            % +KB, -Size
+            engine_save/3,            % +KB, +File, +Header
+            engine_snapshot/2,        % +KB, -Snapshot
+            engine_restore/2,         % +KB, +Snapshot
+            engine_keep/2,            % +KB, +Slot
+            engine_resume/2,          % +KB, +Slot
+            engine_reseed/2,          % +KB, +Seed
+            engine_forget/1,          % +KB
+            engine_param/3,           % +KB, ?Name, ?Value
+            engine_config/3,          % +KB, ?Key, ?Value
+            engine_learner/2,         % +KB, -Learner
+            engine_responses/2,       % +KB, -Responses
+            engine_necessities/2,     % +KB, -Necessities
+            engine_holds/2,           % +KB, +Goal
+            engine_relational_state/2 % +KB, -Facts
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -23,84 +31,217 @@
 :- use_module(declarations).
 :- use_module(perception).
 :- use_module(state).
-:- use_module(responses).
 :- use_module(motivation).
-:- use_module(qtree).
-:- use_module(etg).
-:- use_module(contingency).
+:- use_module(rules).
 
 /** <module> The control step, inside Prolog
 
-One call of engine_step/5 does all the knowledge work of a control step, so the robot's
+One call of engine_step/6 does all the knowledge work of a control step, so the robot's
 loop crosses from Python into Prolog once per step:
 
-    percepts -> working memory -> state code -> necessity units and mediator -> reward
-    -> learner update for the previous step (Eq. 4 / contingency) -> allowed responses
-    -> learner choice
+    percepts -> working memory -> state code (+ the learner's view of the state)
+    -> necessity units and mediator -> reward -> learner update for the previous step
+    -> allowed responses -> learner choice
 
-Learners that live in Prolog (etg, contingency) choose here; a learner that lives in Python
-(`external`, e.g. Q-learning over numpy) gets the state, necessity, reward and allowed
-responses and chooses itself.
+## Learners are hooks
+
+The engine knows no learner by name. A learner is a module that adds clauses, keyed on its
+name, to the multifile hooks below (learners.pl loads every learner module); adding one
+touches its own file and one line of learners.pl.
+
+  | learner(Name)                                   | registers Name                         |
+  | learner_property(Name, external)                | Python chooses (Q-learning over numpy) |
+  | learner_init(Name, KB, Params)                  | start afresh                           |
+  | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
+  | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
+  | learner_update(Name, KB, Transition)            | transition(S0, A0, N0, R, Reinforced, S1, N1, Allowed1) |
+  | learner_explain(Name, KB, State, N, Explanation)| why it would choose what it chooses    |
+  | learner_size(Name, KB, size(Positions, Details))| memory in the paper's positions        |
+  | learner_save(Name, KB, Stream)                  | write the learned knowledge as clauses |
+  | learner_policy_term(Name, Term)                 | Term may appear in Name's policy file  |
+  | learner_restore(Name, KB, Terms)                | rebuild from policy terms (data)       |
+  | learner_text(Name, KB, Text)                    | optional: the knowledge as text        |
+  | learner_graph(Name, KB, graph(Nodes, Edges))    | optional: a tree as a graph            |
+  | learner_knowledge(Name, KB, Terms)              | optional: the knowledge as terms       |
+  | learner_end_episode(Name, KB)                   | optional                               |
+  | learner_snapshot(Name, KB, Snap) / learner_resume(Name, KB, Snap) | optional: episode state |
+
+## Random numbers
+
+Each knowledge base owns its random stream: the engine swaps it in around every call that
+may draw numbers and keeps it with the knowledge base, so two agents in one process give the
+same trajectories as each alone. Learners just use library(random).
+
+## Errors
+
+Domain goals (facts, tests, constraint and behaviour rules, necessity inputs) run through
+engine_holds/2: a goal that fails is false; any exception — a time limit, a resource error,
+an existence error — propagates, wrapped as relrl_rule_error(Goal, Where, Error) so the
+gateway can name the rule.
 */
 
-:- dynamic
-    config_/3,      % KB, Key, Value
-    prev_/3.        % KB, Description, Necessity of the last step
+:- multifile
+    learner/1,
+    learner_property/2,
+    learner_init/3,
+    learner_state/4,
+    learner_choose/7,
+    learner_update/3,
+    learner_explain/5,
+    learner_size/3,
+    learner_save/3,
+    learner_policy_term/2,
+    learner_restore/3,
+    learner_text/3,
+    learner_graph/3,
+    learner_knowledge/3,
+    learner_end_episode/2,
+    learner_snapshot/3,
+    learner_resume/3.
 
-%!  engine_param(+KB, ?Name, ?Value) is nondet.
-%
-%   A parameter of KB's engine (alpha, gamma, epsilon, ...).
+%   Each knowledge base's engine lives in two global variables (per KB, so one KB never
+%   sees another's):
+%     '$relrl_run:KB'  run(Learner, Params, Features, Responses, Units, Reinforcers,
+%                          Constraints, Necessities) — fixed for a run, read without copying
+%     '$relrl_eng:KB'  eng(Prev, Random) — Prev is prev(State, Necessity) of the last step
+%                      or none; Random the KB's random state.
 
-engine_param(KB, Name, Value) :-
-    config_(KB, params, Params),
-    member(Name=Value, Params).
+run_key(KB, Key) :- atom_concat('$relrl_run:', KB, Key).
+eng_key(KB, Key) :- atom_concat('$relrl_eng:', KB, Key).
 
-config(KB, Key, Value) :-
-    (   config_(KB, Key, Value0)
-    ->  Value = Value0
+run(KB, Run) :-
+    run_key(KB, Key),
+    (   nb_current(Key, Run0)
+    ->  Run = Run0
     ;   existence_error(engine_configuration, KB)
     ).
 
+eng(KB, Eng) :-
+    eng_key(KB, Key),
+    nb_getval(Key, Eng).
+
+set_eng(KB, Eng) :-
+    eng_key(KB, Key),
+    nb_setval(Key, Eng).
+
+%!  engine_learner(+KB, -Learner) is det.
+%
+%   The learner KB's engine was configured with.
+
+engine_learner(KB, Learner) :-
+    run(KB, run(Learner, _, _, _, _, _, _, _)).
+
+%!  engine_param(+KB, ?Name, ?Value) is nondet.
+%!  engine_param(+KB, +Name, -Value) is semidet.
+%
+%   A parameter of KB's learner (alpha, gamma, epsilon, ...).
+
+engine_param(KB, Name, Value) :-
+    run(KB, run(_, Params, _, _, _, _, _, _)),
+    (   atom(Name)
+    ->  memberchk(Name=Value, Params)
+    ;   member(Name=Value, Params)
+    ).
+
+%!  engine_config(+KB, ?Key, ?Value) is nondet.
+%!  engine_config(+KB, +Key, -Value) is semidet.
+%
+%   What the engine was configured with: learner, params, features (stimulus(S) and fact(F)
+%   in code order), responses (in declaration order), units, reinforcers, constraints
+%   (true when the domain has constraint rules), necessities.
+
+engine_config(KB, Key, Value) :-
+    run(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
+                Necessities)),
+    Config = [learner-Learner, params-Params, features-Features, responses-Responses,
+              units-Units, reinforcers-Reinforcers, constraints-Constraints,
+              necessities-Necessities],
+    (   atom(Key)
+    ->  memberchk(Key-Value, Config)
+    ;   member(Key-Value, Config)
+    ).
+
+%!  engine_responses(+KB, -Responses:list) is det.
+%
+%   The responses in the order engine_step/6 indexes them.
+
+engine_responses(KB, Responses) :-
+    run(KB, run(_, _, _, Responses, _, _, _, _)).
+
+%!  engine_necessities(+KB, -Necessities:list) is det.
+%
+%   The necessities in declaration order (the order of a step's unit outputs).
+
+engine_necessities(KB, Necessities) :-
+    run(KB, run(_, _, _, _, _, _, _, Necessities)).
+
 %!  engine_configure(+KB, +Learner, +Params:list, +Seed) is det.
 %
-%   Prepare KB for a run with Learner (etg, contingency or external) and Params
-%   (Name=Value). Working memory, the necessity units and the learner start afresh; Seed,
-%   an integer, seeds Prolog's random numbers (`none` leaves them alone).
+%   Prepare KB for a run with Learner (a registered learner) and Params (Name=Value).
+%   Working memory, the necessity units and the learner start afresh. Seed, an integer,
+%   seeds KB's own random stream; `none` gives it a stream seeded from the clock.
+%
+%   @error domain_error(learner, Learner) if no learner of that name is registered.
 
 engine_configure(KB, Learner, Params, Seed) :-
     must_be(atom, KB),
-    must_be(oneof([etg, contingency, external]), Learner),
+    must_be(atom, Learner),
     must_be(list, Params),
-    retractall(config_(KB, _, _)),
-    retractall(prev_(KB, _, _)),
+    (   learner(Learner)
+    ->  true
+    ;   findall(L, learner(L), Known),
+        domain_error(learner(Known), Learner)
+    ),
     state_features(KB, Features),
-    findall(G, declared(KB, etg_test(G)), Extra),
-    append(Features, Extra, Tests),
-    length(Features, NF),
-    findall(S, kb_reinforcer(KB, S), Reinforcers),
     findall(R, kb_response(KB, R), Responses),
+    findall(S, kb_reinforcer(KB, S), Reinforcers),
+    findall(N, kb_necessity(KB, N), Necessities),
     motivation_units(KB, Units),
-    (   current_predicate(KB:forbidden/1),
-        \+ predicate_property(KB:forbidden(_), imported_from(_))
+    (   domain_defines(KB, forbidden(_))
     ->  Constraints = true
     ;   Constraints = false
     ),
-    forall(member(K-V, [learner-Learner, params-Params, features-Features,
-                        extra_tests-Extra, n_features-NF, reinforcers-Reinforcers,
-                        responses-Responses, units-Units, constraints-Constraints]),
-           assertz(config_(KB, K, V))),
-    (   integer(Seed)
-    ->  set_random(seed(Seed))
-    ;   true
-    ),
+    run_key(KB, RunKey),
+    nb_setval(RunKey, run(Learner, Params, Features, Responses, Units, Reinforcers,
+                          Constraints, Necessities)),
+    fresh_random(Seed, Random),
+    set_eng(KB, eng(none, Random)),
     wm_clear(KB),
     motivation_reset(KB),
-    (   Learner == etg
-    ->  etg_init(KB, Tests)
-    ;   Learner == contingency
-    ->  contingency_init(KB)
-    ;   true
-    ).
+    with_random(KB, learner_init(Learner, KB, Params)).
+
+domain_defines(KB, Head) :-
+    functor(Head, Name, Arity),
+    current_predicate(KB:Name/Arity),
+    \+ predicate_property(KB:Head, imported_from(_)).
+
+fresh_random(Seed, Random) :-
+    (   integer(Seed)
+    ->  set_random(seed(Seed))
+    ;   Seed == none
+    ->  set_random(seed(random))
+    ;   type_error(integer, Seed)
+    ),
+    random_property(state(Random)).
+
+%   Run Goal with KB's random stream in place; keep the stream KB leaves behind.
+with_random(KB, Goal) :-
+    eng(KB, eng(_, Random0)),
+    set_random(state(Random0)),
+    call(Goal),
+    random_property(state(Random)),
+    eng(KB, eng(Prev, _)),
+    set_eng(KB, eng(Prev, Random)).
+
+%!  engine_reseed(+KB, +Seed:integer) is det.
+%
+%   Seed KB's own random stream.
+
+engine_reseed(KB, Seed) :-
+    must_be(integer, Seed),
+    eng(KB, eng(Prev, _)),
+    fresh_random(Seed, Random),
+    set_eng(KB, eng(Prev, Random)).
 
 %!  engine_end_episode(+KB) is det.
 %
@@ -108,115 +249,106 @@ engine_configure(KB, Learner, Params, Seed) :-
 %   the necessity units start afresh.
 
 engine_end_episode(KB) :-
-    retractall(prev_(KB, _, _)),
+    run(KB, run(Learner, _, _, _, _, _, _, _)),
+    eng(KB, eng(_, Random)),
+    set_eng(KB, eng(none, Random)),
     wm_clear(KB),
-    motivation_reset(KB).
+    motivation_reset(KB),
+    (   learner_end_episode(Learner, KB)
+    ->  true
+    ;   true
+    ).
 
-%!  engine_step(+KB, +Percepts, +Emitted, +Learning, -Out) is det.
+%!  engine_forget(+KB) is det.
+%
+%   Forget KB's engine (its configuration, last step and random stream).
+
+engine_forget(KB) :-
+    run_key(KB, RunKey),
+    eng_key(KB, EngKey),
+    forall(member(K, [RunKey, EngKey]),
+           (   nb_current(K, _)
+           ->  nb_delete(K)
+           ;   true
+           )).
+
+%!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
 %
 %   One control step. Percepts are this step's perception facts; Emitted is the index
 %   (0-based, in declaration order) of the response emitted at the previous step, or -1;
-%   Learning is `true` to update the learner from the previous step and explore,
-%   `explore` to act with the learner's exploration (epsilon) without learning, `false` to
-%   act greedily without learning.
+%   Mode is `learn` (update the learner from the previous step and explore), `explore`
+%   (act with the learner's exploration without learning) or `greedy` (neither). Want lists
+%   what else to report: memory (working memory as Age-Element pairs), memory_size,
+%   explain (the learner's explanation for this step's state).
 %
-%   Out = step(Code, Necessity, Ys, Reward, Allowed, Action): the state code, the active
-%   necessity (or none), the necessity units' outputs (a list in declaration order), the
-%   reward for the previous response, the allowed responses as a bit mask (bit i set when
-%   response i is allowed), and the index of the learner's choice (-1 for learners outside
-%   Prolog or when nothing is allowed).
-%   Indices keep the bridge to Python cheap; engine_responses/2 maps them to terms.
+%   Out = step(Code, Necessity, Ys, Reward, Reinforced, Allowed, Action, Extras): the state
+%   code, the active necessity (or none), the necessity units' outputs (a list in
+%   declaration order), the reward for the previous response, true/false, the allowed
+%   responses as a bit mask (bit i set when response i is allowed), the index of the
+%   learner's choice (-1 for a learner outside Prolog, or when nothing is allowed), and
+%   Extras, a list of Key-Value pairs for Want.
 
-engine_step(KB, Percepts, EmittedIx, Learning, step(Code, Active, Ys, Reward, AllowedMask,
-                                                    ActionIx)) :-
-    config(KB, responses, Responses),
+engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
+    run(KB, Run),
+    eng(KB, eng(Prev, Random0)),
+    set_random(state(Random0)),
+    step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
+    random_property(state(Random)),
+    set_eng(KB, eng(Next, Random)).
+
+step(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints, _),
+     Prev, Percepts, EmittedIx, Mode, Want,
+     step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
+     prev(State, Active)) :-
     (   EmittedIx >= 0
     ->  nth0(EmittedIx, Responses, Emitted),
-        Elements = [emitted(Emitted)|Percepts]
-    ;   Emitted = none,
-        Elements = Percepts
+        wm_insert(KB, [emitted(Emitted)|Percepts])
+    ;   wm_insert(KB, Percepts)
     ),
-    wm_insert(KB, Elements),
-    description_now(KB, Code, D),
-    config(KB, units, Units),
+    features_code(KB, Features, Code),
+    learner_view(Learner, KB, Code, State),
     motivation_step(KB, Units, Outputs, Active),
     pairs_values(Outputs, Ys),
-    config(KB, reinforcers, Reinforcers),
-    config(KB, params, Params),
     (   reinforced(KB, Reinforcers)
     ->  Reinforced = true, memberchk(reward_positive=Reward, Params)
     ;   Reinforced = false, memberchk(reward_negative=Reward, Params)
     ),
-    allowed(KB, Responses, AllowedIx, Allowed),
+    allowed(KB, Constraints, Responses, AllowedIx, Allowed),
     foldl(set_bit, AllowedIx, 0, AllowedMask),
-    config(KB, learner, Learner),
-    (   Learning == true,
-        Emitted \== none,
-        prev_(KB, D0, N0)
-    ->  learn(Learner, KB, D0, Emitted, N0, Reward, Reinforced, D, Active, Allowed, Params)
+    (   Mode == learn,
+        EmittedIx >= 0,
+        Prev = prev(S0, N0)
+    ->  learner_update(Learner, KB, transition(S0, Emitted, N0, Reward, Reinforced,
+                                               State, Active, Allowed))
     ;   true
     ),
-    choose(Learner, KB, D, Active, Allowed, Learning, Params, Action),
-    (   Action == none
+    (   ( Allowed == [] ; learner_property(Learner, external) )
     ->  ActionIx = -1
-    ;   nth0(ActionIx, Responses, Action)
+    ;   learner_choose(Learner, KB, State, Active, Allowed, Mode, Action),
+        nth0(ActionIx, Responses, Action)
     ->  true
+    ;   existence_error(learner_choice, Learner)
     ),
-    retractall(prev_(KB, _, _)),
-    assertz(prev_(KB, D, Active)).
+    extras(Want, KB, Learner, State, Active, Extras).
 
-%!  engine_save_random(+Slot) is det.
-%!  engine_restore_random(+Slot) is det.
-%!  engine_set_random(+SeedSpec) is det.
-%
-%   Save the state of Prolog's random numbers under the atom Slot, restore it, or seed
-%   them (seed(N)): an evaluation can draw its own numbers without changing the learner's
-%   future.
-
-engine_save_random(Slot) :-
-    must_be(atom, Slot),
-    random_property(state(S)),
-    atom_concat('$relrl_random:', Slot, Key),
-    nb_setval(Key, S).
-
-engine_restore_random(Slot) :-
-    atom_concat('$relrl_random:', Slot, Key),
-    nb_getval(Key, S),
-    set_random(state(S)).
-
-engine_set_random(Spec) :-
-    (   ( Spec = state(_) ; Spec = seed(_) )
-    ->  set_random(Spec)
-    ;   domain_error(random_spec, Spec)
+learner_view(Learner, KB, Code, State) :-
+    (   learner_state(Learner, KB, Code, State0)
+    ->  State = State0
+    ;   State = Code
     ).
 
-%!  engine_responses(+KB, -Responses:list) is det.
-%
-%   The responses in the order engine_step/5 indexes them.
+extras([], _, _, _, _, []) :- !.
+extras(Want, KB, Learner, State, N, Extras) :-
+    foldl(extra(KB, Learner, State, N), Want, Extras, []).
 
-engine_responses(KB, Responses) :-
-    config(KB, responses, Responses).
-
-%   The state code of working memory now, and its description: the code with a bit for
-%   each extra ETG test above it.
-description_now(KB, Code, D) :-
-    config(KB, features, Features),
-    features_code(KB, Features, Code),
-    config(KB, extra_tests, Extra),
-    describe(KB, Extra, Code, D).
-
-%   The description: the state code, with a bit for each extra ETG test above it.
-describe(_, [], Code, Code) :- !.
-describe(KB, Extra, Code, D) :-
-    config(KB, n_features, NF),
-    foldl(extra_bit(KB), Extra, NF-Code, _-D).
-
-extra_bit(KB, Goal, I-D0, I1-D) :-
-    I1 is I + 1,
-    (   catch(once(KB:Goal), _, fail)
-    ->  D is D0 \/ (1 << I)
-    ;   D = D0
-    ).
+extra(KB, _, _, _, memory, [memory-Pairs|T], T) :- !,
+    wm_elements(KB, Pairs).
+extra(KB, _, _, _, memory_size, [memory_size-Size|T], T) :- !,
+    wm_size(KB, Size).
+extra(KB, Learner, State, N, explain, [explain-E|T], T) :- !,
+    explanation(KB, Learner, State, N, E).
+extra(_, _, _, _, What, _, _) :-
+    domain_error(step_report, What).
 
 reinforced(KB, Reinforcers) :-
     member(S, Reinforcers),
@@ -225,8 +357,8 @@ reinforced(KB, Reinforcers) :-
     wm_element(KB, Percept, 0),
     !.
 
-allowed(KB, Responses, AllowedIx, Allowed) :-
-    (   config(KB, constraints, true)
+allowed(KB, Constraints, Responses, AllowedIx, Allowed) :-
+    (   Constraints == true
     ->  findall(I-R, ( nth0(I, Responses, R), \+ forbidden(KB, R) ), Pairs)
     ;   findall(I-R, nth0(I, Responses, R), Pairs)
     ),
@@ -236,148 +368,176 @@ set_bit(I, M0, M) :-
     M is M0 \/ (1 << I).
 
 forbidden(KB, R) :-
-    catch(KB:forbidden(R), error(existence_error(procedure, _), _), fail),
-    !.
+    engine_holds(KB, forbidden(R)).
 
-learn(etg, KB, D0, A0, N0, Reward, _, D, N, Allowed, Params) :-
-    etg_update(KB, D0, A0, N0, Reward, D, N, Allowed, Params).
-learn(contingency, KB, D0, A0, N0, _, Reinforced, _, _, _, Params) :-
-    contingency_update(KB, D0, A0, N0, Reinforced, Params).
-learn(external, _, _, _, _, _, _, _, _, _, _).
-
-choose(_, _, _, _, [], _, _, none) :- !.
-choose(etg, KB, D, N, Allowed, Learning, Params0, Action) :-
-    (   Learning \== false
-    ->  Params = Params0
-    ;   Params = [epsilon=0|Params0]
-    ),
-    etg_choose(KB, D, N, Allowed, Params, Action, _).
-choose(contingency, KB, D, N, Allowed, _, Params, Action) :-
-    contingency_choose(KB, D, N, Allowed, Params, Action).
-choose(external, _, _, _, _, _, _, none).
-
-%!  engine_explain(+KB, -Explanation) is det.
+%!  engine_holds(+KB, +Goal) is semidet.
 %
-%   Why the learner would choose what it chooses in the last step's state.
-%   etg: etg(Path, Ranked); contingency: contingency(Ranked); external: external(Code, N).
+%   Run the domain goal Goal once in KB. Failure is false; an exception propagates as
+%   relrl_rule_error(Goal, Where, Error) (Where is File:Line of the predicate's first
+%   clause, or unknown), so a time limit or a resource error in a rule reaches the caller
+%   and names the rule.
 
-engine_explain(KB, Explanation) :-
-    (   prev_(KB, D, N)
+engine_holds(KB, Goal) :-
+    rule_holds(KB, Goal).
+
+%!  engine_relational_state(+KB, -Facts:list) is det.
+%
+%   Facts are the ground solutions, now, of the domain's relation/1 templates, sorted and
+%   without duplicates: the relational view of the state a relational learner reads.
+
+engine_relational_state(KB, Facts) :-
+    findall(T, declared(KB, relation(T)), Templates),
+    findall(F, ( member(F, Templates), rule_solution(KB, F), ground(F) ), Facts0),
+    sort(Facts0, Facts).
+
+%!  engine_explain(+KB, +When, -Explanation) is det.
+%
+%   Why the learner would choose what it chooses: When is `last` (the last step's state and
+%   necessity) or `now` (the state in working memory now; the necessity the units would
+%   give now; nothing is learned or moved). Explanation is
+%   explanation(Learner, State, Necessity, Detail), Detail from the learner.
+
+engine_explain(KB, When, Explanation) :-
+    must_be(oneof([last, now]), When),
+    run(KB, run(Learner, _, Features, _, Units, _, _, _)),
+    (   When == last,
+        eng(KB, eng(prev(State, N), _))
     ->  true
-    ;   D = 0, N = none
+    ;   features_code(KB, Features, Code),
+        learner_view(Learner, KB, Code, State),
+        motivation_peek(KB, Units, _, N)
     ),
-    explain(KB, D, N, Explanation).
+    explanation(KB, Learner, State, N, Explanation).
 
-explain(KB, D, N, Explanation) :-
-    config(KB, learner, Learner),
-    (   Learner == etg
-    ->  etg_explain(KB, D, N, explain(Path, Ranked)),
-        Explanation = etg(D, N, Path, Ranked)
-    ;   Learner == contingency
-    ->  contingency_explain(KB, D, N, Ranked),
-        Explanation = contingency(D, N, Ranked)
-    ;   Explanation = external(D, N)
+explanation(KB, Learner, State, N, explanation(Learner, State, N, Detail)) :-
+    (   learner_explain(Learner, KB, State, N, Detail0)
+    ->  Detail = Detail0
+    ;   Detail = none
     ).
 
-%!  engine_explain_now(+KB, -Explanation) is det.
+%!  engine_text(+KB, -Text:string) is det.
 %
-%   As engine_explain/2, for the state in working memory now (the necessity is the one
-%   the units would give now; nothing is learned or moved).
+%   The learner's knowledge drawn as text ("" for a learner that has no drawing).
 
-engine_explain_now(KB, Explanation) :-
-    description_now(KB, _, D),
-    config(KB, units, Units),
-    motivation_peek(KB, Units, _, N),
-    explain(KB, D, N, Explanation).
-
-%!  engine_tree(+KB, -Text:string) is det.
-%
-%   The ETG tree of KB drawn as text (empty for other learners).
-
-engine_tree(KB, Text) :-
-    (   config(KB, learner, etg)
-    ->  qtree_format(KB, Text)
+engine_text(KB, Text) :-
+    engine_learner(KB, Learner),
+    (   learner_text(Learner, KB, Text0)
+    ->  Text = Text0
     ;   Text = ""
+    ).
+
+%!  engine_graph(+KB, -Graph) is det.
+%
+%   The learner's tree as graph(Nodes, Edges) (node(Id, test|leaf, Label),
+%   edge(From, To, yes|no)); graph([], []) for a learner without a tree.
+
+engine_graph(KB, Graph) :-
+    engine_learner(KB, Learner),
+    (   learner_graph(Learner, KB, Graph0)
+    ->  Graph = Graph0
+    ;   Graph = graph([], [])
+    ).
+
+%!  engine_knowledge(+KB, -Terms:list) is det.
+%
+%   The learner's knowledge as a list of terms ([] for a learner that does not list it).
+
+engine_knowledge(KB, Terms) :-
+    engine_learner(KB, Learner),
+    (   learner_knowledge(Learner, KB, Terms0)
+    ->  Terms = Terms0
+    ;   Terms = []
     ).
 
 %!  engine_size(+KB, -Size) is det.
 %
-%   The learner's memory: etg(Nodes, Leaves, Entries, Positions),
-%   contingency(Rules, Positions), or external.
+%   Size is size(Learner, Positions, Details): memory in the paper's positions and the
+%   learner's own counts (Details, a list of Key=Value).
 
-engine_size(KB, Size) :-
-    config(KB, learner, Learner),
-    (   Learner == etg
-    ->  etg_size(KB, size(A, B, C, P)), Size = etg(A, B, C, P)
-    ;   Learner == contingency
-    ->  contingency_size(KB, size(R, P)), Size = contingency(R, P)
-    ;   Size = external
+engine_size(KB, size(Learner, Positions, Details)) :-
+    engine_learner(KB, Learner),
+    (   learner_size(Learner, KB, size(Positions, Details))
+    ->  true
+    ;   Positions = 0, Details = []
     ).
+
+%!  engine_snapshot(+KB, -Snapshot) is det.
+%!  engine_restore(+KB, +Snapshot) is det.
+%
+%   Save and restore what an evaluation may disturb: working memory, the necessity units,
+%   the last step, the random stream and the learner's episode state. The learned knowledge
+%   itself is not part of it (evaluating must not change it in the first place).
+
+engine_snapshot(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
+    engine_learner(KB, Learner),
+    wm_state(KB, Memory),
+    motivation_outputs(KB, Units),
+    eng(KB, Eng),
+    (   learner_snapshot(Learner, KB, LearnerSnap0)
+    ->  LearnerSnap = LearnerSnap0
+    ;   LearnerSnap = none
+    ).
+
+engine_restore(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
+    engine_learner(KB, Learner),
+    wm_set_state(KB, Memory),
+    motivation_set_outputs(KB, Units),
+    set_eng(KB, Eng),
+    (   LearnerSnap == none
+    ->  true
+    ;   learner_resume(Learner, KB, LearnerSnap)
+    ).
+
+%!  engine_keep(+KB, +Slot) is det.
+%!  engine_resume(+KB, +Slot) is det.
+%
+%   engine_snapshot/2 kept inside Prolog under the atom Slot, and restored from it (the
+%   slot is forgotten). What Python uses: the snapshot never crosses the bridge.
+
+engine_keep(KB, Slot) :-
+    must_be(atom, Slot),
+    engine_snapshot(KB, Snapshot),
+    slot_key(KB, Slot, Key),
+    nb_setval(Key, Snapshot).
+
+engine_resume(KB, Slot) :-
+    must_be(atom, Slot),
+    slot_key(KB, Slot, Key),
+    (   nb_current(Key, Snapshot)
+    ->  nb_delete(Key),
+        engine_restore(KB, Snapshot)
+    ;   existence_error(engine_snapshot, Slot)
+    ).
+
+slot_key(KB, Slot, Key) :-
+    atomic_list_concat(['$relrl_snap:', KB, ':', Slot], Key).
 
 %!  engine_save(+KB, +File, +Header:string) is det.
 %
-%   Write KB's learned knowledge to File as Prolog facts that plain swipl consults:
-%   relrl_policy/2 (learner and the tests the tree uses), etg_node/2 and
-%   learned_behaviour/4. The file is written next to File and renamed into place, so a
-%   reader never sees half a policy.
+%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with the
+%   domain's features and responses, then the learner's own clauses. Plain swipl consults
+%   the file; relrl reads it back as data (policy.pl). The file is written next to File
+%   and renamed into place, so a reader never sees half a policy.
 
 engine_save(KB, File, Header) :-
-    config(KB, learner, Learner),
-    config(KB, features, Features),
-    config(KB, extra_tests, Extra),
-    append(Features, Extra, Tests),
+    run(KB, run(Learner, _, Features, Responses, _, _, _, _)),
     atom_concat(File, '.tmp', Tmp),
     setup_call_cleanup(
         open(Tmp, write, S, [encoding(utf8)]),
-        write_policy(S, KB, Learner, Tests, Header),
+        write_policy(S, KB, Learner, Features, Responses, Header),
         close(S)),
     rename_file(Tmp, File).
 
-write_policy(S, KB, Learner, Tests, Header) :-
-    format(S, "% ~w~n", [Header]),
-    format(S, "% Consult in plain swipl, or load with: relrl shell DOMAIN.pl --policy FILE~n~n",
+write_policy(S, KB, Learner, Features, Responses, Header) :-
+    split_string(Header, "\n", "", Lines),
+    forall(member(L, Lines), format(S, "% ~w~n", [L])),
+    format(S, "% Consult in plain swipl, or load with: relrl shell DOMAIN.pl --policy FILE~n",
            []),
-    format(S, ":- discontiguous etg_node/2, learned_behaviour/4.~n~n", []),
-    portray_clause(S, relrl_policy(Learner, Tests)),
+    format(S, "% relrl reads this file as data: a directive or a foreign clause is refused.~n~n",
+           []),
+    portray_clause(S, relrl_policy(Learner, [features(Features), responses(Responses)])),
     nl(S),
-    (   Learner == etg
-    ->  forall(qtree_node(KB, Id, Node), portray_clause(S, etg_node(Id, Node)))
-    ;   Learner == contingency
-    ->  contingency_rules(KB, Rules),
-        forall(member(behaviour(A, R, N, F), Rules),
-               portray_clause(S, learned_behaviour(A, R, N, F)))
-    ;   true
-    ).
-
-%!  engine_adopt(+KB) is det.
-%
-%   Take over the policy facts consulted into KB (relrl_policy/2, etg_node/2,
-%   learned_behaviour/4) as the engine's learned knowledge.
-%
-%   @error domain_error(policy_tests, Tests) if the policy was learned over other tests.
-
-engine_adopt(KB) :-
-    (   declared(KB, relrl_policy(Learner, Tests))
+    (   learner_save(Learner, KB, S)
     ->  true
-    ;   existence_error(policy, KB)
-    ),
-    config(KB, features, Features),
-    config(KB, extra_tests, Extra),
-    append(Features, Extra, Mine),
-    (   Tests =@= Mine
-    ->  true
-    ;   domain_error(policy_tests, Tests)
-    ),
-    config(KB, learner, Configured),
-    (   Learner == Configured
-    ->  true
-    ;   domain_error(policy_learner(Configured), Learner)
-    ),
-    (   Learner == etg
-    ->  findall(Id-Node, declared(KB, etg_node(Id, Node)), Nodes),
-        qtree_restore(KB, Tests, Nodes)
-    ;   Learner == contingency
-    ->  findall(behaviour(A, R, N, F), declared(KB, learned_behaviour(A, R, N, F)), Rules),
-        contingency_restore(KB, Rules)
     ;   true
     ).

@@ -10,6 +10,9 @@
 :- use_module(library(apply)).
 :- use_module(library(random)).
 :- use_module(qtree).
+:- use_module(engine).
+:- use_module(declarations).
+:- use_module(rules).
 
 /** <module> Economic TG (ETG)
 
@@ -153,3 +156,118 @@ entry_for(N, e(_, _, N1)) :-
 etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
     qtree_size(KB, Nodes, Leaves, Entries),
     Positions is Nodes + Entries.
+
+%   ---- The engine's hooks (see engine.pl) ------------------------------------------------
+
+%   The candidate tests of KB's tree: the domain's features (stimulus(S), fact(F)) in code
+%   order, then its etg_test/1 goals. A state's description is its code with a bit for each
+%   extra test above the features' bits.
+
+tests_key(KB, Key) :- atom_concat('$relrl_etg:', KB, Key).
+
+relrl_engine:learner(etg).
+
+relrl_engine:learner_init(etg, KB, _Params) :-
+    engine_config(KB, features, Features),
+    findall(G, declared(KB, etg_test(G)), Extra),
+    length(Features, NF),
+    tests_key(KB, Key),
+    nb_setval(Key, extra(NF, Extra)),
+    append(Features, Extra, Tests),
+    etg_init(KB, Tests).
+
+relrl_engine:learner_state(etg, KB, Code, D) :-
+    tests_key(KB, Key),
+    nb_getval(Key, extra(NF, Extra)),
+    (   Extra == []
+    ->  D = Code
+    ;   foldl(extra_bit(KB), Extra, NF-Code, _-D)
+    ).
+
+extra_bit(KB, Goal, I-D0, I1-D) :-
+    I1 is I + 1,
+    (   rule_holds(KB, Goal)
+    ->  D is D0 \/ (1 << I)
+    ;   D = D0
+    ).
+
+relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
+    engine_config(KB, params, Params0),
+    (   Mode == greedy
+    ->  Params = [epsilon=0|Params0]
+    ;   Params = Params0
+    ),
+    etg_choose(KB, D, N, Allowed, Params, Action, _).
+
+relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, R, _, D1, N1, Allowed1)) :-
+    engine_config(KB, params, Params),
+    etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params).
+
+relrl_engine:learner_explain(etg, KB, D, N, etg(Path, Ranked)) :-
+    etg_explain(KB, D, N, explain(Path, Ranked)).
+
+relrl_engine:learner_size(etg, KB, size(Positions, [nodes=Nodes, leaves=Leaves,
+                                                    entries=Entries])) :-
+    etg_size(KB, size(Nodes, Leaves, Entries, Positions)).
+
+relrl_engine:learner_text(etg, KB, Text) :-
+    qtree_format(KB, Text).
+
+relrl_engine:learner_graph(etg, KB, Graph) :-
+    qtree_graph(KB, Graph).
+
+relrl_engine:learner_save(etg, KB, S) :-
+    qtree_tests(KB, Tests),
+    portray_clause(S, etg_tests(Tests)),
+    nl(S),
+    forall(qtree_node(KB, Id, Node), portray_clause(S, etg_node(Id, Node))).
+
+relrl_engine:learner_policy_term(etg, etg_tests(_)).
+relrl_engine:learner_policy_term(etg, etg_node(_, _)).
+
+%   Rebuild the tree from policy terms read as data: the tests must be this domain's, and
+%   every node well formed (no goal from the file is ever run).
+relrl_engine:learner_restore(etg, KB, Terms) :-
+    qtree_tests(KB, Mine),
+    (   memberchk(etg_tests(Tests), Terms)
+    ->  true
+    ;   existence_error(policy_term, etg_tests/1)
+    ),
+    (   Tests =@= Mine
+    ->  true
+    ;   domain_error(policy_tests(Mine), Tests)
+    ),
+    findall(Id-Node, member(etg_node(Id, Node), Terms), Nodes),
+    maplist(check_node(Tests), Nodes),
+    qtree_restore(KB, Tests, Nodes).
+
+check_node(Tests, Id-Node) :-
+    must_be(nonneg, Id),
+    (   Node = test(I, Goal, Yes, No)
+    ->  must_be(nonneg, I),
+        (   nth0(I, Tests, Test), Test =@= Goal
+        ->  true
+        ;   domain_error(etg_test(I), Goal)
+        ),
+        maplist(check_branch, [Yes, No])
+    ;   Node = leaf(Rep, Entries)
+    ->  (   Rep == none
+        ->  true
+        ;   must_be(nonneg, Rep)
+        ),
+        must_be(list, Entries),
+        maplist(check_entry, Entries)
+    ;   domain_error(etg_node, Node)
+    ).
+
+check_branch(B) :-
+    (   B == nil
+    ->  true
+    ;   must_be(nonneg, B)
+    ).
+
+check_entry(E) :-
+    (   E = e(A, Q, N), callable(A), number(Q), atom(N)
+    ->  true
+    ;   domain_error(etg_entry, E)
+    ).

@@ -1,12 +1,14 @@
 :- module(relrl_gateway,
           [ gw_run/3,             % :Goal, +TimeLimit, -Result
             gw_load/3,            % +File, +Module, -Problems
+            gw_load/4,            % +File, +Module, +TimeLimit, -Problems
+            gw_take_abort/1,      % -Where
+            python_api/1,         % ?PredicateIndicator
             gw_query/5,           % +Module, +Text, +TimeLimit, +MaxSolutions, -Result
             gw_new_kb/1,          % -Module
             gw_drop_kb/1,         % +Module
             gw_findall/3,         % +Module, +Template, -List
-            gw_parse/3,           % +Module, +Text, -Terms
-            gw_policy_learner/2   % +File, -Learner
+            gw_parse/3            % +Module, +Text, -Terms
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -14,6 +16,7 @@
 :- use_module(library(time)).
 :- use_module(relrl).
 :- use_module(declarations).
+:- use_module(policy).
 
 /** <module> The Prolog side of relrl's Python gateway
 
@@ -23,9 +26,17 @@ Prolog error never escapes as an uncaught exception into the host and every quer
 bounded in time:
 
   - gw_run/3 runs a goal once under a time limit;
-  - gw_load/3 consults a domain file into a knowledge-base module and collects every
-    error and warning with its file and line instead of printing them;
+  - gw_load/4 consults a domain file into a knowledge-base module under a time limit and
+    collects every error and warning with its file and line instead of printing them;
   - gw_query/5 parses a query typed by a user and collects its solutions as bindings.
+
+gw_run/3 runs only goals of a knowledge-base module (the user's own domain) or of the
+public API listed by python_api/1: the exact contract between relrl's Python and its
+Prolog. Nothing else of relrl's Prolog is reachable from Python, tests included.
+
+Nothing a loaded file or a rule does can end the program: halt/0,1 called during any
+gateway call is cancelled and reported as an error naming the file and line when it came
+from a directive; abort/0 is reported (gw_take_abort/1) instead of unwinding silently.
 
 A knowledge base is a module of its own (gw_new_kb/1), so two knowledge bases in one
 process never see each other's clauses or working memory.
@@ -41,7 +52,111 @@ process never see each other's clauses or working memory.
 %   A TimeLimit of 0 means no limit.
 
 gw_run(Goal, Limit, Result) :-
-    catch(limited(Goal, Limit, Result), E, error_result(E, Result)).
+    active(catch(api_limited(Goal, Limit, Result0), E, error_result(E, Result0)), Result0,
+           Result).
+
+api_limited(Goal, Limit, Result) :-
+    strip_module(Goal, M, G),
+    (   callable(G),
+        functor(G, Name, Arity),
+        (   kb_module_(M)
+        ->  true
+        ;   python_api(M:Name/Arity)
+        )
+    ->  limited(Goal, Limit, Result)
+    ;   functor(G, Name, Arity),
+        permission_error(call, private_predicate, M:Name/Arity)
+    ).
+
+%   Run Goal as a gateway call: halt/0,1 is cancelled while it runs (see halt_hook/0) and
+%   turns Result0 into an error result.
+active(Goal, Result0, Result) :-
+    (   nb_current(relrl_active, Was)
+    ->  true
+    ;   Was = false
+    ),
+    setup_call_cleanup(
+        ( nb_setval(relrl_active, true), nb_setval(relrl_halt, none) ),
+        Goal,
+        nb_setval(relrl_active, Was)),
+    nb_getval(relrl_halt, Halt),
+    (   Halt == none
+    ->  Result = Result0
+    ;   nb_setval(relrl_halt, none),
+        halt_message(Halt, Message),
+        Result = error(halt_called(Halt), Message)
+    ).
+
+halt_message(Where, Message) :-
+    (   Where = File:Line
+    ->  format(string(Message), "~w:~w: halt/0,1 called while loading (a loaded file \c
+                                 cannot end relrl)", [File, Line])
+    ;   format(string(Message), "halt/0,1 called by a goal (a rule cannot end relrl)", [])
+    ).
+
+:- initialization(at_halt(relrl_gateway:halt_hook)).
+
+%   at_halt/1 hook: inside a gateway call, cancel the halt and remember where it came from.
+halt_hook :-
+    (   nb_current(relrl_active, true)
+    ->  load_location(Where),
+        nb_setval(relrl_halt, Where),
+        cancel_halt(relrl_gateway)
+    ;   true
+    ).
+
+load_location(Where) :-
+    (   prolog_load_context(file, File),
+        prolog_load_context(term_position, Pos),
+        stream_position_data(line_count, Pos, Line)
+    ->  Where = File:Line
+    ;   Where = goal
+    ).
+
+%!  python_api(?PI) is nondet.
+%
+%   The predicates of relrl's Prolog that Python may call through gw_run/3, as
+%   Module:Name/Arity. Everything else is private.
+
+python_api(relrl_engine:engine_configure/4).
+python_api(relrl_engine:engine_step/6).
+python_api(relrl_engine:engine_end_episode/1).
+python_api(relrl_engine:engine_explain/3).
+python_api(relrl_engine:engine_text/2).
+python_api(relrl_engine:engine_graph/2).
+python_api(relrl_engine:engine_knowledge/2).
+python_api(relrl_engine:engine_size/2).
+python_api(relrl_engine:engine_save/3).
+python_api(relrl_engine:engine_keep/2).
+python_api(relrl_engine:engine_resume/2).
+python_api(relrl_engine:engine_reseed/2).
+python_api(relrl_engine:engine_responses/2).
+python_api(relrl_engine:engine_necessities/2).
+python_api(relrl_engine:engine_learner/2).
+python_api(relrl_engine:engine_relational_state/2).
+python_api(relrl_policy:policy_learner/2).
+python_api(relrl_policy:policy_load/2).
+python_api(relrl_memory:wm_insert/2).
+python_api(relrl_memory:wm_elements/2).
+python_api(relrl_memory:wm_clear/1).
+python_api(relrl_memory:wm_clock/2).
+python_api(relrl_memory:wm_set_span/2).
+python_api(relrl_state:state_code/2).
+python_api(relrl_state:state_terms/2).
+python_api(relrl_state:state_decode/3).
+python_api(relrl_state:state_encode/3).
+python_api(relrl_state:state_features/2).
+python_api(relrl_responses:allowed_responses/2).
+python_api(relrl_declarations:necessity_inputs/3).
+python_api(relrl_check:check_domain/2).
+python_api(relrl_check:rule_listing/2).
+python_api(relrl_gateway:gw_new_kb/1).
+python_api(relrl_gateway:gw_drop_kb/1).
+python_api(relrl_gateway:gw_load/4).
+python_api(relrl_gateway:gw_query/5).
+python_api(relrl_gateway:gw_findall/3).
+python_api(relrl_gateway:gw_parse/3).
+python_api(relrl_gateway:gw_take_abort/1).
 
 limited(Goal, Limit, Result) :-
     (   Limit > 0
@@ -65,14 +180,82 @@ limited(Goal, Limit, Result) :-
 watchdog(Alarm) :-
     (   nb_current(relrl_watchdog, Alarm0)
     ->  Alarm = Alarm0
-    ;   alarm(3600, throw(time_limit_exceeded), Alarm,
+    ;   alarm(3600, relrl_gateway:time_up, Alarm,
               [remove(false), install(false)]),
         nb_setval(relrl_watchdog, Alarm)
     ).
 
+%   The alarm: remember where a file being loaded was (a directive that never ends), then
+%   throw as call_with_time_limit/2 does.
+time_up :-
+    load_location(Where),
+    nb_setval(relrl_timeout_where, Where),
+    throw(time_limit_exceeded).
+
+%!  error_result(+Exception, -Result) is det.
+%
+%   Result is error(Kind, Message) for Exception: Kind keeps the error's structure for
+%   Python (time_limit_exceeded, time_limit_exceeded(rule(Goal, Where)),
+%   rule_error(Goal, Where, Formal), policy_error(File, Line, Text), or the error term
+%   itself) and Message is one line for a person.
+
+error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
+    where_text(Where0, Where),
+    format(string(GoalText), "~q", [Goal]),
+    (   E == time_limit_exceeded
+    ->  Kind = time_limit_exceeded(rule(GoalText, Where)),
+        format(string(Message), "~w: rule ~w ran longer than the time limit (a rule that \c
+                                 never ends?)", [Where, GoalText])
+    ;   E = error(resource_error(Resource), _)
+    ->  Kind = rule_error(GoalText, Where, resource_error(Resource)),
+        format(string(Message), "~w: rule ~w ran out of ~w (a recursion without end?)",
+               [Where, GoalText, Resource])
+    ;   strip_context(E, E1),
+        message_string(E1, Inner),
+        (   E1 = error(Formal, _)
+        ->  true
+        ;   Formal = E1
+        ),
+        Kind = rule_error(GoalText, Where, Formal),
+        format(string(Message), "~w: rule ~w: ~w", [Where, GoalText, Inner])
+    ).
+error_result(error(relrl_policy_error(File, Line, Text), _),
+             error(policy_error(File, Line, Text1), Message)) :- !,
+    one_line(Text, Text1),
+    (   Line > 0
+    ->  format(string(Message), "~w:~w: ~w", [File, Line, Text1])
+    ;   format(string(Message), "~w: ~w", [File, Text1])
+    ).
+error_result('$aborted', error(aborted, "abort/0 called")) :- !,
+    (   nb_current(relrl_abort, W), W \== none
+    ->  true
+    ;   nb_setval(relrl_abort, goal)
+    ).
 error_result(E0, error(E, Message)) :-
     strip_context(E0, E),
     message_string(E, Message).
+
+where_text(File:Line, Where) :- !,
+    format(string(Where), "~w:~w", [File, Line]).
+where_text(_, "(no source)").
+
+one_line(Text, Line) :-
+    split_string(Text, "\n", " \t", Parts0),
+    exclude(==(""), Parts0, Parts),
+    atomic_list_concat(Parts, ' ', A),
+    atom_string(A, Line).
+
+%!  gw_take_abort(-Where) is det.
+%
+%   Where a goal called abort/0 in the last gateway call (File:Line when a file was being
+%   loaded, goal otherwise, none when no abort happened); forgets it.
+
+gw_take_abort(Where) :-
+    (   nb_current(relrl_abort, Where0)
+    ->  Where = Where0
+    ;   Where = none
+    ),
+    nb_setval(relrl_abort, none).
 
 %   The alarm's context is noise for a user; keep the error itself.
 strip_context(error(Formal, context(time:_, _)), error(Formal, _)) :- !.
@@ -96,7 +279,7 @@ message_to_codes(E, Codes) :-
 %
 %   Module is a fresh, empty knowledge-base module that sees relrl's predicates.
 
-:- dynamic kb_counter/1.
+:- dynamic kb_counter/1, kb_module_/1.
 kb_counter(0).
 
 gw_new_kb(Module) :-
@@ -104,6 +287,7 @@ gw_new_kb(Module) :-
     N is N0 + 1,
     assertz(kb_counter(N)),
     format(atom(Module), "relrl_kb_~d", [N]),
+    assertz(kb_module_(Module)),
     set_module(Module:class(user)),
     add_import_module(Module, relrl, start),
     set_prolog_flag(Module:unknown, error).
@@ -115,33 +299,54 @@ gw_new_kb(Module) :-
 gw_drop_kb(Module) :-
     must_be(atom, Module),
     relrl_memory:wm_clear(Module),
+    relrl_engine:engine_forget(Module),
+    retractall(kb_module_(Module)),
     forall(( current_predicate(Module:Name/Arity),
              functor(Head, Name, Arity),
              \+ predicate_property(Module:Head, imported_from(_)) ),
            abolish(Module:Name/Arity)).
 
 %!  gw_load(+File, +Module, -Problems:list) is det.
+%!  gw_load(+File, +Module, +TimeLimit, -Problems:list) is det.
 %
-%   Consult File into Module. Problems lists every error and warning printed while
-%   loading, as problem(Kind, File, Line, Message), in order. Nothing is printed.
-%   A file that does not exist gives one problem with line 0.
+%   Consult File into Module, its directives running under TimeLimit seconds (0: none).
+%   Problems lists every error and warning printed while loading, as
+%   problem(Kind, File, Line, Message), in order. Nothing is printed. A file that does not
+%   exist gives one problem with line 0; a directive that runs past the time limit or calls
+%   halt/0,1 gives an error at its line.
 
 :- dynamic collecting/1, collected/2.
 
 gw_load(File, Module, Problems) :-
+    gw_load(File, Module, 0, Problems).
+
+gw_load(File, Module, Limit, Problems) :-
     must_be(atom, Module),
+    must_be(number, Limit),
     (   exists_file(File)
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),
         gensym(load_, Key),
-        setup_call_cleanup(
-            asserta(collecting(Key)),
-            catch(load_stream(Abs, Id, Module), E, note_exception(Key, Abs, E)),
-            retract(collecting(Key))),
-        findall(P, retract(collected(Key, P)), Problems)
+        nb_setval(relrl_timeout_where, none),
+        active(setup_call_cleanup(
+                   asserta(collecting(Key)),
+                   catch(limited(load_stream(Abs, Id, Module), Limit, _), E,
+                         note_exception(Key, Abs, Limit, E)),
+                   retract(collecting(Key))),
+               true, Result),
+        (   Result = error(halt_called(F:L), _)
+        ->  assertz(collected(Key, problem(error, F, L, "halt/0,1 called while loading \c
+                                       (a loaded file cannot end relrl)")))
+        ;   true
+        ),
+        findall(P, retract(collected(Key, P)), Problems0),
+        exclude(cancelled_halt_warning(Result), Problems0, Problems)
     ;   format(string(Msg), "no such file", []),
         Problems = [problem(error, File, 0, Msg)]
     ).
+
+%   The directive whose halt was cancelled also "failed": one problem for it is enough.
+cancelled_halt_warning(error(halt_called(F:L), _), problem(warning, F, L, _)).
 
 load_stream(Abs, Id, Module) :-
     setup_call_cleanup(
@@ -149,11 +354,26 @@ load_stream(Abs, Id, Module) :-
         load_files(Module:Id, [stream(Stream), if(true)]),
         close(Stream)).
 
-note_exception(Key, File, E) :-
-    message_string(E, Msg),
-    (   E = error(_, file(F, L, _, _))
-    ->  true
-    ;   F = File, L = 0
+note_exception(Key, File, Limit, E) :-
+    (   E == time_limit_exceeded
+    ->  nb_getval(relrl_timeout_where, Where),
+        (   Where = F:L
+        ->  true
+        ;   F = File, L = 0
+        ),
+        format(string(Msg), "loading ran longer than the time limit (~w s): a directive \c
+                             that never ends?", [Limit])
+    ;   E == '$aborted'
+    ->  nb_setval(relrl_abort, File:0),
+        F = File, L = 0, Msg = "abort/0 called while loading"
+    ;   E = relrl_rule_error(_, _, _)
+    ->  error_result(E, error(_, Msg)),
+        F = File, L = 0
+    ;   message_string(E, Msg),
+        (   E = error(_, file(F, L, _, _))
+        ->  true
+        ;   F = File, L = 0
+        )
     ),
     assertz(collected(Key, problem(error, F, L, Msg))).
 
@@ -249,23 +469,3 @@ gw_findall(Module, Template, List) :-
 gw_parse(Module, Text, Terms) :-
     term_string(Term, Text, [module(Module)]),
     comma_list(Term, Terms).
-
-%!  gw_policy_learner(+File, -Learner) is det.
-%
-%   Learner is the learner named by the relrl_policy/2 fact of a saved policy file (read
-%   only, nothing is run). Fails if the file has none.
-
-gw_policy_learner(File, Learner) :-
-    setup_call_cleanup(
-        open(File, read, S),
-        policy_header(S, Learner),
-        close(S)).
-
-policy_header(S, Learner) :-
-    read_term(S, T, []),
-    (   T == end_of_file
-    ->  fail
-    ;   T = relrl_policy(Learner, _)
-    ->  true
-    ;   policy_header(S, Learner)
-    ).

@@ -5,7 +5,10 @@
             wm_clear/1,           % +KB
             wm_span/2,            % +KB, -Span
             wm_set_span/2,        % +KB, +Span
-            wm_clock/2            % +KB, -Clock
+            wm_clock/2,           % +KB, -Clock
+            wm_size/2,            % +KB, -Size
+            wm_state/2,           % +KB, -State
+            wm_set_state/2        % +KB, +State
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -161,3 +164,27 @@ wm_clear(KB) :-
     must_be(atom, KB),
     get(KB, wm(_, Span, _)),
     put(KB, wm(0, Span, [])).
+
+%!  wm_size(+KB, -Size:nonneg) is det.
+%
+%   Size is the number of elements in KB's memory.
+
+wm_size(KB, Size) :-
+    get(KB, wm(_, _, Elements)),
+    length(Elements, Size).
+
+%!  wm_state(+KB, -State) is det.
+%!  wm_set_state(+KB, +State) is det.
+%
+%   Save KB's whole memory (clock, span and elements) as one term, and put it back: an
+%   evaluation can use the memory and leave it as it found it.
+
+wm_state(KB, State) :-
+    get(KB, State).
+
+wm_set_state(KB, State) :-
+    must_be(atom, KB),
+    (   State = wm(Clock, _, Elements), integer(Clock), is_list(Elements)
+    ->  put(KB, State)
+    ;   domain_error(working_memory_state, State)
+    ).

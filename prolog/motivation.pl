@@ -5,6 +5,7 @@
             motivation_step/4,      % +KB, +Units, -Outputs, -Active
             motivation_peek/4,      % +KB, +Units, -Outputs, -Active
             motivation_outputs/2,   % +KB, -Outputs
+            motivation_set_outputs/2, % +KB, +Outputs
             unit_activation/5,      % +Inputs, +Wr, +Ir, +Bias, -U
             unit_output/3           % +U, +Delta, -Y
           ]).
@@ -12,6 +13,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(declarations).
+:- use_module(rules).
 
 /** <module> Consequence control: necessity units and the mediator
 
@@ -72,6 +74,15 @@ motivation_reset(KB) :-
 motivation_outputs(KB, Outputs) :-
     findall(N-Y, output_(KB, N, Y), Outputs).
 
+%!  motivation_set_outputs(+KB, +Outputs:list) is det.
+%
+%   Put back the unit outputs saved with motivation_outputs/2.
+
+motivation_set_outputs(KB, Outputs) :-
+    must_be(list, Outputs),
+    retractall(output_(KB, _, _)),
+    forall(member(N-Y, Outputs), assertz(output_(KB, N, Y))).
+
 %!  motivation_step(+KB, -Outputs:list, -Active) is det.
 %
 %   Compute every unit's output from working memory (Eq. 1, 2), remember it for the
@@ -130,7 +141,7 @@ unit_value(KB, unit(N, B, Wr, Delta, _, Y0, Goals), N-Y) :-
     unit_output(U, Delta, Y).
 
 input_signal(KB, Goal-W, W-I) :-
-    (   once(KB:Goal)
+    (   rule_holds(KB, Goal)
     ->  I = 1
     ;   I = 0
     ).

@@ -11,6 +11,7 @@
             qtree_node/3,         % +Tree, ?Id, ?Node
             qtree_clear/1,        % +Tree
             qtree_format/2,       % +Tree, -Text
+            qtree_graph/2,        % +Tree, -Graph
             qtree_restore/3,      % +Tree, +Tests, +Nodes
             qtree_put_entry/3,    % +Entries0, +Entry, -Entries
             qtree_entry_q/5,      % +Entries, +Action, +Necessity, +Default, -Q
@@ -93,7 +94,10 @@ qtree_tests(Tree, Tests) :-
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
-    node_(Tree, Id, Node).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, Node))
+    ;   node_(Tree, Id, Node)
+    ).
 
 %!  test_holds(+Description, +Index) is semidet.
 
@@ -128,7 +132,7 @@ sort_from(Tree, Id, D, Where) :-
 
 %   Id is a test node; the state described by D takes its Branch (yes or no) to Next.
 step_down(Tree, Id, D, Goal, Branch, Next) :-
-    node_(Tree, Id, test(I, Goal, Yes, No)),
+    once(node_(Tree, Id, test(I, Goal, Yes, No))),
     (   test_holds(D, I)
     ->  Branch = yes, Next = Yes
     ;   Branch = no, Next = No
@@ -156,7 +160,10 @@ path_from(Tree, Id, D, Path) :-
 %!  qtree_leaf(+Tree, ?Id, -Rep, -Entries) is nondet.
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
-    node_(Tree, Id, leaf(Rep, Entries)).
+    (   integer(Id)
+    ->  once(node_(Tree, Id, leaf(Rep, Entries)))
+    ;   node_(Tree, Id, leaf(Rep, Entries))
+    ).
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.
 
@@ -168,7 +175,7 @@ qtree_set_leaf(Tree, Id, _, _) :-
     existence_error(qtree_leaf, Tree-Id).
 
 new_id(Tree, Id) :-
-    retract(next_id_(Tree, Id)),
+    once(retract(next_id_(Tree, Id))),
     Id1 is Id + 1,
     assertz(next_id_(Tree, Id1)).
 
@@ -178,7 +185,7 @@ new_id(Tree, Id) :-
 
 qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
     must_be(oneof([yes, no]), Branch),
-    retract(node_(Tree, Parent, test(I, Goal, Yes, No))),
+    once(retract(node_(Tree, Parent, test(I, Goal, Yes, No)))),
     new_id(Tree, Id),
     (   Branch == yes
     ->  must_be(oneof([nil]), Yes), Node = test(I, Goal, Id, No)
@@ -193,7 +200,7 @@ qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
 %   representative takes; the other branch is empty (nil).
 
 qtree_split(Tree, LeafId, I) :-
-    retract(node_(Tree, LeafId, leaf(Rep, Entries))),
+    once(retract(node_(Tree, LeafId, leaf(Rep, Entries)))),
     tests_(Tree, Tests),
     nth0(I, Tests, Goal),
     new_id(Tree, Id),
@@ -271,3 +278,34 @@ format_branch(_, nil, Indent, Label) :-
     format("~w~wnull~n", [Indent, Label]).
 format_branch(Tree, Id, Indent, Label) :-
     format_node(Tree, Id, Indent, Label).
+
+%!  qtree_graph(+Tree, -Graph) is det.
+%
+%   Graph is graph(Nodes, Edges) for drawing Tree: node(Id, test, Label) for a test node
+%   (Label its goal as text), node(Id, leaf, Label) for a leaf (its entries, best first),
+%   node(nil(Parent, Branch), null, "null") for an empty branch, and edge(From, To, yes|no).
+
+qtree_graph(Tree, graph(Nodes, Edges)) :-
+    findall(N, graph_node(Tree, N), Nodes),
+    findall(E, graph_edge(Tree, E), Edges).
+
+graph_node(Tree, node(Id, test, Label)) :-
+    node_(Tree, Id, test(_, Goal, _, _)),
+    format(string(Label), "~q", [Goal]).
+graph_node(Tree, node(Id, leaf, Label)) :-
+    node_(Tree, Id, leaf(_, Entries)),
+    findall(L, ( member(e(A, Q, N), Entries),
+                 format(string(L), "~q ~2f [~q]", [A, Q, N]) ), Lines),
+    atomic_list_concat(Lines, '\n', Atom),
+    atom_string(Atom, Label).
+graph_node(Tree, node(nil(Id, Branch), null, "null")) :-
+    node_(Tree, Id, test(_, _, Yes, No)),
+    member(Branch-nil, [yes-Yes, no-No]).
+
+graph_edge(Tree, edge(Id, To, Branch)) :-
+    node_(Tree, Id, test(_, _, Yes, No)),
+    member(Branch-Child, [yes-Yes, no-No]),
+    (   Child == nil
+    ->  To = nil(Id, Branch)
+    ;   To = Child
+    ).

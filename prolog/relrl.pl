@@ -25,6 +25,8 @@
 :- use_module(responses).
 :- use_module(check).
 :- use_module(engine).
+:- use_module(learners).
+:- use_module(policy).
 
 /** <module> relrl: the knowledge layer
 

@@ -13,6 +13,7 @@
 :- use_module(library(apply)).
 :- use_module(declarations).
 :- use_module(perception).
+:- use_module(rules).
 
 /** <module> The state code
 
@@ -51,7 +52,7 @@ feature_code(KB, Term, X) :-
 feature_active(KB, stimulus(S)) :-
     stimulus_perceived(KB, S).
 feature_active(KB, fact(F)) :-
-    once(KB:F).
+    rule_holds(KB, F).
 
 %!  state_terms(+KB, -Terms:list) is det.
 %

@@ -18,6 +18,8 @@ __all__ = [
     "PrologError",
     "PrologLoadError",
     "QueryTimeout",
+    "RuleError",
+    "PolicyError",
     "DomainError",
     "ConfigError",
 ]
@@ -65,7 +67,39 @@ class PrologLoadError(UserError):
 
 
 class QueryTimeout(UserError):
-    """A Prolog goal ran longer than its time bound (a runaway rule)."""
+    """A Prolog goal ran longer than its time bound (a runaway rule).
+
+    Attributes:
+        rule: the domain goal that was running (text), when it came from one.
+        where: ``file:line`` of that goal's predicate, when known.
+    """
+
+    def __init__(self, message: str, rule: str | None = None, where: str | None = None) -> None:
+        super().__init__(message)
+        self.rule = rule
+        self.where = where
+
+
+class RuleError(UserError):
+    """A goal of the user's domain raised an error (a stack overflow, an undefined
+    predicate, a call of halt/abort ...) while the engine ran it; the message names the rule
+    and its file and line.
+
+    Attributes:
+        rule: the goal, as text; ``where``: ``file:line``; ``term``: the Prolog error.
+    """
+
+    def __init__(self, message: str, rule: str | None = None, where: str | None = None,
+                 term: Any = None) -> None:
+        super().__init__(message)
+        self.rule = rule
+        self.where = where
+        self.term = term
+
+
+class PolicyError(UserError):
+    """A policy file is not this learner's policy for this domain (or not a policy at all);
+    the message names the file and line. Policies are read as data, never run."""
 
 
 class DomainError(UserError):

@@ -33,7 +33,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from relrl.errors import PrologError, PrologLoadError, QueryTimeout, RelrlError
+from relrl.errors import (
+    PolicyError,
+    PrologError,
+    PrologLoadError,
+    QueryTimeout,
+    RelrlError,
+    RuleError,
+)
 from relrl.terms import Term, Var
 
 __all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls", "DEFAULT_TIMEOUT"]
@@ -44,6 +51,12 @@ PROLOG_DIR = Path(os.environ.get("RELRL_PROLOG_DIR",
 
 #: Seconds a single gateway call may run before it raises QueryTimeout.
 DEFAULT_TIMEOUT = 10.0
+#: Bytes of Prolog stack (all stacks together) before a rule raises a resource error.
+STACK_LIMIT = 512 * 1024 * 1024
+#: Deepest nesting of a term passed from Prolog to Python (deeper, or cyclic, raises).
+MAX_DEPTH = 400
+#: Longest list passed from Prolog to Python.
+MAX_LIST = 10_000_000
 
 # SWI-Prolog 9 foreign-interface constants.
 _PL_VARIABLE, _PL_ATOM, _PL_INTEGER, _PL_RATIONAL, _PL_FLOAT = 1, 2, 3, 4, 5
@@ -244,8 +257,15 @@ class _Engine:
             name = ctypes.string_at(s, n.value).decode("utf-8")
         return name
 
-    def get(self, t: int) -> Term:
-        """Read the term at reference ``t`` as a Python value."""
+    def get(self, t: int, depth: int = 0) -> Term:
+        """Read the term at reference ``t`` as a Python value.
+
+        Raises:
+            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic).
+        """
+        if depth > MAX_DEPTH:
+            raise PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
+                              "cannot be passed to Python", "term_too_deep")
         kind = self.term_type(t)
         if kind == _PL_ATOM:
             return self._text(t, _CVT_ATOM)
@@ -267,11 +287,16 @@ class _Engine:
             head = self.new_term_ref()
             rest = self.new_term_ref()
             self.put_term(rest, t)
+            n = 0
             while self.get_list(rest, head, rest):
-                items.append(self.get(head))
+                items.append(self.get(head, depth + 1))
+                n += 1
+                if n > MAX_LIST:
+                    raise PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) "
+                                      "cannot be passed to Python", "list_too_long")
             if self.term_type(rest) != _PL_NIL:
                 # A partial list [a, b|T]: as the '[|]' compounds it is made of.
-                value: Term = self.get(rest)
+                value: Term = self.get(rest, depth + 1)
                 for item in reversed(items):
                     value = ("[|]", item, value)
                 return value
@@ -284,7 +309,7 @@ class _Engine:
             values = [self._atom_name(name.value)]
             for i in range(1, arity.value + 1):
                 self.get_arg(i, t, arg)
-                values.append(self.get(arg))
+                values.append(self.get(arg, depth + 1))
             return tuple(values)
         if kind == _PL_VARIABLE:
             return Var(self._text(t, _CVT_VARIABLE))
@@ -321,7 +346,11 @@ class _Engine:
                                      self._gw_run, a0)
             if not ok:
                 ex = self.exception(0)
-                detail = self.get(ex) if ex else "no exception"
+                if not ex:
+                    # abort/0 unwinds past every catch/3: gw_run/3 noted where it came from.
+                    self.clear_exception()
+                    raise self._aborted()
+                detail = self.get(ex)
                 self.clear_exception()
                 raise PrologError(f"gateway call failed: {detail!r}", detail)
             result = self.get(a0 + 2)
@@ -346,6 +375,14 @@ class _Engine:
             self.discard_frame(fid)
             self.release_strings(mark.value)
 
+    def _aborted(self) -> RelrlError:
+        """The error for a goal that called abort/0 (asks gw_take_abort/1 where)."""
+        out = self.run((":", "relrl_gateway", ("gw_take_abort", Var())), 0, (0,))
+        where = out[0] if out else "goal"
+        if isinstance(where, tuple) and where[0] == ":":
+            return Aborted(str(where[1]), where[2] or None)
+        return Aborted(None, None)
+
     def _bootstrap(self) -> None:
         gateway = PROLOG_DIR / "gateway.pl"
         if not gateway.exists():
@@ -354,7 +391,10 @@ class _Engine:
         fid = self.open_frame()
         try:
             t = self.new_term_ref()
-            self.put(t, ("use_module", str(gateway)), {})
+            # A runaway recursion in a rule must end soon: 512 MB of stack (SWI-Prolog's
+            # default is 1 GB) overflows in about 1.5 s here instead of 3.
+            self.put(t, (",", ("set_prolog_flag", "stack_limit", STACK_LIMIT),
+                         ("use_module", str(gateway))), {})
             pred = self.predicate(b"call", 1, b"user")
             if not self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION, pred, t):
                 raise RelrlError(f"cannot load {gateway}")
@@ -363,15 +403,48 @@ class _Engine:
         self._gw_run = self.predicate(b"gw_run", 3, b"relrl_gateway")
 
 
+class Aborted(RuleError):
+    """A loaded file or a rule called abort/0."""
+
+    def __init__(self, path: str | None, line: int | None) -> None:
+        where = f"{_display_path(path)}:{line}" if path and line else (
+            _display_path(path) if path else None)
+        text = "abort/0 called" + (" while loading" if path else " by a goal")
+        super().__init__(f"{where}: {text}" if where else text, "abort", where)
+        self.path = path
+        self.line = line
+
+
 def _raise_result(result: Term, timeout: float) -> None:
     """Turn an error(E, Message) result of gw_run/3 into a Python exception."""
     if isinstance(result, tuple) and result[0] == "error":
         error, message = result[1], result[2]
         message = _KB_MODULE.sub("", str(message))
-        if error == "time_limit_exceeded":
+        kind = error[0] if isinstance(error, tuple) else error
+        if kind == "time_limit_exceeded":
+            if isinstance(error, tuple):  # time_limit_exceeded(rule(Goal, Where))
+                _, (_, rule, where) = error
+                raise QueryTimeout(f"{_where(where)}: rule {_KB_MODULE.sub('', rule)} ran longer "
+                                   f"than {timeout:g} s (a rule that never ends?)", rule, where)
             raise QueryTimeout(f"query ran longer than {timeout:g} s (a rule that never ends?)")
+        if kind == "rule_error":
+            _, rule, where, formal = error
+            raise RuleError(message.replace(str(where), _where(where), 1),
+                            _KB_MODULE.sub("", rule), _where(where), formal)
+        if kind == "policy_error":
+            raise PolicyError(message.replace(str(error[1]), _display_path(str(error[1])), 1))
+        if kind == "halt_called":
+            raise RuleError(message, "halt", None, error)
+        if kind == "aborted":
+            raise Aborted(None, None)
         raise PrologError(message, error)
     raise PrologError(f"unexpected gateway result {result!r}", result)
+
+
+def _where(where: str) -> str:
+    """``file:line`` with the file shown relative to the working directory."""
+    path, sep, line = str(where).rpartition(":")
+    return f"{_display_path(path)}:{line}" if sep and path else str(where)
 
 
 _engine: _Engine | None = None
@@ -431,8 +504,13 @@ class KnowledgeBase:
                 or (when ``strict``) a warning; the message names file and line.
         """
         p = Path(path)
-        out = self._engine.run((":", "relrl_gateway", ("gw_load", str(p), self.module, Var())),
-                               0, (2,))
+        try:
+            out = self._engine.run((":", "relrl_gateway",
+                                    ("gw_load", str(p), self.module, float(self.timeout),
+                                     Var())), 0, (3,))
+        except Aborted as exc:
+            raise PrologLoadError(_display_path(str(p)), None,
+                                  "abort/0 called while loading") from exc
         problems = [Problem(kind, str(f) if f else str(p), line or None, msg)
                     for (_, kind, f, line, msg) in out[0]]  # type: ignore[index]
         problems = [Problem(pr.kind, _display_path(pr.path), pr.line, pr.message)
@@ -495,43 +573,53 @@ class KnowledgeBase:
 
     # -- the knowledge layer ---------------------------------------------------------------
 
+    # Each method below is one goal of the knowledge layer, named in relrl.engine.GOALS.
+
     def insert(self, elements: Iterable[Term]) -> None:
         """One insertion of ``elements`` into working memory (they get age 0)."""
-        self.call("relrl_memory:wm_insert", self.module, list(elements))
+        _engine_call(self, "wm_insert", self.module, list(elements))
 
     def memory(self) -> list[tuple[int, Term]]:
         """Working memory as ``(age, element)`` pairs, youngest first."""
-        out = self.call("relrl_memory:wm_elements", self.module, Var())
-        return [(age, element) for (_, age, element) in out[0]]  # type: ignore[index]
+        pairs = _engine_call(self, "wm_elements", self.module, Var())[0]
+        return [(age, element) for (_, age, element) in pairs]
 
     def clear_memory(self) -> None:
         """Forget every element of working memory."""
-        self.call("relrl_memory:wm_clear", self.module)
+        _engine_call(self, "wm_clear", self.module)
 
     def state_code(self) -> int:
         """The current state code: sum of 2^x over the stimuli and facts that hold now."""
-        return self.call("relrl_state:state_code", self.module, Var())[0]  # type: ignore[index]
+        return _engine_call(self, "state_code", self.module, Var())[0]
 
     def state_terms(self) -> list[Term]:
         """The stimuli and facts that hold now, as ``("stimulus", S)`` / ``("fact", F)``."""
-        return self.call("relrl_state:state_terms", self.module, Var())[0]  # type: ignore
+        return _engine_call(self, "state_terms", self.module, Var())[0]
 
     def decode_state(self, code: int) -> list[Term]:
         """The stimuli and facts whose bits are set in ``code``."""
-        return self.call("relrl_state:state_decode", self.module, code, Var())[0]  # type: ignore
+        return _engine_call(self, "state_decode", self.module, code, Var())[0]
+
+    def encode_state(self, terms: list[Term]) -> int:
+        """The state code of ``terms`` (``("stimulus", S)`` / ``("fact", F)`` features)."""
+        return _engine_call(self, "state_encode", self.module, terms, Var())[0]
 
     def features(self) -> list[Term]:
         """Every stimulus and fact in code order (position x has code 2^x)."""
-        return self.call("relrl_state:state_features", self.module, Var())[0]  # type: ignore
+        return _engine_call(self, "state_features", self.module, Var())[0]
 
     def allowed_responses(self) -> list[Term]:
         """The responses the constraint rules allow now, in declaration order."""
-        return self.call("relrl_responses:allowed_responses", self.module, Var())[0]  # type: ignore
+        return _engine_call(self, "allowed_responses", self.module, Var())[0]
 
     def declarations(self, kind: str) -> list[Term]:
         """All ``kind`` declarations (``stimulus``, ``fact``, ``response``, ``necessity``)."""
-        out = self.call("relrl_gateway:gw_findall", self.module, (kind, Var("X")), Var())
-        return [t[1] for t in out[0]]  # type: ignore[index]
+        return [t[1] for t in self.find(kind, Var("X"))]
+
+    def find(self, name: str, *arguments: Term) -> list[Term]:
+        """Every declaration ``name(arguments...)`` of the domain, as terms (a template with
+        :class:`~relrl.terms.Var` arguments; nothing but the domain's own clauses is run)."""
+        return _engine_call(self, "findall", self.module, (name, *arguments), Var())[0]
 
     # -- life cycle ------------------------------------------------------------------------
 
@@ -552,6 +640,12 @@ class KnowledgeBase:
         return f"KnowledgeBase({self.module}: {files})"
 
 
+def _engine_call(kb: KnowledgeBase, goal: str, *arguments: Term) -> list:
+    from relrl.engine import call
+
+    return call(kb, goal, *arguments)
+
+
 def _display_path(path: str) -> str:
     """Show a path relative to the working directory when it is below it."""
     try:
@@ -564,10 +658,13 @@ def measure_call_cost(n: int = 2000) -> float:
     """Seconds per gateway call with one binding (``relrl_state:state_code``-sized work)."""
     kb = KnowledgeBase()
     try:
-        kb.call("relrl_memory:wm_clock", kb.module, Var())
+        from relrl.engine import GOALS
+
+        goal = GOALS["wm_clock"]
+        kb.call(goal, kb.module, Var())
         t0 = time.perf_counter()
         for _ in range(n):
-            kb.call("relrl_memory:wm_clock", kb.module, Var())
+            kb.call(goal, kb.module, Var())
         return (time.perf_counter() - t0) / n
     finally:
         kb.close()

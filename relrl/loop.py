@@ -9,15 +9,17 @@ optional :class:`~relrl.interfaces.Actuator` with an agent.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import contextlib
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from relrl.engine import Engine
 from relrl.errors import UserError
 from relrl.interfaces import Actuator, Environment
-from relrl.kb import Cached, KnowledgeBase
+from relrl.kb import KnowledgeBase
 from relrl.learners.base import Learner, StepOut
-from relrl.terms import Term, Var
+from relrl.terms import Term
 
 __all__ = ["Agent", "Interaction", "StepRecord", "run"]
 
@@ -28,27 +30,28 @@ class Agent:
     Args:
         kb: the knowledge base holding the domain.
         learner: the learner (see :func:`relrl.learners.make_learner`).
-        seed: seeds Prolog's and the learner's random numbers: same seed, same run.
+        seed: seeds the agent's own random streams (its knowledge base's Prolog stream and
+            the learner's numpy generator): same seed, same run, whatever other agents in
+            the process do. None seeds them from the clock.
     """
 
     def __init__(self, kb: KnowledgeBase, learner: Learner, *, seed: int | None = 0) -> None:
         self.kb = kb
         self.learner = learner
         self.seed = seed
-        learner.attach(kb, seed)
-        (responses,) = kb.call("relrl_engine:engine_responses", kb.module, Var())
-        self.responses: list[Term] = responses
-        (names,) = kb.call("relrl_gateway:gw_findall", kb.module, ("necessity", Var()), Var())
-        self.necessities: list[str] = [n[1] for n in names]
+        self.engine = Engine(kb)
+        learner.attach(self.engine, seed)
+        self.responses: list[Term] = self.engine.responses
+        self.necessities: list[str] = self.engine.necessities
         self._emitted = -1
-        self.emitted: Term = "none"
+        self.emitted: Term | None = None
         self.steps = 0
         self.states: set[int] = set()
 
     def step(self, percepts: Sequence[Term], *, learning: bool = True,
-             explore: bool | None = None) -> StepOut:
+             explore: bool | None = None, want: Iterable[str] = ()) -> StepOut:
         """One control step from this time unit's percepts; returns what happened and the
-        response to emit (``out.action``).
+        response to emit (``out.action``, None when nothing is allowed).
 
         Args:
             percepts: this time unit's perception facts.
@@ -56,46 +59,67 @@ class Agent:
             explore: keep the learner's exploration (epsilon); by default only when learning.
                 Evaluating with ``learning=False, explore=True`` measures the behaviour the
                 robot shows, without changing what it knows.
+            want: what else to report from the same gateway call: ``"memory"`` (working
+                memory with ages), ``"memory_size"``, ``"explain"`` (the learner's
+                explanation of this step's choice).
         """
         if explore is None:
             explore = learning
-        mode = "true" if learning else ("explore" if explore else "false")
-        (raw,) = self.kb.call("relrl_engine:engine_step", self.kb.module,
-                              Cached(percepts if isinstance(percepts, list) else list(percepts)),
-                              self._emitted, mode, Var())
-        _, code, necessity, ys, reward, mask, action = raw
+        mode = "learn" if learning else ("explore" if explore else "greedy")
+        r = self.engine.step(percepts, self._emitted, mode, want)
         responses = self.responses
-        allowed = [i for i in range(len(responses)) if mask >> i & 1]
-        out = StepOut(code, necessity, dict(zip(self.necessities, ys, strict=True)), reward,
-                      [responses[i] for i in allowed], responses[action] if action >= 0 else "none",
-                      allowed)
+        allowed = r.allowed_index
+        out = StepOut(r.code, r.necessity, dict(zip(self.necessities, r.outputs, strict=True)),
+                      r.reward, [responses[i] for i in allowed],
+                      responses[r.action_index] if r.action_index >= 0 else None, allowed,
+                      reinforced=r.reinforced, memory=r.memory, memory_size=r.memory_size)
         out.action = self.learner.act(out, learning, explore)
+        if r.explanation is not None:
+            out.explanation = self.learner.decode_explanation(r.explanation)
         self.emitted = out.action
         self._emitted = self._index_of(out.action)
         self.steps += 1
-        self.states.add(code)
+        self.states.add(r.code)
         return out
 
+    @contextlib.contextmanager
+    def preserved(self) -> Iterator[Agent]:
+        """Within the block the agent may act (an evaluation); on exit its working memory,
+        necessity units, last step and every random stream are as they were, so what it
+        learns afterwards does not depend on what was evaluated.
+
+        The learned knowledge is not saved: act with ``learning=False`` inside."""
+        slot = self.engine.keep()
+        learner_state = self.learner.episode_state()
+        emitted = (self._emitted, self.emitted)
+        try:
+            yield self
+        finally:
+            self.engine.resume(slot)
+            self.learner.set_episode_state(learner_state)
+            self._emitted, self.emitted = emitted
+
     def save_random(self) -> Any:
-        """Save the state of every random stream the agent draws from (Prolog's, the
-        learner's); :meth:`restore_random` puts it back."""
-        self.kb.call("relrl_engine:engine_save_random", self.kb.module)
-        return self.learner.rng.bit_generator.state
+        """Save the state of every random stream the agent draws from (its knowledge
+        base's, the learner's); :meth:`restore_random` puts it back. Prefer
+        :meth:`preserved`, which saves the episode state as well."""
+        return (self.engine.keep(), self.learner.rng.bit_generator.state)
 
     def restore_random(self, saved: Any) -> None:
-        """Restore the random streams saved by :meth:`save_random`."""
-        self.kb.call("relrl_engine:engine_restore_random", self.kb.module)
-        self.learner.rng.bit_generator.state = saved
+        """Restore the random streams (and episode state) saved by :meth:`save_random`."""
+        slot, state = saved
+        self.engine.resume(slot)
+        self.learner.rng.bit_generator.state = state
 
     def reseed(self, seed: int) -> None:
         """Seed every random stream the agent draws from."""
         import numpy as np
 
-        self.kb.call("relrl_engine:engine_set_random", ("seed", int(seed)))
+        self.engine.reseed(int(seed))
         self.learner.rng = np.random.default_rng(int(seed))
 
-    def _index_of(self, action: Term) -> int:
-        if action == "none":
+    def _index_of(self, action: Term | None) -> int:
+        if action is None:
             return -1
         try:
             return self.responses.index(action)
@@ -105,9 +129,9 @@ class Agent:
 
     def end_episode(self) -> None:
         """End an interaction: forget the last step and working memory."""
-        self.kb.call("relrl_engine:engine_end_episode", self.kb.module)
+        self.engine.end_episode()
         self.learner.end_episode()
-        self.emitted = "none"
+        self.emitted = None
         self._emitted = -1
 
 
@@ -154,10 +178,12 @@ class Interaction:
         return self.info
 
     def run(self, steps: int, *, learning: bool = True, explore: bool | None = None,
-            keep: bool = True) -> list[StepRecord]:
+            keep: bool = True, want: Iterable[str] = ()) -> list[StepRecord]:
         """Run ``steps`` time units; returns their records (none when ``keep`` is False).
 
-        ``learning`` and ``explore`` are as in :meth:`Agent.step`."""
+        ``learning``, ``explore`` and ``want`` are as in :meth:`Agent.step` (what ``want``
+        asks for arrives in each record's ``out`` from the step's one gateway call)."""
+        want = tuple(want)
         if self.info is None:
             self.reset()
         assert self.info is not None
@@ -166,8 +192,8 @@ class Interaction:
         info = self.info
         for _ in range(steps):
             percepts = info["percepts"]
-            out = agent.step(percepts, learning=learning, explore=explore)
-            if actuator is not None and out.action != "none":
+            out = agent.step(percepts, learning=learning, explore=explore, want=want)
+            if actuator is not None and out.action is not None:
                 actuator.emit(out.action)
             _, env_reward, terminated, truncated, info = env.step(out.action)
             self.info = info

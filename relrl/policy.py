@@ -14,7 +14,7 @@ from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from relrl.loop import Agent
 from relrl.shell import Shell, command
-from relrl.terms import Var, format_term
+from relrl.terms import format_term
 
 __all__ = ["policy_learner", "load_policy", "attach_learner"]
 
@@ -26,10 +26,9 @@ def policy_learner(path: str | Path, kb: KnowledgeBase) -> str:
         raise UserError(f"{path}: no such policy file")
     if path.suffix == ".npz":
         return "qlearning"
-    out = kb.call("relrl_gateway:gw_policy_learner", str(path), Var())
-    if out is None:
-        raise UserError(f"{path}: not a relrl policy (no relrl_policy/2 fact)")
-    return out[0]
+    from relrl.engine import policy_learner as read_learner
+
+    return read_learner(kb, path)
 
 
 def attach_learner(shell: Shell, name: str) -> Agent:

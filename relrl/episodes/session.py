@@ -147,14 +147,19 @@ def _live_line(t: int, phase: str, record: Any, outcome: str | None, said: str |
     wants = (f"{out.necessity} ({out.outputs.get(out.necessity, 0.0):.2f})"
              if out.necessity != "none" else
              "nothing (" + ", ".join(f"{k} {v:.2f}" for k, v in out.outputs.items()) + ")")
+    does = format_term(out.action) if out.action is not None else "nothing"
     text = (f"t={t:<4d} [{phase}] perceives: "
             f"{', '.join(format_term(p) for p in record.percepts)}\n"
-            f"       wants: {wants}  does: {format_term(out.action)}  reward {out.reward:+.0f}")
+            f"       wants: {wants}  does: {does}  reward {out.reward:+.0f}")
     if said:
         text += f'  says: "{said}"'
     if outcome:
         text += f"  naming: {outcome}"
     return text
+
+
+#: What a traced step asks the engine for, in the step's one gateway call.
+TRACE_WANTS = ("memory_size", "explain")
 
 
 def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
@@ -176,12 +181,12 @@ def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
     trace.write({
         "t": run.t, "phase": phase,
         "percepts": [format_term(p) for p in record.percepts],
-        "memory": len(run.kb.memory()),
+        "memory": out.memory_size,
         "state": out.code, "necessity": out.necessity,
         "activation": {k: round(v, 6) for k, v in out.outputs.items()},
-        "reward": out.reward, "response": format_term(out.action),
+        "reward": out.reward, "response": format_term(out.action) if out.action is not None else None,
         "allowed": [format_term(a) for a in out.allowed],
-        "explanation": run.learner.explain(),
+        "explanation": out.explanation,
         "caregiver": info.get("scene"), "focus": info["record"].focus,
         "heard": info["words"], "naming": outcome, "said": said,
     })
@@ -253,7 +258,8 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             phase_name = phase.name
             _pull_words(run, env)
             run.t = t
-            interaction.run(1, learning=phase.learning, keep=False)
+            interaction.run(1, learning=phase.learning, keep=False,
+                            want=TRACE_WANTS if out is not None else ())
             if opts.step_seconds:
                 time.sleep(opts.step_seconds)
         if ev and not stop() and episode.steps % ev["every"] == 0:

@@ -11,13 +11,15 @@ from __future__ import annotations
 import abc
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from relrl.errors import ConfigError
-from relrl.kb import KnowledgeBase
-from relrl.terms import Term, Var
+from relrl.terms import Term
+
+if TYPE_CHECKING:
+    from relrl.engine import Engine
 
 __all__ = ["Learner", "StepOut", "register", "make_learner", "LEARNERS", "COMMON_DEFAULTS"]
 
@@ -27,15 +29,19 @@ COMMON_DEFAULTS: dict[str, float] = {"reward_positive": 10.0, "reward_negative":
 
 @dataclass
 class StepOut:
-    """What the engine's control step reports."""
+    """What a control step reports (:meth:`relrl.loop.Agent.step`)."""
 
     code: int                      #: state code (sum of 2^x)
     necessity: str                 #: active necessity, or "none"
     outputs: dict[str, float]      #: every necessity unit's output y
     reward: float                  #: reward for the previous response
     allowed: list[Term]            #: responses allowed now
-    action: Term                   #: the learner's choice ("none" when nothing is allowed)
+    action: Term | None            #: the learner's choice (None when nothing is allowed)
     allowed_index: list[int] = field(default_factory=list)  #: their indices (declaration order)
+    reinforced: bool = False       #: a reinforcer was perceived this step
+    memory: tuple[tuple[int, Term], ...] | None = None   #: (age, element), when asked
+    memory_size: int | None = None                        #: when asked
+    explanation: dict[str, Any] | None = None             #: as Learner.explain, when asked
     extra: dict[str, Any] = field(default_factory=dict)
 
 
@@ -65,12 +71,13 @@ def make_learner(name: str, **params: float) -> Learner:
 class Learner(abc.ABC):
     """Base class of relrl's learners.
 
-    Subclasses set ``name``, ``engine`` (the Prolog side: ``etg``, ``contingency`` or
-    ``external``) and ``defaults``; Python-side learners override :meth:`act`.
+    Subclasses set ``name``, ``engine_name`` (the Prolog learner behind it: ``etg``,
+    ``contingency``, or ``external`` for a learner that chooses in Python) and
+    ``defaults``; Python-side learners override :meth:`act`.
     """
 
     name: ClassVar[str]
-    engine: ClassVar[str]
+    engine_name: ClassVar[str]
     defaults: ClassVar[dict[str, float]]
 
     def __init__(self, **params: float) -> None:
@@ -88,8 +95,13 @@ class Learner(abc.ABC):
                 raise ConfigError(f"parameter {key} of learner {self.name!r} must be a number, "
                                   f"not {value!r}") from None
         self._check_params()
-        self.kb: KnowledgeBase | None = None
+        self.engine: Engine | None = None
         self.rng = np.random.default_rng(0)
+
+    @property
+    def kb(self) -> Any:
+        """The knowledge base the learner is attached to (None before :meth:`attach`)."""
+        return self.engine.kb if self.engine is not None else None
 
     def _check_params(self) -> None:
         """Validate parameter ranges (override to add checks)."""
@@ -97,60 +109,71 @@ class Learner(abc.ABC):
             if key in self.params and not 0.0 <= self.params[key] <= 1.0:
                 raise ConfigError(f"{key} must be in [0, 1], not {self.params[key]}")
 
-    def attach(self, kb: KnowledgeBase, seed: int | None) -> None:
-        """Start learning in ``kb``: configure the engine, seed the random numbers."""
-        self.kb = kb
+    def attach(self, engine: Engine, seed: int | None) -> None:
+        """Start learning with ``engine``: configure it, seed the random numbers."""
+        self.engine = engine
         self.rng = np.random.default_rng(seed)
-        params = [("=", k, v) for k, v in self.params.items()]
-        kb.call("relrl_engine:engine_configure", kb.module, self.engine, params,
-                seed if seed is not None else "none")
-        self.responses: list[Term] = kb.declarations("response")
+        engine.configure(self.engine_name, self.params, seed)
+        self.responses: list[Term] = engine.responses
 
-    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term:
+    def _engine(self) -> Engine:
+        if self.engine is None:
+            raise ConfigError(f"the {self.name} learner is not attached to an agent yet")
+        return self.engine
+
+    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term | None:
         """Return the response to emit. Prolog learners have already chosen."""
         return out.action
 
     def end_episode(self) -> None:  # noqa: B027 - an optional hook
         """Called when an interaction ends (the engine forgets the last step)."""
 
-    @abc.abstractmethod
-    def size(self) -> dict[str, int]:
-        """The learner's memory, with ``positions`` in the paper's sense."""
+    def episode_state(self) -> Any:
+        """What an evaluation may disturb on the Python side (random stream, last step);
+        :meth:`set_episode_state` puts it back (see :meth:`relrl.loop.Agent.preserved`)."""
+        return self.rng.bit_generator.state
 
-    def _engine_size(self) -> Term:
-        """The engine's report of a Prolog learner's memory (relrl_engine:engine_size/2)."""
-        assert self.kb is not None
-        (size,) = self.kb.call("relrl_engine:engine_size", self.kb.module, Var())
-        return size
+    def set_episode_state(self, state: Any) -> None:
+        """Put back what :meth:`episode_state` saved."""
+        self.rng.bit_generator.state = state
+
+    def size(self) -> dict[str, int]:
+        """The learner's memory: ``positions`` in the paper's sense and its own counts."""
+        positions, details = self._engine().size()
+        return {**details, "positions": positions}
 
     def explain(self, *, now: bool = False) -> dict[str, Any]:
         """Why the learner chooses what it chooses in the last step's state (or, with
         ``now``, in the state working memory holds now)."""
-        assert self.kb is not None
-        pred = "relrl_engine:engine_explain_now" if now else "relrl_engine:engine_explain"
-        (exp,) = self.kb.call(pred, self.kb.module, Var())
-        return self._explain_from(exp)
+        return self.decode_explanation(self._engine().explain("now" if now else "last"))
 
-    def tree(self) -> str:
-        """The learner's tree drawn as text ("" for learners without a tree)."""
-        assert self.kb is not None
-        (text,) = self.kb.call("relrl_engine:engine_tree", self.kb.module, Var())
-        return text
+    def decode_explanation(self, exp: Term) -> dict[str, Any]:
+        """Turn the engine's ``explanation(Learner, State, Necessity, Detail)`` into a dict
+        with ``learner``, ``state``, ``necessity`` and what the learner adds."""
+        _, _, state, necessity, detail = exp
+        return {"learner": self.name, "state": state, "necessity": necessity,
+                **self._explain_from(detail, state, necessity)}
 
     @abc.abstractmethod
-    def _explain_from(self, exp: Term) -> dict[str, Any]:
-        """Turn the engine's explanation term into a dict (see :meth:`explain`)."""
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """The learner's part of an explanation (``path``, ``ranked``, ...)."""
+
+    def tree(self) -> str:
+        """The learner's knowledge drawn as text ("" for learners without a drawing)."""
+        return self._engine().text()
+
+    def graph(self) -> dict[str, list[dict[str, Any]]]:
+        """The learner's tree as nodes and edges (empty for learners without a tree)."""
+        return self._engine().graph()
 
     def save(self, path: str | Path, header: str = "") -> Path:
         """Save the learned knowledge (atomic write); returns the file written."""
-        assert self.kb is not None
-        path = Path(path)
-        self.kb.call("relrl_engine:engine_save", self.kb.module, str(path),
-                     header or f"relrl policy: {self.name} learner")
-        return path
+        return self._engine().save(path, header or f"relrl policy: {self.name} learner")
 
     def load(self, path: str | Path) -> None:
-        """Load knowledge saved by :meth:`save` into the attached knowledge base."""
-        assert self.kb is not None
-        self.kb.load(path)
-        self.kb.call("relrl_engine:engine_adopt", self.kb.module)
+        """Load knowledge saved by :meth:`save`, read as data (never run).
+
+        Raises:
+            PolicyError: not this learner's policy for this domain (names file and line).
+        """
+        self._engine().load_policy(path)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from relrl.learners.base import Learner, register
-from relrl.terms import Term, Var, format_term
+from relrl.terms import Term, format_term
 
 __all__ = ["ContingencyLearner"]
 
@@ -19,7 +19,7 @@ class ContingencyLearner(Learner):
     """
 
     name = "contingency"
-    engine = "contingency"
+    engine_name = "contingency"
     defaults = {"default_fitness": 1.0, "influence": 0.5, "min_fitness": 0.05,
                 "max_fitness": 10.0}
 
@@ -32,18 +32,11 @@ class ContingencyLearner(Learner):
             raise ConfigError("need 0 < min_fitness <= default_fitness <= max_fitness, got "
                               f"{p['min_fitness']}, {p['default_fitness']}, {p['max_fitness']}")
 
-    def size(self) -> dict[str, int]:
-        """The stored behaviour rules; one position each."""
-        _, rules, positions = self._engine_size()
-        return {"rules": rules, "positions": positions}
-
-    def _explain_from(self, exp: Term) -> dict[str, Any]:
-        _, code, necessity, ranked = exp
-        return {"learner": "contingency", "state": code, "necessity": necessity,
-                "ranked": [{"response": format_term(r), "fitness": f} for (_, r, f) in ranked]}
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """The responses with a matching rule, highest summed fitness first."""
+        _, ranked = detail
+        return {"ranked": [{"response": format_term(r), "fitness": f} for (_, r, f) in ranked]}
 
     def rules(self) -> list[tuple[Term, Term, Term, float]]:
-        """Every behaviour rule: (antecedent, response, necessity, fitness)."""
-        assert self.kb is not None
-        (rules,) = self.kb.call("relrl_contingency:contingency_rules", self.kb.module, Var())
-        return [tuple(r[1:]) for r in rules]  # type: ignore[misc]
+        """Every behaviour rule: (antecedent, response, necessity, fitness), authored first."""
+        return [tuple(r[1:]) for r in self._engine().knowledge()]  # type: ignore[misc]

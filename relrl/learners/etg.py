@@ -20,27 +20,15 @@ class ETGLearner(Learner):
     """
 
     name = "etg"
-    engine = "etg"
+    engine_name = "etg"
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0,
                 "split_threshold": 0.1}
 
-    def size(self) -> dict[str, int]:
-        """Nodes, leaves, stored action entries; positions = nodes + entries."""
-        _, nodes, leaves, entries, positions = self._engine_size()
-        return {"nodes": nodes, "leaves": leaves, "entries": entries, "positions": positions}
-
-    def _explain_from(self, exp: Term) -> dict[str, Any]:
-        _, description, necessity, path, ranked = exp
-        tests = []
-        for step in path:
-            if isinstance(step, tuple) and step[0] == "-":
-                tests.append({"test": format_term(step[1]), "holds": step[2] == "true"})
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """The path of tests from the root (with outcomes), the leaf, its ranked entries."""
+        _, path, ranked = detail
+        tests = [{"test": format_term(step[1]), "holds": step[2] == "true"}
+                 for step in path if isinstance(step, tuple) and step[0] == "-"]
         end = path[-1]
-        return {
-            "learner": "etg",
-            "state": description,
-            "necessity": necessity,
-            "path": tests,
-            "leaf": end[1] if isinstance(end, tuple) else None,
-            "ranked": [{"response": format_term(a), "q": q} for (_, a, q, _) in ranked],
-        }
+        return {"path": tests, "leaf": end[1] if isinstance(end, tuple) else None,
+                "ranked": [{"response": format_term(a), "q": q} for (_, a, q, _) in ranked]}

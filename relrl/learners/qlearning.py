@@ -9,7 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from relrl.errors import ConfigError
+from relrl.engine import Engine
+from relrl.errors import PolicyError
 from relrl.learners.base import Learner, StepOut, register
 from relrl.terms import Term, format_term
 
@@ -29,11 +30,12 @@ class QLearner(Learner):
     """
 
     name = "qlearning"
-    engine = "external"
+    engine_name = "external"
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0}
 
-    def attach(self, kb, seed):  # type: ignore[override]
-        super().attach(kb, seed)
+    def attach(self, engine: Engine, seed: int | None) -> None:
+        """Start learning with ``engine`` (an empty table)."""
+        super().attach(engine, seed)
         self._rows: dict[tuple[int, str], int] = {}
         self._q = np.full((64, len(self.responses)), self.params["q_init"])
         self._prev: tuple[int, int] | None = None
@@ -50,7 +52,7 @@ class QLearner(Learner):
             self._rows[key] = row
         return row
 
-    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term:
+    def act(self, out: StepOut, learning: bool, explore: bool | None = None) -> Term | None:
         """Update Q for the previous step (Eq. 3), then choose epsilon-greedily.
 
         Without learning, a state never met gets no row (every Q is q_init): evaluating
@@ -67,7 +69,7 @@ class QLearner(Learner):
             q[prev_row, prev_action] += self.params["alpha"] * (target - q[prev_row, prev_action])
         if not allowed:
             self._prev = None
-            return "none"
+            return None
         if explore is None:
             explore = learning
         epsilon = self.params["epsilon"] if explore else 0.0
@@ -86,6 +88,15 @@ class QLearner(Learner):
         """No update links the next step to the last one."""
         self._prev = None
 
+    def episode_state(self) -> Any:
+        """The random stream and the last step (an evaluation must not disturb them)."""
+        return (super().episode_state(), self._prev)
+
+    def set_episode_state(self, state: Any) -> None:
+        """Put back what :meth:`episode_state` saved."""
+        rng_state, self._prev = state
+        super().set_episode_state(rng_state)
+
     def size(self) -> dict[str, int]:
         """rows x actions positions, and the distinct states met."""
         rows = len(self._rows)
@@ -93,17 +104,14 @@ class QLearner(Learner):
                 "states": len({code for code, _ in self._rows}),
                 "positions": rows * len(self.responses)}
 
-    def _explain_from(self, exp: Term) -> dict[str, Any]:
-        """The Q row of the state the engine reports (external(Code, Necessity))."""
-        _, code, necessity = exp
-        row = self._rows.get((code, necessity))
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """The Q row of the state the engine reports."""
+        row = self._rows.get((state, necessity))
         if row is None:
-            return {"learner": "qlearning", "state": code, "necessity": necessity,
-                    "ranked": [], "note": "state never met: every Q is q_init"}
+            return {"ranked": [], "note": "state never met: every Q is q_init"}
         values = self._q[row]
         order = np.argsort(-values, kind="stable")
-        return {"learner": "qlearning", "state": code, "necessity": necessity,
-                "ranked": [{"response": format_term(self.responses[i]), "q": float(values[i])}
+        return {"ranked": [{"response": format_term(self.responses[i]), "q": float(values[i])}
                            for i in order]}
 
     def save(self, path: str | Path, header: str = "") -> Path:
@@ -123,17 +131,27 @@ class QLearner(Learner):
 
     def load(self, path: str | Path) -> None:
         """Load a table saved by :meth:`save` (its responses must match the domain's)."""
+        import zipfile
+
         try:
             data = np.load(path, allow_pickle=False)
-        except (OSError, ValueError) as exc:
-            raise ConfigError(f"{path}: not a Q-table (.npz): {exc}") from None
+            fields = {k: data[k] for k in ("q", "codes", "necessities", "responses")}
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise PolicyError(f"{path}: not a relrl Q-table (.npz): {exc}") from None
+        if not (fields["q"].ndim == 2 and np.issubdtype(fields["q"].dtype, np.number)
+                and len(fields["q"]) == len(fields["codes"]) == len(fields["necessities"])):
+            raise PolicyError(f"{path}: not a relrl Q-table (.npz): inconsistent arrays")
+        data = fields
         responses = [str(r) for r in data["responses"]]
         mine = [format_term(r) for r in self.responses]
-        if responses != mine:
-            raise ConfigError(f"{path}: the table's responses {responses} are not the "
-                              f"domain's {mine}")
-        self._rows = {(int(c), str(n)): i for i, (c, n) in
-                      enumerate(zip(data["codes"], data["necessities"], strict=True))}
+        if responses != mine or fields["q"].shape[1] != len(mine):
+            raise PolicyError(f"{path}: learned for another domain: the table's responses "
+                              f"{responses} are not the domain's {mine}")
+        try:
+            self._rows = {(int(c), str(n)): i for i, (c, n) in
+                          enumerate(zip(data["codes"], data["necessities"], strict=True))}
+        except ValueError as exc:
+            raise PolicyError(f"{path}: not a relrl Q-table (.npz): {exc}") from None
         self._q = np.array(data["q"], dtype=float)
         if len(self._q) == 0:
             self._q = np.full((64, len(self.responses)), self.params["q_init"])

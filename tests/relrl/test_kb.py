@@ -154,9 +154,12 @@ def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
     from relrl.kb import _get_engine
 
     engine = _get_engine()
-    for _ in range(1_300_000):
-        engine.run("true", 0, ())
-    assert engine.run(("=", Var(), "still alive"), 0, (0,)) == ["still alive"]
+    with KnowledgeBase() as kb:
+        goal = (":", kb.module, "true")
+        for _ in range(1_300_000):
+            engine.run(goal, 0, ())
+        assert engine.run((":", kb.module, ("=", Var(), "still alive")), 0, (0,)) == \
+            ["still alive"]
 
 
 def test_partial_list_keeps_its_tail(fruits: KnowledgeBase) -> None:

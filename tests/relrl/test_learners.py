@@ -80,49 +80,35 @@ def test_eq3_by_hand() -> None:
     kb.close()
 
 
-def etg_call(kb: KnowledgeBase, *args):
-    params = [("=", "alpha", 0.5), ("=", "gamma", 0.9), ("=", "q_init", 0.0),
-              ("=", "split_threshold", 1.0)]
-    return kb.call("relrl_etg:etg_update", kb.module, *args, params)
+def test_etg_tree_by_hand_through_the_step() -> None:
+    """Eq. 4 and Algorithm 3 by hand, fed through the public step (alpha 0.5, gamma 0.9,
+    q_init 0, split threshold 1; codes: light 1, dark 2, food 4). The same tree built
+    example by example is in tests/prolog/test_tree.plt."""
+    from relrl.engine import Engine
 
-
-def tree_nodes(kb: KnowledgeBase) -> dict:
-    nodes = kb.call("relrl_gateway:gw_findall", "relrl_qtree",
-                    ("node_", kb.module, Var("I"), Var("N")), Var())
-    return {n[2]: n[3] for n in nodes[0]}
-
-
-def test_etg_tree_shape_and_leaf_order() -> None:
-    """Eq. 4 and Algorithm 3 by hand (alpha 0.5, gamma 0.9, split threshold 1)."""
-    kb = KnowledgeBase(TINY)
-    Agent(kb, make_learner("etg"), seed=0)  # tests: stimulus(light), (dark), (food)
-    light, dark = 1, 2
-    # 1. light, a, r=10, next dark: single empty leaf, max Q(next) = q_init = 0.
-    etg_call(kb, light, "a", "hunger", 10, dark, "hunger", [])
-    assert tree_nodes(kb) == {0: ("leaf", light, [("e", "a", 5.0, "hunger")])}
-    # 2. light, b, r=-1: target -1 + 0.9*5 = 3.5, Q = 0 + 0.5*3.5; kept in decreasing Q.
-    etg_call(kb, light, "b", "hunger", -1, dark, "hunger", [])
-    assert tree_nodes(kb) == {0: ("leaf", light, [("e", "a", 5.0, "hunger"),
-                                                  ("e", "b", 1.75, "hunger")])}
-    # 3. dark, a, r=1: target 1 + 4.5 = 5.5, error 0.5 <= 1: dark shares light's leaf.
-    etg_call(kb, dark, "a", "hunger", 1, light, "hunger", [])
-    assert tree_nodes(kb) == {0: ("leaf", light, [("e", "a", 5.25, "hunger"),
-                                                  ("e", "b", 1.75, "hunger")])}
-    # 4. dark, b, r=-1: target -1 + 0.9*5.25 = 3.725, error 1.975 > 1: split on the first
-    #    test telling light from dark, stimulus(light); dark gets a new leaf on the null side:
-    #    Q(b) = 0 + 0.5 * (3.725 - 0).
-    etg_call(kb, dark, "b", "hunger", -1, light, "hunger", [])
-    nodes = tree_nodes(kb)
-    assert nodes[0] == ("test", 0, ("stimulus", "light"), 1, 2)
-    assert nodes[1] == ("leaf", light, [("e", "a", 5.25, "hunger"), ("e", "b", 1.75, "hunger")])
-    assert nodes[2] == ("leaf", dark, [("e", "b", pytest.approx(1.8625), "hunger")])
-    # 5. dark, c, r=10: target 10 + 0.9*5.25, Q = 7.3625 goes first in the leaf.
-    etg_call(kb, dark, "c", "hunger", 10, light, "hunger", [])
-    assert tree_nodes(kb)[2] == ("leaf", dark, [("e", "c", pytest.approx(7.3625), "hunger"),
-                                                ("e", "b", pytest.approx(1.8625), "hunger")])
-    (size,) = kb.call("relrl_engine:engine_size", kb.module, Var())
-    assert size == ("etg", 3, 2, 4, 7)   # 3 nodes, 2 leaves, 4 entries, 7 positions
-    kb.close()
+    with KnowledgeBase(TINY) as kb:
+        engine = Engine(kb)
+        engine.configure("etg", {"alpha": 0.5, "gamma": 0.9, "epsilon": 0.0, "q_init": 0.0,
+                                 "split_threshold": 1.0, "reward_positive": 10.0,
+                                 "reward_negative": -1.0}, seed=0)
+        a, c = engine.responses.index("a"), engine.responses.index("c")
+        engine.step([("see", "light")])                      # state 1, nothing to learn
+        # a in the light, no food: target -1 + 0.9 * q_init, Q(a) = 0.5 * -1
+        engine.step([("see", "dark")], emitted=a)
+        assert engine.graph()["nodes"] == [{"id": "0", "kind": "leaf",
+                                            "label": "a -0.50 [hunger]"}]
+        # c in the dark, food: target 10 + 0.9 * max(-0.5, q_init for untried) = 10; the
+        # error 10 > 1 splits the leaf on the first test telling 1 from 2, stimulus(light);
+        # the dark state takes the empty no-branch: Q(c) = 0.5 * 10.
+        engine.step([("see", "light"), ("smell", "food")], emitted=c)
+        graph = engine.graph()
+        assert graph["nodes"] == [
+            {"id": "0", "kind": "test", "label": "stimulus(light)"},
+            {"id": "1", "kind": "leaf", "label": "a -0.50 [hunger]"},
+            {"id": "2", "kind": "leaf", "label": "c 5.00 [hunger]"}]
+        assert graph["edges"] == [{"from": "0", "to": "1", "branch": "yes"},
+                                  {"from": "0", "to": "2", "branch": "no"}]
+        assert engine.size() == (5, {"nodes": 3, "leaves": 2, "entries": 2})
 
 
 @pytest.mark.parametrize("name", ["etg", "contingency", "qlearning"])

@@ -1,0 +1,58 @@
+:- module(relrl_rules,
+          [ rule_holds/2,         % +KB, +Goal
+            rule_solution/2,      % +KB, +Goal
+            rule_where/3          % +KB, +Goal, -Where
+          ]).
+:- use_module(library(error)).
+
+/** <module> Running the domain's goals
+
+Every goal of a domain that the engine runs — a fact's definition, an ETG test, a constraint
+rule, a behaviour rule's antecedent, a necessity input, a relation of the relational view —
+runs through this module. A goal that fails is false. An exception is never turned into
+failure: it propagates, wrapped as
+
+    relrl_rule_error(Goal, Where, Error)
+
+where Where is File:Line of the first clause of Goal's predicate (or `unknown`), so that a
+time limit, a stack overflow or a call to an undefined predicate reaches the robot's loop
+and names the rule that caused it. An error already wrapped by an inner goal passes through
+unchanged (it names the innermost rule the engine called).
+*/
+
+%!  rule_holds(+KB, +Goal) is semidet.
+%
+%   Goal, a goal of the domain loaded into KB, has a solution.
+
+rule_holds(KB, Goal) :-
+    catch(once(KB:Goal), E, rule_error(KB, Goal, E)).
+
+%!  rule_solution(+KB, +Goal) is nondet.
+%
+%   Enumerate the solutions of Goal in KB.
+
+rule_solution(KB, Goal) :-
+    catch(KB:Goal, E, rule_error(KB, Goal, E)).
+
+rule_error(_, _, E) :-
+    (   E = relrl_rule_error(_, _, _)
+    ;   E == '$aborted'
+    ),
+    !,
+    throw(E).
+rule_error(KB, Goal, E) :-
+    rule_where(KB, Goal, Where),
+    throw(relrl_rule_error(Goal, Where, E)).
+
+%!  rule_where(+KB, +Goal, -Where) is det.
+%
+%   Where is File:Line of the first clause of Goal's predicate in KB, or `unknown`.
+
+rule_where(KB, Goal, Where) :-
+    (   callable(Goal),
+        \+ predicate_property(KB:Goal, imported_from(_)),
+        predicate_property(KB:Goal, file(File)),
+        predicate_property(KB:Goal, line_count(Line))
+    ->  Where = File:Line
+    ;   Where = unknown
+    ).

@@ -1,0 +1,276 @@
+"""The one typed front over relrl's Prolog engine.
+
+Every goal of relrl's Prolog that Python calls is named here, in :data:`GOALS`, and nowhere
+else (``prolog/gateway.pl``'s ``python_api/1`` lists the same set; the gateway refuses any
+other goal of relrl's modules). Results come back decoded: :meth:`Engine.step` returns a
+:class:`StepResult` dataclass, not a term to unpack by position, and a goal that fails where
+it must succeed raises :class:`EngineError` naming it.
+
+One :class:`Engine` serves one knowledge base. The control loop (:mod:`relrl.loop`) and the
+learners (:mod:`relrl.learners`) use it; so can a researcher embedding relrl:
+
+Example:
+    >>> from relrl.kb import KnowledgeBase
+    >>> from relrl.engine import Engine
+    >>> kb = KnowledgeBase("examples/domains/sis.pl")
+    >>> engine = Engine(kb)
+    >>> engine.configure("etg", {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05,
+    ...                          "q_init": 30.0, "split_threshold": 0.1,
+    ...                          "reward_positive": 10.0, "reward_negative": -1.0}, seed=0)
+    >>> r = engine.step([("see", "face"), ("pose", "face", "frontal"), ("at", "centre")])
+    >>> engine.responses[r.action_index]
+    ('look', 'centre')
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from relrl.errors import RelrlError
+from relrl.kb import Cached, KnowledgeBase
+from relrl.terms import Term, Var
+
+__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult"]
+
+#: Every goal of relrl's Prolog that Python calls: short name -> "module:predicate".
+GOALS: dict[str, str] = {
+    # the control step and the learner (prolog/engine.pl)
+    "configure": "relrl_engine:engine_configure",
+    "step": "relrl_engine:engine_step",
+    "end_episode": "relrl_engine:engine_end_episode",
+    "explain": "relrl_engine:engine_explain",
+    "text": "relrl_engine:engine_text",
+    "graph": "relrl_engine:engine_graph",
+    "knowledge": "relrl_engine:engine_knowledge",
+    "size": "relrl_engine:engine_size",
+    "save": "relrl_engine:engine_save",
+    "keep": "relrl_engine:engine_keep",
+    "resume": "relrl_engine:engine_resume",
+    "reseed": "relrl_engine:engine_reseed",
+    "responses": "relrl_engine:engine_responses",
+    "necessities": "relrl_engine:engine_necessities",
+    "learner": "relrl_engine:engine_learner",
+    "relational_state": "relrl_engine:engine_relational_state",
+    # policies, read as data (prolog/policy.pl)
+    "policy_learner": "relrl_policy:policy_learner",
+    "policy_load": "relrl_policy:policy_load",
+    # working memory (prolog/memory.pl)
+    "wm_insert": "relrl_memory:wm_insert",
+    "wm_elements": "relrl_memory:wm_elements",
+    "wm_clear": "relrl_memory:wm_clear",
+    "wm_clock": "relrl_memory:wm_clock",
+    "wm_set_span": "relrl_memory:wm_set_span",
+    # the state code (prolog/state.pl) and the constraint rules (prolog/responses.pl)
+    "state_code": "relrl_state:state_code",
+    "state_terms": "relrl_state:state_terms",
+    "state_decode": "relrl_state:state_decode",
+    "state_encode": "relrl_state:state_encode",
+    "state_features": "relrl_state:state_features",
+    "allowed_responses": "relrl_responses:allowed_responses",
+    # declarations and checks (prolog/declarations.pl, prolog/check.pl, prolog/gateway.pl)
+    "necessity_inputs": "relrl_declarations:necessity_inputs",
+    "check_domain": "relrl_check:check_domain",
+    "rule_listing": "relrl_check:rule_listing",
+    "findall": "relrl_gateway:gw_findall",
+    "parse": "relrl_gateway:gw_parse",
+}
+
+#: Step modes: update the learner and explore, explore without learning, or neither.
+MODES = ("learn", "explore", "greedy")
+#: What a step can report besides its result, in the same call.
+WANTS = ("memory", "memory_size", "explain")
+
+_slots = itertools.count()
+
+
+class EngineError(RelrlError):
+    """A goal of relrl's engine failed where it must succeed (a bug, not a user error)."""
+
+
+@dataclass(frozen=True, slots=True)
+class StepResult:
+    """What one control step (``relrl_engine:engine_step/6``) reports."""
+
+    code: int                     #: the state code, sum of 2^x
+    necessity: str                #: the active necessity, or "none"
+    outputs: tuple[float, ...]    #: every necessity unit's output, in declaration order
+    reward: float                 #: the reward for the previous response
+    reinforced: bool              #: a reinforcer was perceived this step
+    allowed_mask: int             #: bit i set when response i is allowed
+    action_index: int             #: the learner's choice (index), -1 for none / Python learner
+    memory: tuple[tuple[int, Term], ...] | None = None   #: (age, element), when asked
+    memory_size: int | None = None                        #: when asked
+    explanation: Term | None = None                       #: the learner's, when asked
+
+    @property
+    def allowed_index(self) -> list[int]:
+        """Indices of the allowed responses, in declaration order."""
+        mask, out, i = self.allowed_mask, [], 0
+        while mask:
+            if mask & 1:
+                out.append(i)
+            mask >>= 1
+            i += 1
+        return out
+
+
+def call(kb: KnowledgeBase, goal: str, *arguments: Term, timeout: float | None = None) -> list:
+    """Call the engine goal named ``goal`` (a key of :data:`GOALS`) once.
+
+    Returns the values of its :class:`~relrl.terms.Var` arguments.
+
+    Raises:
+        EngineError: the goal failed.
+    """
+    out = kb.call(GOALS[goal], *arguments, timeout=timeout)
+    if out is None:
+        raise EngineError(f"{GOALS[goal]}/{len(arguments)} failed in {kb.module}")
+    return out
+
+
+def one(kb: KnowledgeBase, goal: str, *arguments: Term) -> Term:
+    """Call ``goal`` with ``arguments`` and one more output argument; return its value."""
+    return call(kb, goal, *arguments, Var())[0]
+
+
+class Engine:
+    """The engine of one knowledge base: configure it, step it, ask it why.
+
+    Args:
+        kb: the knowledge base holding the domain.
+    """
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.kb = kb
+        self.module = kb.module
+        self.learner: str | None = None
+        self.responses: list[Term] = []
+        self.necessities: list[str] = []
+
+    # -- a run ------------------------------------------------------------------------------
+
+    def configure(self, learner: str, params: Mapping[str, float], seed: int | None) -> None:
+        """Start a run with the Prolog-side ``learner`` (``etg``, ``contingency``,
+        ``external``, ...) and its ``params``; ``seed`` seeds this knowledge base's own random
+        stream (None: from the clock). Working memory and the necessity units start afresh."""
+        plist = [("=", k, v) for k, v in params.items()]
+        call(self.kb, "configure", self.module, learner, plist,
+             int(seed) if seed is not None else "none")
+        self.learner = learner
+        self.responses = one(self.kb, "responses", self.module)
+        self.necessities = list(one(self.kb, "necessities", self.module))
+
+    def step(self, percepts: Sequence[Term] | Cached, emitted: int = -1, mode: str = "learn",
+             want: Iterable[str] = ()) -> StepResult:
+        """One control step: one gateway call.
+
+        Args:
+            percepts: this time unit's perception facts (a list, or a :class:`Cached` one).
+            emitted: index of the response emitted at the previous step, -1 for none.
+            mode: one of :data:`MODES`.
+            want: any of :data:`WANTS`, reported in the same call.
+        """
+        if not isinstance(percepts, Cached):
+            percepts = Cached(percepts if isinstance(percepts, list) else list(percepts))
+        want = list(want)
+        raw = call(self.kb, "step", self.module, percepts, emitted, mode, want, Var())[0]
+        (_, code, necessity, ys, reward, reinforced, mask, action, extras) = raw
+        memory = memory_size = explanation = None
+        for _, key, value in extras:
+            if key == "memory":
+                memory = tuple((age, element) for (_, age, element) in value)
+            elif key == "memory_size":
+                memory_size = value
+            else:
+                explanation = value
+        return StepResult(code, necessity, tuple(ys), float(reward), reinforced == "true",
+                          mask, action, memory, memory_size, explanation)
+
+    def end_episode(self) -> None:
+        """End an interaction: forget the last step, working memory and the units' state."""
+        call(self.kb, "end_episode", self.module)
+
+    # -- what the learner knows -------------------------------------------------------------
+
+    def explain(self, when: str = "last") -> Term:
+        """``explanation(Learner, State, Necessity, Detail)`` for the last step's state
+        (``when="last"``) or the state in working memory now (``"now"``)."""
+        return one(self.kb, "explain", self.module, when)
+
+    def text(self) -> str:
+        """The learner's knowledge as text ("" when it has no drawing)."""
+        return one(self.kb, "text", self.module)
+
+    def graph(self) -> dict[str, list[dict[str, Any]]]:
+        """The learner's tree as ``{"nodes": [{id, kind, label}], "edges": [{from, to,
+        branch}]}`` (empty lists for a learner without a tree)."""
+        _, nodes, edges = one(self.kb, "graph", self.module)
+        return {"nodes": [{"id": _node_id(i), "kind": k, "label": str(label)}
+                          for (_, i, k, label) in nodes],
+                "edges": [{"from": _node_id(a), "to": _node_id(b), "branch": br}
+                          for (_, a, b, br) in edges]}
+
+    def knowledge(self) -> list[Term]:
+        """The learner's knowledge as terms (for contingency, its behaviour/4 rules)."""
+        return one(self.kb, "knowledge", self.module)
+
+    def size(self) -> tuple[int, dict[str, int]]:
+        """``(positions, details)``: the learner's memory in the paper's positions and its
+        own counts."""
+        _, _, positions, details = one(self.kb, "size", self.module)
+        return positions, {k: v for (_, k, v) in details}
+
+    def relational_state(self) -> list[Term]:
+        """The relational view of the state now (the domain's relation/1 facts)."""
+        return one(self.kb, "relational_state", self.module)
+
+    # -- files ------------------------------------------------------------------------------
+
+    def save(self, path: str | Path, header: str) -> Path:
+        """Write the learned knowledge as a readable policy file (atomic)."""
+        call(self.kb, "save", self.module, str(path), header)
+        return Path(path)
+
+    def load_policy(self, path: str | Path) -> None:
+        """Replace the learned knowledge by the policy at ``path``, read as data.
+
+        Raises:
+            PolicyError: the file is not this learner's policy for this domain (file:line).
+        """
+        call(self.kb, "policy_load", self.module, str(path))
+
+    # -- evaluation without side effects ----------------------------------------------------
+
+    def keep(self) -> str:
+        """Save working memory, the units, the last step, the random stream and the
+        learner's episode state inside Prolog; returns the slot for :meth:`resume`."""
+        slot = f"s{next(_slots)}"
+        call(self.kb, "keep", self.module, slot)
+        return slot
+
+    def resume(self, slot: str) -> None:
+        """Restore what :meth:`keep` saved in ``slot`` (once)."""
+        call(self.kb, "resume", self.module, slot)
+
+    def reseed(self, seed: int) -> None:
+        """Seed this knowledge base's random stream."""
+        call(self.kb, "reseed", self.module, int(seed))
+
+
+def policy_learner(kb: KnowledgeBase, path: str | Path) -> str:
+    """The learner named by a saved policy's first term (read as data).
+
+    Raises:
+        PolicyError: not a relrl policy (file:line).
+    """
+    return one(kb, "policy_learner", str(path))
+
+
+def _node_id(i: Term) -> str:
+    if isinstance(i, tuple):  # nil(Parent, Branch): an empty branch
+        return f"nil_{i[1]}_{i[2]}"
+    return str(i)

@@ -1,0 +1,274 @@
+/*  plunit tests of the learning core: motivation (Eq. 1, 2), contingency, the Q-tree and
+    ETG (Algorithm 3, Eq. 4), and the control step on hand-made percept streams.
+    Run from pytest (tests/prolog/test_plunit.py) or:
+        swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_core.plt
+*/
+:- use_module(library(plunit)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module('../../prolog/relrl').
+:- use_module('../../prolog/gateway').
+
+domain_path(File, Path) :-
+    module_property(relrl, file(RelrlFile)),
+    file_directory_name(RelrlFile, Dir),
+    atomic_list_concat([Dir, '/../', File], Path).
+
+kb_with(File, KB) :-
+    relrl_gateway:gw_new_kb(KB),
+    domain_path(File, Path),
+    relrl_gateway:gw_load(Path, KB, Problems),
+    assertion(Problems == []).
+
+close_to(Expected, Actual) :-
+    abs(Expected - Actual) < 0.0005.
+
+etg_params([alpha=0.5, gamma=0.9, epsilon=0.0, q_init=0.0, split_threshold=1.0,
+            reward_positive=10.0, reward_negative= -1.0]).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(motivation).
+
+test(eq1_by_hand, [true(U =:= 0.5*1 + -1.5*0 + 0.25*0.4 + 1.0)]) :-
+    relrl_motivation:unit_activation([0.5-1, -1.5-0], 0.25, 0.4, 1.0, U).
+
+test(eq2_by_hand, [true(close_to(0.768525, Y))]) :-
+    relrl_motivation:unit_output(1.0, 0.2, Y).
+
+%   docs/engine.md: alone, socialize climbs 0.769, 0.877, 0.889 towards 0.890.
+test(socialize_alone_rises, [true(maplist(close_to, [0.768525, 0.877490, 0.888741], Ys))]) :-
+    kb_with('examples/domains/fruits.pl', KB),
+    relrl_motivation:motivation_reset(KB),
+    findall(Y, ( between(1, 3, _),
+                 relrl_memory:wm_insert(KB, []),
+                 relrl_motivation:motivation_step(KB, [socialize-Y], _) ), Ys).
+
+%   ... and falls to about 0.171 with attention, a frontal face and the robot looking at it.
+test(socialize_satisfied_falls, [true((close_to(0.171, Y), Active == none))]) :-
+    kb_with('examples/domains/fruits.pl', KB),
+    relrl_motivation:motivation_reset(KB),
+    forall(between(1, 30, _),
+           ( relrl_memory:wm_insert(KB, []),
+             relrl_motivation:motivation_step(KB, _, _) )),
+    Contact = [hear(attention), see(face), pose(face, frontal), at(centre)],
+    forall(between(1, 30, _),
+           ( relrl_memory:wm_insert(KB, Contact),
+             relrl_motivation:motivation_step(KB, _, _) )),
+    relrl_memory:wm_insert(KB, Contact),
+    relrl_motivation:motivation_step(KB, [socialize-Y], Active).
+
+test(mediator_threshold, [true(Active == socialize)]) :-
+    kb_with('examples/domains/fruits.pl', KB),
+    relrl_motivation:motivation_reset(KB),
+    relrl_memory:wm_insert(KB, []),
+    relrl_motivation:motivation_step(KB, _, Active).
+
+:- end_tests(motivation).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(contingency).
+
+contingency_params([default_fitness=1.0, influence=0.5, min_fitness=0.05,
+                    max_fitness=10.0]).
+
+%   A response with no rule creates one from the default fitness moved by the consequence.
+test(new_rule_from_consequence, [Rules == [behaviour(state(5), a, hunger, 1.5)]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    contingency_params(P),
+    relrl_contingency:contingency_init(KB),
+    relrl_contingency:contingency_update(KB, 5, a, hunger, true, P),
+    relrl_contingency:contingency_rules(KB, Rules).
+
+%   The rule a choice used rises when the reinforcer came, falls otherwise, within bounds.
+test(fitness_moves_and_clamps, [Fs == [1.5, 2.0, 1.5, 0.05]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    contingency_params(P),
+    relrl_contingency:contingency_init(KB),
+    relrl_contingency:contingency_update(KB, 1, a, hunger, true, P),
+    findall(F, ( member(R, [true, false, skip]),
+                 (   R == skip
+                 ->  forall(between(1, 10, _),
+                            ( relrl_contingency:contingency_choose(KB, 1, hunger, [a], P, _),
+                              relrl_contingency:contingency_update(KB, 1, a, hunger, false, P)
+                            ))
+                 ;   relrl_contingency:contingency_choose(KB, 1, hunger, [a], P, a),
+                     relrl_contingency:contingency_update(KB, 1, a, hunger, R, P)
+                 ),
+                 relrl_contingency:contingency_rules(KB, [behaviour(_, a, _, F)]) ), Fs0),
+    Fs = [1.5|Fs0].
+
+%   Roulette-wheel: a response's slice is its rules' fitness (default without one).
+test(roulette_proportional, [true(abs(Share - 0.75) < 0.02)]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    relrl_contingency:contingency_restore(KB, [behaviour(state(1), a, hunger, 3.0)]),
+    contingency_params(P),
+    set_random(seed(11)),
+    findall(A, ( between(1, 4000, _),
+                 relrl_contingency:contingency_choose(KB, 1, hunger, [a, b], P, A) ), As),
+    include(==(a), As, AsA),
+    length(AsA, NA),
+    Share is NA / 4000.
+
+:- end_tests(contingency).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(qtree).
+
+test(new_tree_one_empty_leaf, [Nodes == [0-leaf(none, [])]]) :-
+    relrl_qtree:qtree_new(t1, [a, b]),
+    findall(I-N, relrl_qtree:qtree_node(t1, I, N), Nodes).
+
+put_all(Entries, Es) :-
+    foldl(put_one, Entries, [], Es).
+
+put_one(E, L0, L) :-
+    relrl_qtree:qtree_put_entry(L0, E, L).
+
+test(entries_in_decreasing_q_ties_keep_order,
+     [Es == [e(c, 3, n), e(a, 1, n), e(b, 1, n), e(a, 0, m)]]) :-
+    put_all([e(a, 1, n), e(b, 1, n), e(a, 0, m), e(c, 3, n)], Es).
+
+test(put_replaces_same_action_and_necessity, [Es == [e(b, 2, n), e(a, 0.5, n)]]) :-
+    put_all([e(a, 1, n), e(b, 2, n), e(a, 0.5, n)], Es).
+
+test(split_and_sort, [Where == [leaf(1), null(0, no), leaf(1)]]) :-
+    relrl_qtree:qtree_new(t2, [x0, x1]),
+    relrl_qtree:qtree_set_leaf(t2, 0, 1, [e(a, 1, n)]),   % representative: bit 0 set
+    relrl_qtree:qtree_split(t2, 0, 0),
+    findall(W, ( member(D, [1, 2, 3]), relrl_qtree:qtree_sort(t2, D, W) ), Where).
+
+test(grow_on_null, [Leaf == leaf(2, [e(b, 4, n)])]) :-
+    relrl_qtree:qtree_new(t3, [x0]),
+    relrl_qtree:qtree_set_leaf(t3, 0, 1, []),
+    relrl_qtree:qtree_split(t3, 0, 0),
+    relrl_qtree:qtree_grow(t3, 0, no, 2, [e(b, 4, n)], Id),
+    once(relrl_qtree:qtree_node(t3, Id, Leaf)).
+
+test(first_difference_lowest_bit, [I == 1]) :-
+    relrl_qtree:first_difference(0b101, 0b111, I).
+
+%   Eq. 4 and Algorithm 3 by hand (alpha 0.5, gamma 0.9, q_init 0, split threshold 1),
+%   tests: stimulus(light) 0, stimulus(dark) 1, stimulus(food) 2.
+test(etg_by_hand) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    % 1. light, a, r=10, next dark: one empty leaf; Q = 0.5 * 10.
+    relrl_etg:etg_update(KB, 1, a, hunger, 10, 2, hunger, [], P),
+    tree_nodes(KB, [0-leaf(1, [e(a, 5.0, hunger)])]),
+    % 2. light, b, r=-1: target -1 + 0.9*5 = 3.5; kept in decreasing Q.
+    relrl_etg:etg_update(KB, 1, b, hunger, -1, 2, hunger, [], P),
+    tree_nodes(KB, [0-leaf(1, [e(a, 5.0, hunger), e(b, 1.75, hunger)])]),
+    % 3. dark, a, r=1: target 5.5, error 0.5 <= 1: dark shares light's leaf.
+    relrl_etg:etg_update(KB, 2, a, hunger, 1, 1, hunger, [], P),
+    tree_nodes(KB, [0-leaf(1, [e(a, 5.25, hunger), e(b, 1.75, hunger)])]),
+    % 4. dark, b, r=-1: target 3.725, error 1.975 > 1: split on stimulus(light); dark
+    %    grows a leaf on the empty no-branch with Q(b) = 0.5 * 3.725.
+    relrl_etg:etg_update(KB, 2, b, hunger, -1, 1, hunger, [], P),
+    tree_nodes(KB, [0-test(0, stimulus(light), 1, 2),
+               1-leaf(1, [e(a, 5.25, hunger), e(b, 1.75, hunger)]),
+               2-leaf(2, [e(b, Q4, hunger)])]),
+    close_to(1.8625, Q4),
+    % 5. dark, c, r=10: target 10 + 0.9*5.25; Q = 7.3625 goes first.
+    relrl_etg:etg_update(KB, 2, c, hunger, 10, 1, hunger, [], P),
+    once(relrl_qtree:qtree_node(KB, 2, leaf(2, [e(c, Q5, hunger), e(b, _, hunger)]))),
+    close_to(7.3625, Q5),
+    relrl_engine:engine_size(KB, Size),
+    Size == size(etg, 7, [nodes=3, leaves=2, entries=4]).
+
+tree_nodes(KB, Nodes) :-
+    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes0),
+    msort(Nodes0, Nodes).
+
+:- end_tests(qtree).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(engine_step).
+
+%   tiny.pl: light 1, dark 2, food 4; hunger always active; food is the reinforcer.
+test(step_reports_code_reward_and_mask,
+     [true((Code == 5, N == hunger, Reward =:= 10, R == true, Mask == 7,
+            between(0, 2, A)))]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light), smell(food)], -1, learn, [],
+                             step(Code, N, [Y], Reward, R, Mask, A, [])),
+    assertion(Y > 0.5).
+
+test(emitted_enters_memory, [Pairs == [0-emitted(b), 0-see(dark)]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_step(KB, [see(dark)], 1, learn, [memory], step(_, _, _, _, _, _, _,
+                                                                       [memory-M])),
+    assertion(M == [0-emitted(b), 0-see(dark)]),
+    relrl_memory:wm_elements(KB, Pairs).
+
+%   The example of the previous step is learned at this step with this step's reward:
+%   a (index 0) in the light, then food: Q(light, a) = 0.5 * (10 + 0.9 * q_init).
+test(learns_previous_step, [Entries == [e(a, 5.0, hunger)]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, learn, [], _),
+    relrl_qtree:qtree_leaf(KB, 0, _, Entries).
+
+test(greedy_and_explore_do_not_learn, [Nodes == [0-leaf(none, [])]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light)], -1, greedy, [], _),
+    relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, explore, [], _),
+    relrl_engine:engine_step(KB, [see(light)], 2, greedy, [], _),
+    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes).
+
+test(end_episode_cuts_the_link, [Nodes == [0-leaf(none, [])]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_end_episode(KB),
+    relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, learn, [], _),
+    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes).
+
+%   Each knowledge base draws from its own random stream.
+test(random_streams_per_kb, [As1 == As2]) :-
+    Steps = [[see(light)], [see(dark)], [see(light), smell(food)], [see(dark)]],
+    P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,
+         reward_positive=10.0, reward_negative= -1.0],
+    kb_with('tests/data/tiny.pl', A),
+    relrl_engine:engine_configure(A, etg, P, 7),
+    findall(X, ( member(S, Steps),
+                 relrl_engine:engine_step(A, S, -1, learn, [], step(_, _, _, _, _, _, X, _)) ),
+            As1),
+    kb_with('tests/data/tiny.pl', B),
+    kb_with('tests/data/tiny.pl', C),
+    relrl_engine:engine_configure(B, etg, P, 7),
+    relrl_engine:engine_configure(C, etg, P, 8),
+    findall(X, ( member(S, Steps),
+                 relrl_engine:engine_step(C, S, -1, learn, [], _),
+                 random(_),
+                 relrl_engine:engine_step(B, S, -1, learn, [], step(_, _, _, _, _, _, X, _)) ),
+            As2).
+
+test(snapshot_restores_memory_and_stream, [X1 == X2]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,
+         reward_positive=10.0, reward_negative= -1.0],
+    relrl_engine:engine_configure(KB, etg, P, 3),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_keep(KB, s),
+    relrl_engine:engine_step(KB, [see(dark)], 0, greedy, [], step(_, _, _, _, _, _, X1, _)),
+    relrl_engine:engine_step(KB, [see(dark)], 0, greedy, [], _),
+    relrl_engine:engine_resume(KB, s),
+    relrl_memory:wm_elements(KB, [0-see(light)]),
+    relrl_engine:engine_step(KB, [see(dark)], 0, greedy, [], step(_, _, _, _, _, _, X2, _)).
+
+test(unknown_learner, [error(domain_error(learner(_), sarsa))]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    relrl_engine:engine_configure(KB, sarsa, [], 0).
+
+:- end_tests(engine_step).

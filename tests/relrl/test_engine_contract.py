@@ -1,0 +1,277 @@
+"""The engine's contract (issue 13): bounded rules, isolated agents, one typed front,
+policies read as data."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+from relrl.engine import GOALS, Engine, StepResult
+from relrl.errors import PolicyError, PrologError, PrologLoadError, QueryTimeout, RuleError
+from relrl.kb import KnowledgeBase
+from relrl.learners import make_learner
+from relrl.loop import Agent, Interaction
+from relrl.sim.caregiver import make_caregiver
+from relrl.sim.sis import SharedAttentionEnv
+from relrl.terms import Var
+from tests.conftest import ROOT
+
+SIS = ROOT / "examples" / "domains" / "sis.pl"
+TINY = ROOT / "tests" / "data" / "tiny.pl"
+GATEWAY = ROOT / "prolog" / "gateway.pl"
+
+
+def domain(tmp_path: Path, text: str, name: str = "d.pl") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+BASE = "stimulus(face).\nresponse(look(a)).\nresponse(look(b)).\n"
+
+
+# -- 1. rules are bounded, and their errors name them --------------------------------------
+
+def test_runaway_test_raises_every_time_and_names_the_rule(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "spin :- spin.\netg_test(spin).\n")
+    with KnowledgeBase(path, timeout=0.5) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        for _ in range(2):  # found every step, not swallowed once and then forever slow
+            with pytest.raises(QueryTimeout) as info:
+                agent.step([("see", "face")])
+            assert info.value.rule == "spin"
+            assert info.value.where.endswith("d.pl:4")
+            assert "d.pl:4: rule spin ran longer than 0.5 s" in str(info.value)
+
+
+def test_runaway_constraint_rule_names_the_rule(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "forbidden(look(a)) :- repeat, fail.\n")
+    with KnowledgeBase(path, timeout=0.5) as kb:
+        agent = Agent(kb, make_learner("qlearning"), seed=0)
+        with pytest.raises(QueryTimeout, match=r"rule forbidden\(look\(a\)\)"):
+            agent.step([("see", "face")])
+
+
+def test_resource_error_in_a_rule_is_a_user_error_naming_it(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "forbidden(look(b)) :- down(0).\n"
+                            "down(N) :- M is N + 1, down(M), M > 0.\n")
+    with KnowledgeBase(path, timeout=30) as kb:
+        agent = Agent(kb, make_learner("contingency"), seed=0)
+        with pytest.raises(RuleError, match=r"d\.pl:4: rule forbidden\(look\(b\)\) ran out "
+                                            r"of stack"):
+            agent.step([("see", "face")])
+        assert kb.holds("true")  # the engine is still usable
+
+
+def test_undefined_predicate_in_a_fact_is_an_error_not_false(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "fact(broken(face)).\nbroken(face) :- nothere.\n")
+    with KnowledgeBase(path, strict=False) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        with pytest.raises(RuleError, match=r"rule broken\(face\).*nothere/0"):
+            agent.step([("see", "face")])
+
+
+def test_loading_runs_under_the_time_limit(tmp_path: Path) -> None:
+    path = domain(tmp_path, "stimulus(face).\n:- repeat, fail.\nresponse(look).\n")
+    with pytest.raises(PrologLoadError, match=r"d\.pl:2: loading ran longer than the time "
+                                              r"limit") as info:
+        KnowledgeBase(path, timeout=0.5)
+    assert info.value.line == 2
+
+
+@pytest.mark.parametrize("directive", ["halt", "halt(3)", "system:halt"])
+def test_halt_in_a_loaded_file_cannot_end_relrl(tmp_path: Path, directive: str) -> None:
+    path = domain(tmp_path, f"stimulus(face).\n:- {directive}.\nresponse(look).\n")
+    with pytest.raises(PrologLoadError, match=r"d\.pl:2: halt/0,1 called while loading"):
+        KnowledgeBase(path)
+    with KnowledgeBase(SIS) as kb:  # still alive
+        assert kb.holds("true")
+
+
+def test_halt_in_a_rule_is_an_error(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "fact(leave(face)).\nleave(face) :- halt.\n")
+    with KnowledgeBase(path) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        with pytest.raises(RuleError, match="halt/0,1 called by a goal"):
+            agent.step([("see", "face")])
+        assert kb.holds("true")
+
+
+def test_abort_while_loading_is_a_load_error(tmp_path: Path) -> None:
+    path = domain(tmp_path, "stimulus(face).\n:- abort.\nresponse(look).\n")
+    with pytest.raises(PrologLoadError, match="abort/0 called while loading"):
+        KnowledgeBase(path)
+    with KnowledgeBase(SIS) as kb:
+        assert kb.holds("true")
+
+
+def test_deep_and_cyclic_terms(tmp_path: Path) -> None:
+    path = domain(tmp_path, BASE + "cyc(X) :- X = f(X).\n"
+                                   "deep(0, z) :- !.\ndeep(N, f(T)) :- M is N-1, deep(M, T).\n")
+    with KnowledgeBase(path) as kb:
+        with pytest.raises(PrologError, match="nested deeper"):
+            kb.call("cyc", Var())
+        with pytest.raises(PrologError, match="nested deeper"):
+            kb.call("deep", 100_000, Var())
+        assert kb.call("deep", 3, Var())[0] == ("f", ("f", ("f", "z")))
+
+
+# -- 2. each agent owns its random stream ----------------------------------------------------
+
+def _trajectory(learner: str, with_other: bool, steps: int = 300) -> list:
+    kb = KnowledgeBase(SIS)
+    agent = Agent(kb, make_learner(learner), seed=3)
+    env = SharedAttentionEnv(make_caregiver("paper"), max_steps=None, record_trace=False)
+    me = Interaction(env, agent)
+    me.reset(seed=3)
+    other = None
+    if with_other:
+        kb2 = KnowledgeBase(SIS)
+        env2 = SharedAttentionEnv(make_caregiver("paper"), max_steps=None, record_trace=False)
+        other = Interaction(env2, Agent(kb2, make_learner(learner), seed=99))
+        other.reset(seed=99)
+    actions = []
+    for _ in range(steps):
+        actions += [r.out.action for r in me.run(1)]
+        if other is not None:
+            other.run(1)
+    kb.close()
+    if other is not None:
+        other.agent.kb.close()
+    return actions
+
+
+@pytest.mark.parametrize("learner", ["etg", "contingency", "qlearning"])
+def test_two_agents_in_one_process_are_isolated(learner: str) -> None:
+    assert _trajectory(learner, with_other=False) == _trajectory(learner, with_other=True)
+
+
+def test_preserved_leaves_learning_as_it_was() -> None:
+    def learn(evaluate: bool) -> list:
+        with KnowledgeBase(SIS) as kb:
+            agent = Agent(kb, make_learner("etg"), seed=1)
+            env = SharedAttentionEnv(make_caregiver("paper"), max_steps=None,
+                                     record_trace=False)
+            learning = Interaction(env, agent)
+            learning.reset(seed=1)
+            actions = [r.out.action for r in learning.run(150)]
+            if evaluate:
+                with agent.preserved():
+                    probe = Interaction(SharedAttentionEnv(make_caregiver("paper")), agent)
+                    probe.reset(seed=7)
+                    probe.run(80, learning=False, explore=True)
+            return actions + [r.out.action for r in learning.run(150)]
+    assert learn(False) == learn(True)
+
+
+# -- 3. one typed front ---------------------------------------------------------------------
+
+def test_goal_table_is_the_gateway_api() -> None:
+    api = set(re.findall(r"^python_api\((\w+:\w+)/\d+\)\.", GATEWAY.read_text(), re.M))
+    transport = {"relrl_gateway:gw_new_kb", "relrl_gateway:gw_drop_kb",
+                 "relrl_gateway:gw_load", "relrl_gateway:gw_query",
+                 "relrl_gateway:gw_take_abort"}
+    assert set(GOALS.values()) == api - transport
+
+
+def test_private_predicates_are_refused() -> None:
+    with KnowledgeBase(TINY) as kb:
+        Agent(kb, make_learner("etg"), seed=0)
+        with pytest.raises(PrologError, match="private_predicate"):
+            kb.call("relrl_qtree:qtree_node", kb.module, Var(), Var())
+        with pytest.raises(PrologError, match="private_predicate"):
+            kb.call("user:shell", "true")
+
+
+def test_step_result_is_decoded() -> None:
+    with KnowledgeBase(TINY) as kb:
+        engine = Engine(kb)
+        engine.configure("etg", {**make_learner("etg").params}, seed=0)
+        r = engine.step([("see", "light"), ("smell", "food")], want=("memory", "memory_size",
+                                                                      "explain"))
+        assert isinstance(r, StepResult)
+        assert r.code == 1 | 4 and r.necessity == "hunger" and r.reinforced
+        assert r.allowed_index == [0, 1, 2] and 0 <= r.action_index <= 2
+        assert r.memory_size == 2 and r.memory == ((0, ("see", "light")), (0, ("smell", "food")))
+        assert r.explanation[0] == "explanation" and r.explanation[1] == "etg"
+
+
+def test_a_response_called_none_is_a_response(tmp_path: Path) -> None:
+    path = domain(tmp_path, "stimulus(s).\nresponse(none).\n")
+    with KnowledgeBase(path) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        out = agent.step([("see", "s")])
+        assert out.action == "none" and out.action is not None
+        out = agent.step([("see", "s")])
+        assert kb.memory()[0] == (0, ("emitted", "none"))
+
+
+def test_traced_step_is_one_gateway_call() -> None:
+    from relrl.kb import gateway_calls
+
+    with KnowledgeBase(SIS) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        env = SharedAttentionEnv(make_caregiver("paper"))
+        _, info = env.reset(seed=0)
+        before = gateway_calls()
+        for _ in range(50):
+            out = agent.step(info["percepts"], want=("memory_size", "explain"))
+            _, _, _, _, info = env.step(out.action)
+            assert out.explanation["learner"] == "etg" and out.memory_size > 0
+        assert gateway_calls() - before == 50
+
+
+# -- policies are data ----------------------------------------------------------------------
+
+def _etg_policy(tmp_path: Path) -> tuple[KnowledgeBase, Agent, Path]:
+    kb = KnowledgeBase(TINY)
+    agent = Agent(kb, make_learner("etg"), seed=0)
+    for percepts in ([("see", "light")], [("see", "dark")], [("see", "light")]):
+        agent.step(percepts)
+    return kb, agent, agent.learner.save(tmp_path / "p.pl")
+
+
+def test_a_directive_in_a_policy_is_refused_and_never_runs(tmp_path: Path) -> None:
+    kb, agent, path = _etg_policy(tmp_path)
+    marker = tmp_path / "ran"
+    text = path.read_text()
+    path.write_text(text + f":- shell('touch {marker}').\n")
+    line = len(text.splitlines()) + 1
+    with pytest.raises(PolicyError, match=rf"p\.pl:{line}: a directive in a policy file is "
+                                          "refused"):
+        agent.learner.load(path)
+    assert not marker.exists()
+    kb.close()
+
+
+@pytest.mark.parametrize("extra,message", [
+    ("evil(X) :- shell(X).", r"p\.pl:\d+: evil/1 is not part of a etg policy \(refused\)"),
+    ("etg_node(9, leaf(abc, [])).", r"bad policy: Type error: `nonneg' expected, found `abc'"),
+    ("etg_node(9, leaf(none, [e(a, high, hunger)])).", r"bad policy: Domain error"),
+    ("etg_node(9, test(0, shell(rm), nil, nil)).", r"bad policy: Domain error: `etg_test\(0\)'"),
+])
+def test_foreign_or_malformed_policy_terms_are_refused(tmp_path: Path, extra: str,
+                                                       message: str) -> None:
+    kb, agent, path = _etg_policy(tmp_path)
+    path.write_text(path.read_text() + extra + "\n")
+    with pytest.raises(PolicyError, match=message):
+        agent.learner.load(path)
+    kb.close()
+
+
+def test_random_bytes_and_other_domains_are_refused(tmp_path: Path) -> None:
+    kb, agent, path = _etg_policy(tmp_path)
+    junk = tmp_path / "junk.pl"
+    junk.write_bytes(bytes(range(256)) * 4)
+    with pytest.raises(PolicyError, match="junk.pl"):
+        agent.learner.load(junk)
+    with KnowledgeBase(SIS) as other:
+        stranger = Agent(other, make_learner("etg"), seed=0)
+        with pytest.raises(PolicyError, match=r"learned for another domain"):
+            stranger.learner.load(path)
+        contingency = Agent(other, make_learner("contingency"), seed=0)
+        with pytest.raises(PolicyError, match=r"learned by etg, not by contingency"):
+            contingency.learner.load(path)
+    kb.close()
