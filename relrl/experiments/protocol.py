@@ -106,7 +106,6 @@ class Session:
                 caregiver_params=self.eval_caregiver_params, steps=self.eval_steps,
                 sequence=sequence)
         agent, explore = self.agent, self.explore
-        saved = agent.save_random()
         before = set(agent.states)
         agent.states.clear()
 
@@ -118,11 +117,10 @@ class Session:
             return agent.step(info["percepts"], learning=False, explore=explore).action
 
         try:
-            result = evaluate(policy, runs=runs, steps=self.eval_steps, seed=self.seed,
-                              which=which, on_run=on_run, env=env)
+            with agent.preserved():
+                result = evaluate(policy, runs=runs, steps=self.eval_steps, seed=self.seed,
+                                  which=which, on_run=on_run, env=env)
         finally:
-            agent.end_episode()
-            agent.restore_random(saved)
             self.eval_states.update(agent.states)
             agent.states = before
         self.steps += self.eval_steps * len(result.runs)
