@@ -24,7 +24,7 @@ swipl:
 $(STAMP): pyproject.toml Makefile
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev,speech]'
+	$(BIN)/pip install -q -e '.[dev,speech,ray]'
 	@touch $(STAMP)
 
 demo: setup

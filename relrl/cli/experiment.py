@@ -204,6 +204,9 @@ def build_scaling_config(args: argparse.Namespace):
     if "places" in {k.split("=")[0].strip() for k in args.world.split(",")}:
         raise ConfigError("--world sets the other fields; give the places with --sizes")
     config.world = {k: v for k, v in world.to_dict().items() if k != "places"}
+    if args.transfer == "places" and "placement" in config.caregiver_params:
+        raise ConfigError("--transfer places sets the placement weights itself; drop "
+                          "--caregiver-param placement or use --transfer none")
     for size in config.sizes:
         try:
             config.world_of(size).caregiver_params(config.caregiver_params, config.caregiver)
@@ -218,9 +221,6 @@ def build_scaling_config(args: argparse.Namespace):
     config.holdout = args.holdout
     if config.transfer == "kinds" and world.kinds < 2:
         raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
-    if config.transfer == "places" and "placement" in config.caregiver_params:
-        raise ConfigError("--transfer places sets the placement weights itself; drop "
-                          "--caregiver-param placement or use --transfer none")
     return config
 
 

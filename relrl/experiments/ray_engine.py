@@ -39,10 +39,36 @@ def _task(fn: Callable[..., dict[str, Any]], args: tuple, index: int, queue: Any
         return ("crash", type(exc).__name__, "".join(traceback.format_exception(exc)))
 
 
+def _check_reachable(address: str, timeout: float = 3.0) -> None:
+    """Fail at once, in one line, when a ``HOST:PORT`` (or ``ray://HOST:PORT``) address does
+    not answer (Ray itself retries for minutes, printing warnings)."""
+    import socket
+
+    target = address.removeprefix("ray://")
+    host, sep, port = target.rpartition(":")
+    if not sep or not port.isdigit() or not host:
+        if address == "auto":
+            return
+        raise ConfigError(f"--address {address!r}: use HOST:PORT, ray://HOST:PORT or auto")
+    try:
+        with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+            pass
+    except OSError as exc:
+        raise ConfigError(f"--address {address}: no Ray cluster answers there "
+                          f"({exc.strerror or exc})") from None
+
+
 def _connect(ray: Any, address: str | None, workers: int) -> bool:
     """Start or join Ray; returns True when this call started it (and must stop it)."""
+    if address is not None:
+        _check_reachable(address)
     if ray.is_initialized():
         return False
+    import os
+
+    # a quiet start: no usage-statistics upload, only Ray's own errors on stderr
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    os.environ.setdefault("RAY_BACKEND_LOG_LEVEL", "error")
     options: dict[str, Any] = {"include_dashboard": False, "logging_level": "ERROR",
                                "log_to_driver": False}
     if address is None:
