@@ -40,6 +40,24 @@ def _caregiver_param(text: str) -> tuple[str, object]:
         return key, value
 
 
+def _places(option: str, text: str | None) -> list[str] | None:
+    """The toy places of ``--train-places`` / ``--eval-places`` (None when not given)."""
+    from relrl.errors import ConfigError
+    from relrl.sim.errors import did_you_mean
+    from relrl.sim.places import TOY_PLACES
+
+    if text is None:
+        return None
+    places = [p.strip() for p in text.split(",") if p.strip()]
+    if not places:
+        raise ConfigError(f"{option} needs at least one place ({', '.join(TOY_PLACES)})")
+    for p in places:
+        if p not in TOY_PLACES:
+            raise ConfigError(f"{option}: unknown toy place {p!r}{did_you_mean(p, TOY_PLACES)} "
+                              f"(places: {', '.join(TOY_PLACES)})")
+    return list(dict.fromkeys(places))
+
+
 def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds: str) -> None:
     p.add_argument("--learners", default=default_learners,
                    help=f"comma-separated learners (default: {default_learners})")
@@ -78,9 +96,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     sis = sub.add_parser("sis", help="the paper's Experiment 1 (three learners in the SIS)",
                          description="The paper's Experiment 1: learning curves (CGI), eye "
                                      "contacts and memory of each learner in the simulator.")
-    _common(sis, default_learners="contingency,qlearning,etg", default_seeds="0")
+    _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
     sis.add_argument("--points", type=int, default=None,
                      help="evaluation points after the first (default 20; --quick: 4)")
+    sis.add_argument("--train-places", default=None, metavar="P,P,...",
+                     help="toy places while learning, e.g. left,left_down,down (default: "
+                          "all); the others are held out")
+    sis.add_argument("--eval-places", default=None, metavar="P,P,...",
+                     help="toy places of the evaluation (default: all); with held-out "
+                          "places the CGI is reported for trained and held-out apart")
     sis.add_argument("--domain", default=None, help="domain file (default sis.pl)")
     sis.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
     sc = sub.add_parser("scaling", help="every learner in worlds that grow; transfer",
@@ -168,6 +192,8 @@ def build_config(args: argparse.Namespace):
         raise ConfigError(f"--points must be at least 1, not {config.points}")
     _check_common(args, config, LEARNERS)
     make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker
+    config.train_places = _places("--train-places", args.train_places)
+    config.eval_places = _places("--eval-places", args.eval_places)
     if args.domain:
         if not Path(args.domain).is_file():
             raise ConfigError(f"--domain {args.domain}: no such file")

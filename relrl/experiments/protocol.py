@@ -90,7 +90,8 @@ class Session:
         self.learned += steps
 
     def evaluate(self, runs: int, *, which: tuple[int, int] | None = None,
-                 sequence: Sequence[str] | None = None, world: Any = None) -> Any:
+                 sequence: Sequence[str] | None = None, world: Any = None,
+                 by_place: bool = False) -> Any:
         """Evaluate without changing the learner: runs ``which`` of ``runs`` (all by default)
         by :func:`relrl.sim.evaluation.evaluate`, targets from ``sequence`` (default: the
         world's balanced sequence) in ``world`` (default: the learning world)."""
@@ -119,7 +120,7 @@ class Session:
         try:
             with agent.preserved():
                 result = evaluate(policy, runs=runs, steps=self.eval_steps, seed=self.seed,
-                                  which=which, on_run=on_run, env=env)
+                                  which=which, on_run=on_run, env=env, by_place=by_place)
         finally:
             self.eval_states.update(agent.states)
             agent.states = before

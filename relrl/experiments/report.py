@@ -56,6 +56,9 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
         memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
         evaluation = [j["states_met"]["evaluation"] for j in mine
                       if j["states_met"]["evaluation"] is not None]
+        firsts = [j["curve"][1]["memory"] for j in mine if len(j["curve"]) > 1]
+        memory_first = ({k: float(np.mean([m[k] for m in firsts])) for k in firsts[0]}
+                        if firsts else None)
         out[name] = {
             "curve": curve,
             "cgi_after_first_run": curve[1]["cgi_mean"] if points > 1 else None,
@@ -67,26 +70,50 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
                              "opportunities": n_opp,
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
+            "memory_after_first_run": memory_first,
             "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
             "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
             "partial": any(j.get("partial", False) for j in mine),
         }
+        if "cgi_places" in mine[0]["curve"][0]:
+            out[name]["cgi_places"] = _places_curve(mine, points)
+    return out
+
+
+def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any]]:
+    """Per place group (trained, held_out), the CGI at each point pooled over seeds and runs
+    (correct shifts over shifts; None when no shift was made)."""
+    out: dict[str, list[Any]] = {}
+    for group in jobs[0]["curve"][0]["cgi_places"]:
+        values = []
+        for p in range(points):
+            runs = [r for j in jobs if len(j["curve"]) > p
+                    for r in j["curve"][p]["cgi_places"][group]["runs"]]
+            shifts = sum(r[1] for r in runs)
+            values.append(sum(r[0] for r in runs) / shifts if shifts else None)
+        out[group] = values
     return out
 
 
 def summary_table(summary: dict[str, Any]) -> str:
     """The results as a fixed-width text table."""
     nan = float("nan")
-    lines = [f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'literal':>8} "
-             f"{'eye contacts':>13} {'memory':>8} {'states':>7}"]
+    places = any("cgi_places" in s for s in summary.values())
+    head = (f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'literal':>8} "
+            f"{'eye contacts':>13} {'memory':>8} {'states':>7}")
+    lines = [head + (f" {'trained':>8} {'held out':>8}" if places else "")]
     for name, s in summary.items():
         ec = s["eye_contacts"]
         first = s["cgi_after_first_run"]
-        lines.append(f"{name:<12} {first if first is not None else nan:>9.3f} "
-                     f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
-                     f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
-                     f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}"
-                     + ("  (partial)" if s.get("partial") else ""))
+        line = (f"{name:<12} {first if first is not None else nan:>9.3f} "
+                f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
+                f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
+                f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+        if places:
+            for group in ("trained", "held_out"):
+                v = s.get("cgi_places", {}).get(group, [None])[-1]
+                line += f" {v:>8.3f}" if v is not None else f" {'-':>8}"
+        lines.append(line + ("  (partial)" if s.get("partial") else ""))
     return "\n".join(lines)
 
 
@@ -125,6 +152,18 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
             detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
             w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
     written += [fig5, fig4, memory]
+    if any("cgi_places" in s for s in summary.values()):
+        places = out_dir / "cgi_places.csv"
+        with open(places, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["learner", "point", "cgi_trained", "cgi_held_out"])
+            for name, s in summary.items():
+                groups = s.get("cgi_places", {})
+                for p in range(len(s["curve"])):
+                    w.writerow([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
+                                            else f"{groups[g][p]:.6f}"
+                                            for g in ("trained", "held_out")])
+        written.append(places)
     written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
 

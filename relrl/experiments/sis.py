@@ -1,5 +1,5 @@
 """Experiment 1 of da Silva & Romero (2012, section 5.1): contingency, Q-learning and ETG in
-the Social Interactive Simulator.
+the Social Interactive Simulator (and every other registered learner beside them).
 
 Protocol: a learner interacts with the caregiver; every ``block`` (500) learning time units
 learning stops for an evaluation of ``eval_runs`` (20) runs of ``eval_steps`` (500) time
@@ -8,6 +8,12 @@ the distractor at random. Each run's CGI (Eq. 5) is recorded; Fig. 5 plots their
 standard deviation per evaluation point. Fig. 4 counts the eye contacts the robot establishes
 in the first 125 opportunities of the interaction. The learner's memory is reported in the
 paper's positions.
+
+Held-out places (``train_places``/``eval_places``): while learning, toys appear (and the
+caregiver looks) only at the training places (the caregiver's placement weights); evaluation
+puts targets (by a balanced sequence) and distractors at the evaluation places, and the CGI is
+also reported for the trained and the held-out places apart (``cgi_places`` at each point:
+pooled correct shifts over shifts).
 
 One *job* is one learner with one seed; jobs are independent and run in worker processes
 (each holds one Prolog engine).
@@ -36,11 +42,18 @@ PAPER: dict[str, Any] = {
 }
 
 
+def _all_learners() -> list[str]:
+    from relrl.learners import LEARNERS
+
+    return list(LEARNERS)
+
+
 @dataclass
 class SISConfig:
     """Everything that determines an Experiment 1 run (written into results.json)."""
 
-    learners: list[str] = field(default_factory=lambda: ["contingency", "qlearning", "etg"])
+    #: the registered learners (the paper's three, and relrl's own when registered).
+    learners: list[str] = field(default_factory=_all_learners)
     seeds: list[int] = field(default_factory=lambda: [0])
     points: int = 20                 #: evaluation points after the first (point 0: no learning)
     block: int = 500                 #: learning time units between evaluations
@@ -56,6 +69,10 @@ class SISConfig:
     #: "behaviour": evaluate the robot as it behaves (its exploration kept, no learning);
     #: "greedy": the learners' greedy policy (contingency's roulette stays a roulette).
     eval_policy: str = "behaviour"
+    #: toy places used while learning (None: the caregiver's own placement).
+    train_places: list[str] | None = None
+    #: toy places of the evaluation's targets and distractors (None: all of them).
+    eval_places: list[str] | None = None
 
     def jobs(self) -> list[tuple[str, int]]:
         """Every (learner, seed) pair, learners first."""
@@ -69,6 +86,23 @@ class SISConfig:
         out["caregiver_resolved"] = make_caregiver(self.caregiver,
                                                    self.caregiver_params).params.to_dict()
         return out
+
+    def place_split(self) -> tuple[dict[str, Any], dict[str, Any], tuple[str, ...] | None,
+                                   dict[str, set[str]]]:
+        """Learning and evaluation caregiver overrides, the evaluation's target places and
+        the place groups reported apart (empty without held-out places)."""
+        from relrl.sim.places import TOY_PLACES
+
+        learn, evaluation = dict(self.caregiver_params), dict(self.caregiver_params)
+        if self.train_places:
+            learn["placement"] = {p: 1.0 for p in self.train_places}
+        if not (self.train_places or self.eval_places):
+            return learn, evaluation, None, {}
+        places = tuple(self.eval_places or TOY_PLACES)
+        evaluation["placement"] = {p: 1.0 for p in places}
+        trained = set(self.train_places or TOY_PLACES)
+        return learn, evaluation, places, {"trained": set(places) & trained,
+                                           "held_out": set(places) - trained}
 
 
 def run_job(config: SISConfig, learner_name: str, seed: int,
@@ -91,22 +125,31 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
     same seed gives the same file).
     """
     from relrl.experiments.protocol import Session, point_summary
+    from relrl.sim.caregiver import evaluation_sequence
 
     start, stop = runs if runs is not None else (0, config.eval_runs)
+    learn, evaluation, places, groups = config.place_split()
+    sequence = evaluation_sequence(places) if places else None
     with Session(config.domain, learner_name, config.learner_params.get(learner_name, {}),
-                 seed, caregiver=config.caregiver, caregiver_params=config.caregiver_params,
-                 eval_steps=config.eval_steps, eval_policy=config.eval_policy) as session:
+                 seed, caregiver=config.caregiver, caregiver_params=learn,
+                 eval_caregiver_params=evaluation, eval_steps=config.eval_steps,
+                 eval_policy=config.eval_policy) as session:
         curve = []
         for point in range(config.points + 1):
             if point > 0:
                 session.learn(config.block)
-            ev = session.evaluate(config.eval_runs, which=(start, stop))
+            ev = session.evaluate(config.eval_runs, which=(start, stop), sequence=sequence,
+                                  by_place=bool(groups))
             entry = {"point": point, "learning_steps": point * config.block,
                      "runs": [start, stop], **point_summary(ev),
                      "memory": session.memory(),
                      "eye_contacts": session.eye_contacts(config.opportunities),
                      "learning": session.learning_summary(),
                      "states_met": len(session.learning_states)}
+            if groups:
+                entry["place_runs"] = {
+                    g: [[sum(r["by_place"].get(p, [0, 0])[i] for p in ps) for i in (0, 1)]
+                        for r in ev.runs] for g, ps in sorted(groups.items())}
             curve.append(entry)
             if report is not None:
                 report({"kind": "point", "learner": learner_name, "seed": seed,
@@ -114,6 +157,12 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
         return {"learner": learner_name, "seed": seed,
                 "params": session.learner.params, "curve": curve, "runs": [start, stop],
                 "eval_states": sorted(session.eval_states), "timing": session.timing()}
+
+
+def _pooled(runs: list[list[int]]) -> dict[str, Any]:
+    """The runs' ``[correct, shifts]`` and their pooled CGI (None: no shift at all)."""
+    correct, shifts = sum(r[0] for r in runs), sum(r[1] for r in runs)
+    return {"cgi": correct / shifts if shifts else None, "runs": runs}
 
 
 def job_from_curve(learner: str, seed: int, parts: list[list[dict[str, Any]]],
@@ -144,7 +193,11 @@ def job_from_curve(learner: str, seed: int, parts: list[list[dict[str, Any]]],
                       "cgi_std": float(np.std(runs["cgi_runs"])),
                       "cgi_literal_mean": float(np.mean(runs["cgi_literal_runs"])),
                       "cgi_literal_std": float(np.std(runs["cgi_literal_runs"])),
-                      "memory_positions": first[i]["memory"]["positions"], **runs})
+                      "memory": first[i]["memory"], **runs})
+        if "place_runs" in first[i]:
+            curve[-1]["cgi_places"] = {
+                g: _pooled([r for c in parts for r in c[i]["place_runs"][g]])
+                for g in first[i]["place_runs"]}
     last = first[n - 1]
     job = {"learner": learner, "seed": seed, "curve": curve,
            "eye_contacts": last["eye_contacts"],

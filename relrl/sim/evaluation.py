@@ -93,7 +93,7 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
              steps: int = 500, seed: int = 0, sequence: Sequence[str] | None = None,
              which: tuple[int, int] | None = None,
              on_run: Callable[[int, int], None] | None = None,
-             env: Any = None, observation: int = 0) -> Evaluation:
+             env: Any = None, observation: int = 0, by_place: bool = False) -> Evaluation:
     """Evaluate a policy by the paper's protocol.
 
     Args:
@@ -113,6 +113,8 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
             agent's random streams and clear its working memory).
         env: an evaluation environment built by :func:`evaluation_env` (saves building one).
         observation: the observation version the policy reads (0: ``-v0``, 1: ``-v1``).
+        by_place: add each run's ``by_place``: per place the caregiver looked at,
+            ``[correct shifts, shifts]``.
 
     Returns:
         An :class:`Evaluation` with one metrics dict per run.
@@ -136,6 +138,9 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
         for _ in range(steps):
             obs, _, _, _, info = env.step(policy(obs, info))
         metrics = env.metrics()
+        if by_place:
+            metrics["by_place"] = {p: list(c) for p, c in
+                                   sorted(env.gaze_metrics.by_place.items())}
         for key in ("cgi", "cgi_literal"):
             if math.isnan(metrics[key]):
                 metrics[key] = 0.0

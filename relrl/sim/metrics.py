@@ -131,6 +131,8 @@ class GazeMetrics:
         self.correct_shifts = 0
         #: every shift from the human, whatever the caregiver looked at (Eq. 5 literally).
         self.all_shifts = 0
+        #: per place the caregiver looked at: [correct shifts, shifts] (relrl's CGI by place).
+        self.by_place: dict[str, list[int]] = {}
         self._finished: list[bool] = []
         self._streak = 0
         self._prev: StepRecord | None = None
@@ -159,8 +161,11 @@ class GazeMetrics:
             self.all_shifts += 1
             if prev.gaze != FRONTAL:
                 self.shifts += 1
+                counts = self.by_place.setdefault(prev.gaze, [0, 0])
+                counts[1] += 1
                 if rec.focus == prev.gaze:
                     self.correct_shifts += 1
+                    counts[0] += 1
         self._prev = rec
 
     def extend(self, records: Iterable[StepRecord]) -> GazeMetrics:

@@ -311,6 +311,11 @@ class SharedAttentionEnv(gym.Env, Environment):
         """The record of the current time unit (``None`` before ``reset``)."""
         return self._record
 
+    @property
+    def gaze_metrics(self) -> GazeMetrics:
+        """The episode's :class:`GazeMetrics`, fed every time unit (CGI by place too)."""
+        return self._metrics
+
     def metrics(self, first: int | None = None) -> dict[str, float | int]:
         """The episode's metrics so far (:meth:`GazeMetrics.summary`): ``cgi`` (relrl's),
         ``cgi_literal`` (Eq. 5 as written), ``eye_contacts`` of ``opportunities``, ..."""

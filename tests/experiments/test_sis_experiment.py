@@ -80,3 +80,30 @@ def test_bad_options_one_line_exit_2(args: list[str], message: str, tmp_path: Pa
     err = capsys.readouterr().err
     assert message in err
     assert len(err.strip().splitlines()) == 1
+
+
+def test_held_out_places_are_reported_apart(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "held"
+    assert main(["experiment", "sis", "--learners", "qlearning", *SMALL, "--train-places",
+                 "left,down,right", "--out", str(out), "--workers", "2"]) == 0
+    assert "held out" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    curve = results["jobs"][0]["curve"]
+    groups = curve[-1]["cgi_places"]
+    assert set(groups) == {"trained", "held_out"}
+    assert len(groups["trained"]["runs"]) == 2             # both parts' runs pooled
+    pooled = [groups[g]["cgi"] for g in ("trained", "held_out")]
+    assert all(v is None or 0 <= v <= 1 for v in pooled)
+    assert (out / "cgi_places.csv").read_text().startswith("learner,point,cgi_trained,")
+    config = results["config"]
+    assert config["train_places"] == ["left", "down", "right"] and config["eval_places"] is None
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--train-places", "left,upp"], "--train-places: unknown toy place 'upp'"),
+    (["--eval-places", ","], "--eval-places needs at least one place"),
+])
+def test_bad_place_options_one_line_exit_2(args, message, tmp_path: Path, capsys) -> None:
+    assert main(["experiment", "sis", *args, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
