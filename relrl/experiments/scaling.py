@@ -49,9 +49,9 @@ class ScalingConfig:
     caregiver_params: dict[str, Any] = field(default_factory=dict)
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     budget: int = 60_000             #: learning time units at most
-    block: int = 1_000               #: learning time units between evaluations
+    block: int = 2_000               #: learning time units between evaluations
     eval_runs: int = 10
-    eval_steps: int = 500
+    eval_steps: int = 300
     threshold: float = 0.9
     patience: int = 2                #: stop after this many evaluations >= threshold (0: never)
     eval_policy: str = "behaviour"
