@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "skip_plots", "summary_table", "write_json_atomic", "write_outputs"]
+__all__ = ["aggregate", "pyplot_or_note", "skip_plots", "summary_table", "write_json_atomic",
+           "write_outputs"]
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -177,8 +178,9 @@ def skip_plots(out_dir: Path) -> list[Path]:
     return [note]
 
 
-def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
-    """Fig. 4 and Fig. 5 as PNG files; nothing (and a note) without matplotlib."""
+def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
+    """``(matplotlib.pyplot, [])`` drawing off-screen, or ``(None, [note])`` with a note in
+    ``out_dir`` saying how to get plots when matplotlib is not installed."""
     try:
         import matplotlib
 
@@ -189,7 +191,16 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
                         "are in the CSV files.\nInstall the extra to get plots:  "
                         "pip install 'relrl[plots]'\n")
-        return [note]
+        return None, [note]
+    return plt, []
+
+
+def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
+    """Fig. 4 and Fig. 5 as PNG files; nothing (and a note) without matplotlib."""
+    plt, note = pyplot_or_note(out_dir)
+    if plt is None:
+        return note
+
     def finish(fig, ax, name: str, xlabel: str, ylabel: str, title: str) -> Path:
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)

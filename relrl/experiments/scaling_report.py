@@ -14,7 +14,7 @@ import platform
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import skip_plots, write_json_atomic
+from relrl.experiments.report import pyplot_or_note, skip_plots, write_json_atomic
 from relrl.experiments.runner import run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
 
@@ -116,17 +116,9 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
 
 def plot(out: Path, results: dict[str, Any]) -> list[Path]:
     """The three figures as PNG files; a note instead without matplotlib."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        note = out / "PLOTS.txt"
-        note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
-                        "are in the CSV files.\nInstall the extra to get plots:  "
-                        "pip install 'relrl[plots]'\n")
-        return [note]
+    plt, note = pyplot_or_note(out)
+    if plt is None:
+        return note
     summary, config = results["summary"], results["config"]
     threshold, budget = config["threshold"], config["budget"]
     files = []
