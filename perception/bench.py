@@ -5,8 +5,13 @@
   interaction: the caregiver's face in changing poses for runs of frames, then the head turning
   to toys and fruits (and empty places). Frames are rendered before timing. ``*_cold`` figures
   reset the tracker before every frame: a full search each time (the worst case).
-* **Photos**: the same on two real photographs from scikit-image (cold), whose clutter makes the
-  cascades work harder than the rendered scenes do.
+* **Photos**: the same on two real photographs from scikit-image, the astronaut and the
+  cameraman, each squeezed from 512x512 to the frame size, full search every frame (cold), whose
+  clutter makes the cascades work harder than the rendered scenes do: at 320x240 no cascade
+  fires on the squeezed astronaut, so all three search the whole frame, and the cameraman is
+  found by the last one (``right_2``). ``cpu_fps_*`` count frames per second of this process's
+  CPU time, which other jobs on a shared machine barely change; ``ms_photos_320x240_cold`` is the
+  CPU time per frame of each stage (faces, saliency, colour).
 * **Faces**: recall on the 100 faces of scikit-image's ``lfw_subset()`` and false detections on
   its 100 non-faces, with the same detector (full search, all three cascades). The 25x25 crops
   are enlarged to 64x64 and padded by 16 pixels of replicated border, so that the 20x20
@@ -48,18 +53,20 @@ def interaction_views(n: int = 240, seed: int = 0):
     return views[:n]
 
 
-def _fps(frames: list[np.ndarray], cold: bool) -> float:
+def _fps(frames: list[np.ndarray], cold: bool, cpu: bool = False) -> float:
+    """Frames per second of wall time (per second of this process's CPU time if ``cpu``)."""
     from perception.pipeline import Perceiver
 
+    clock = time.process_time if cpu else time.perf_counter
     perceiver = Perceiver()
     perceiver.analyse(frames[0])  # warm up (cascades load)
     perceiver.reset()
-    start = time.perf_counter()
+    start = clock()
     for frame in frames:
         if cold:
             perceiver.reset()
         perceiver.analyse(frame)
-    return len(frames) / (time.perf_counter() - start)
+    return len(frames) / (clock() - start)
 
 
 def lfw_figures() -> dict[str, int]:
@@ -83,18 +90,52 @@ def lfw_figures() -> dict[str, int]:
             "false_detections": int(sum(found[100:]))}
 
 
-def _photo_fps(frames: int) -> dict[str, float]:
-    """Speed on real photographs (cluttered, so the cascades work harder than on renders):
-    scikit-image's astronaut (a frontal face) and cameraman (a turned face), cold."""
+def _photos(size: tuple[int, int]) -> list[np.ndarray]:
+    """scikit-image's astronaut and cameraman (512x512) resized to ``size`` as BGR frames."""
     import cv2
     from skimage import data
 
+    return [cv2.resize(cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR), size),
+            cv2.resize(cv2.cvtColor(data.camera(), cv2.COLOR_GRAY2BGR), size)]
+
+
+def _stage_ms(photos: list[np.ndarray], rounds: int) -> dict[str, float]:
+    """CPU milliseconds per frame of each stage of a full search on ``photos``."""
+    from perception.colour import colour_summary
+    from perception.faces import FaceTracker
+    from perception.saliency import most_salient
+
+    tracker = FaceTracker()
+    areas = [most_salient(f) for f in photos]
+    masks = [np.zeros(f.shape[:2], np.uint8) if a is None else a.mask
+             for f, a in zip(photos, areas, strict=True)]
+    stages = {"faces": lambda k: tracker.detect(photos[k]),
+              "saliency": lambda k: most_salient(photos[k]),
+              "colour": lambda k: colour_summary(photos[k], masks[k])}
     out = {}
+    for name, stage in stages.items():
+        stage(0)
+        start = time.process_time()
+        for k in range(rounds):
+            tracker.reset()
+            stage(k % len(photos))
+        out[name] = round(1e3 * (time.process_time() - start) / rounds, 2)
+    return out
+
+
+def _photo_fps(frames: int) -> dict[str, float]:
+    """Speed on real photographs (cluttered, so the cascades work harder than on renders):
+    scikit-image's astronaut and cameraman, each squeezed from 512x512 to the frame size, full
+    search every frame. Wall-clock fps (the figure) and fps per CPU second of this process
+    (what the frames cost, whatever else runs on the machine); and at 320x240 the CPU
+    milliseconds per frame of the face search, saliency and colour stages."""
+    out: dict[str, float] = {}
     for w, h in ((320, 240), (640, 480)):
-        photos = [cv2.resize(cv2.cvtColor(data.astronaut(), cv2.COLOR_RGB2BGR), (w, h)),
-                  cv2.resize(cv2.cvtColor(data.camera(), cv2.COLOR_GRAY2BGR), (w, h))]
-        out[f"fps_photos_{w}x{h}_cold"] = round(_fps([photos[k % 2] for k in range(frames // 2)],
-                                                     cold=True), 1)
+        photos = _photos((w, h))
+        run = [photos[k % 2] for k in range(frames // 2)]
+        out[f"fps_photos_{w}x{h}_cold"] = round(_fps(run, cold=True), 1)
+        out[f"cpu_fps_photos_{w}x{h}_cold"] = round(_fps(run, cold=True, cpu=True), 1)
+    out["ms_photos_320x240_cold"] = _stage_ms(_photos((320, 240)), frames // 4)
     return out
 
 
@@ -108,7 +149,9 @@ def bench(frames: int = 240, seed: int = 0, faces: bool = True) -> dict[str, flo
 
     Returns:
         ``fps_320x240``, ``fps_640x480`` (tracking), ``fps_320x240_cold``, ``fps_640x480_cold``
-        (full search every frame), ``face_recall`` (fraction), ``faces_found``,
+        (full search every frame); with ``faces``: ``fps_photos_*_cold`` and
+        ``cpu_fps_photos_*_cold`` (real photos, full search), ``ms_photos_320x240_cold`` (CPU
+        ms per frame by stage), ``face_recall`` (fraction), ``faces_found``,
         ``false_detections`` and the counts behind them.
     """
     import cv2

@@ -79,7 +79,12 @@ def colour_summary(frame: np.ndarray, mask: np.ndarray, min_saturation: float = 
     Returns:
         The summary.
     """
-    pixels = frame[mask > 0]
+    import cv2
+
+    # gathered inside the area's bounding box: the same pixels in the same order, faster
+    inside = np.asarray(mask) > 0
+    x, y, w, h = cv2.boundingRect(inside.view(np.uint8))
+    pixels = frame[y:y + h, x:x + w][inside[y:y + h, x:x + w]]
     if len(pixels) == 0:
         return ColourSummary(0, 0, 0, None, 0.0, 0.0, None)
     step = 256 // _RGB_BINS

@@ -89,6 +89,7 @@ def _gabor_kernels() -> list[np.ndarray]:
 
 
 _GABORS: list[np.ndarray] = []
+_PEAK_KERNEL = np.ones((3, 3), np.uint8)
 
 
 def _normalise(m: np.ndarray) -> np.ndarray:
@@ -98,14 +99,15 @@ def _normalise(m: np.ndarray) -> np.ndarray:
     top = float(m.max())
     if top <= 1e-9:
         return m
-    peaks = (m == cv2.dilate(m, np.ones((3, 3), np.uint8))) & (m > 0.05 * top)
+    peaks = (m == cv2.dilate(m, _PEAK_KERNEL)) & (m > 0.05 * top)
     values = m[peaks]
     others = values[values < top]
-    mean = float(others.mean()) if others.size else 0.0
+    # the float32 sum over the count is what ndarray.mean computes, without its overhead
+    mean = float(others.sum() / others.size) if others.size else 0.0
     return m * (1.0 - mean / top) ** 2
 
 
-def _centre_surround(pyr: list[np.ndarray], size: tuple[int, int]) -> np.ndarray:
+def _centre_surround(pyr: list[np.ndarray | None], size: tuple[int, int]) -> np.ndarray:
     """Sum over (c, s) of N(|F(c) - F(s)|), each resized to the map level."""
     import cv2
 
@@ -155,7 +157,8 @@ def saliency_map(frame: np.ndarray, params: SaliencyParams = SaliencyParams()) -
     cons_c = _centre_surround(rg, size) + _centre_surround(by, size)
     cons_o = np.zeros_like(cons_i)
     for kernel in _GABORS:
-        opyr = [np.abs(cv2.filter2D(level, -1, kernel)) for level in ipyr]
+        # level 0 is only the base of the pyramid: centre-surround starts at level 1
+        opyr = [None] + [np.abs(cv2.filter2D(level, -1, kernel)) for level in ipyr[1:]]
         cons_o += _normalise(_centre_surround(opyr, size))
     return ((_normalise(cons_i) + _normalise(cons_c) + _normalise(cons_o)) / 3.0).astype(
         np.float32)
@@ -193,7 +196,7 @@ def most_salient(frame: np.ndarray, params: SaliencyParams = SaliencyParams(),
     _, labels = cv2.connectedComponents(above, connectivity=8)
     small = (labels == labels[py, px]).astype(np.uint8) * 255
     mask = cv2.resize(small, (w, h), interpolation=cv2.INTER_LINEAR)
-    mask = np.where(mask >= 128, 255, 0).astype(np.uint8)
+    cv2.threshold(mask, 127, 255, cv2.THRESH_BINARY, dst=mask)  # 255 where >= 128, else 0
     area = float(np.count_nonzero(mask)) / (w * h)
     if area < params.min_area:
         return None

@@ -198,11 +198,11 @@ relrl_engine:learner_init(contingency, KB, _Params) :-
     contingency_init(KB).
 
 relrl_engine:learner_choose(contingency, KB, Code, N, Allowed, _Mode, Action) :-
-    engine_config(KB, params, Params),
+    engine_params(KB, Params),
     contingency_choose(KB, Code, N, Allowed, Params, Action).
 
 relrl_engine:learner_update(contingency, KB, transition(Code0, A0, N0, _, Reinforced, _, _, _)) :-
-    engine_config(KB, params, Params),
+    engine_params(KB, Params),
     contingency_update(KB, Code0, A0, N0, Reinforced, Params).
 
 relrl_engine:learner_explain(contingency, KB, Code, N, contingency(Ranked)) :-

@@ -15,6 +15,7 @@
             engine_reseed/2,          % +KB, +Seed
             engine_forget/1,          % +KB
             engine_param/3,           % +KB, ?Name, ?Value
+            engine_params/2,          % +KB, -Params
             engine_config/3,          % +KB, ?Key, ?Value
             engine_learner/2,         % +KB, -Learner
             engine_responses/2,       % +KB, -Responses
@@ -143,6 +144,13 @@ engine_param(KB, Name, Value) :-
     ;   member(Name=Value, Params)
     ).
 
+%!  engine_params(+KB, -Params:list) is det.
+%
+%   The learner's parameters, Name=Value (what learners read in every step).
+
+engine_params(KB, Params) :-
+    run(KB, run(_, Params, _, _, _, _, _, _)).
+
 %!  engine_config(+KB, ?Key, ?Value) is nondet.
 %!  engine_config(+KB, +Key, -Value) is semidet.
 %
@@ -153,8 +161,12 @@ engine_param(KB, Name, Value) :-
 engine_config(KB, Key, Value) :-
     run(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
                 Necessities)),
+    (   Constraints == true
+    ->  HasConstraints = true
+    ;   HasConstraints = false
+    ),
     Config = [learner-Learner, params-Params, features-Features, responses-Responses,
-              units-Units, reinforcers-Reinforcers, constraints-Constraints,
+              units-Units, reinforcers-Reinforcers, constraints-HasConstraints,
               necessities-Necessities],
     (   atom(Key)
     ->  memberchk(Key-Value, Config)
@@ -199,7 +211,9 @@ engine_configure(KB, Learner, Params, Seed) :-
     motivation_units(KB, Units),
     (   domain_defines(KB, forbidden(_))
     ->  Constraints = true
-    ;   Constraints = false
+    ;   findall(I, nth0(I, Responses, _), AllIx),     % no constraint rules: all allowed,
+        foldl(set_bit, AllIx, 0, AllMask),            % always (computed once)
+        Constraints = none(AllIx, AllMask)
     ),
     run_key(KB, RunKey),
     nb_setval(RunKey, run(Learner, Params, Features, Responses, Units, Reinforcers,
@@ -313,8 +327,7 @@ step(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constrain
     ->  Reinforced = true, memberchk(reward_positive=Reward, Params)
     ;   Reinforced = false, memberchk(reward_negative=Reward, Params)
     ),
-    allowed(KB, Constraints, Responses, AllowedIx, Allowed),
-    foldl(set_bit, AllowedIx, 0, AllowedMask),
+    allowed(KB, Constraints, Responses, Allowed, AllowedMask),
     (   Mode == learn,
         EmittedIx >= 0,
         Prev = prev(S0, N0)
@@ -354,15 +367,26 @@ reinforced(KB, Reinforcers) :-
     member(S, Reinforcers),
     sense(Sense),
     Percept =.. [Sense, S],
-    wm_element(KB, Percept, 0),
+    wm_now(KB, Percept),
     !.
 
-allowed(KB, Constraints, Responses, AllowedIx, Allowed) :-
-    (   Constraints == true
-    ->  findall(I-R, ( nth0(I, Responses, R), \+ forbidden(KB, R) ), Pairs)
-    ;   findall(I-R, nth0(I, Responses, R), Pairs)
+allowed(KB, Constraints, Responses, Allowed, Mask) :-
+    (   Constraints = none(_, AllMask)
+    ->  Allowed = Responses,
+        Mask = AllMask
+    ;   allowed_(Responses, KB, 0, Allowed, 0, Mask)
+    ).
+
+allowed_([], _, _, [], Mask, Mask).
+allowed_([R|Rs], KB, I, Allowed, Mask0, Mask) :-
+    (   forbidden(KB, R)
+    ->  Allowed = Allowed1,
+        Mask1 = Mask0
+    ;   Allowed = [R|Allowed1],
+        Mask1 is Mask0 \/ (1 << I)
     ),
-    pairs_keys_values(Pairs, AllowedIx, Allowed).
+    I1 is I + 1,
+    allowed_(Rs, KB, I1, Allowed1, Mask1, Mask).
 
 set_bit(I, M0, M) :-
     M is M0 \/ (1 << I).

@@ -62,16 +62,38 @@ etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
     leaf_entries(KB, D, Entries),
     param(Params, q_init, Q0),
     param(Params, epsilon, Epsilon),
-    findall(Qa-A, ( member(A, Allowed), qtree_entry_q(Entries, A, N, Q0, Qa) ), Scored),
+    Allowed = [A1|As],
+    entry_q(Entries, A1, N, Q0, Q1),
+    scores(As, Entries, N, Q0, Scored1, Q1, Best),
+    Scored = [Q1-A1|Scored1],
     (   random_float < Epsilon
     ->  random_member(Q-Action, Scored)
-    ;   max_member(Best-_, Scored),
-        include(scored(Best), Scored, Ties),
+    ;   ties(Scored, Best, Ties),
         random_member(Q-Action, Ties)
     ).
 
-scored(Best, Q-_) :-
-    Q =:= Best.
+%   Q of each allowed action (in order), and the largest.
+scores([], _, _, _, [], Best, Best).
+scores([A|As], Entries, N, Q0, [Q-A|Ss], Best0, Best) :-
+    entry_q(Entries, A, N, Q0, Q),
+    Best1 is max(Best0, Q),
+    scores(As, Entries, N, Q0, Ss, Best1, Best).
+
+ties([], _, []).
+ties([Q-A|Ss], Best, Ties) :-
+    (   Q =:= Best
+    ->  Ties = [Q-A|Ties1]
+    ;   Ties = Ties1
+    ),
+    ties(Ss, Best, Ties1).
+
+%   The Q of the entry for action A under necessity N (Q0 when there is none).
+entry_q([], _, _, Q0, Q0).
+entry_q([e(A1, Q1, N1)|Es], A, N, Q0, Q) :-
+    (   A1 == A, N1 == N
+    ->  Q = Q1
+    ;   entry_q(Es, A, N, Q0, Q)
+    ).
 
 %   The entries of the state's own leaf; none when it reaches an empty branch (a state
 %   the tree has not met: every response then has Q = q_init).
@@ -99,16 +121,28 @@ etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params) :-
     insert_example(KB, D0, A0, N0, Target, Alpha, Qinit, Threshold).
 
 max_q(Entries, N, Allowed, Qinit, Max) :-
-    findall(Q, ( member(e(A, Q, N1), Entries), N1 == N, allowed_or_any(Allowed, A) ),
-            Qs0),
-    (   Qs0 == []
+    max_q_(Entries, N, Allowed, none, 0, Max1, K),
+    (   K =:= 0
     ->  Max = Qinit
-    ;   max_list(Qs0, Max1),
-        (   Allowed \== [], length(Qs0, K), length(Allowed, L), K < L
-        ->  Max is max(Max1, Qinit)     % some allowed action is still untried
-        ;   Max = Max1
-        )
+    ;   Allowed \== [], length(Allowed, L), K < L
+    ->  Max is max(Max1, Qinit)     % some allowed action is still untried
+    ;   Max = Max1
     ).
+
+%   The largest Q among the entries for N of allowed actions, and how many there are.
+max_q_([], _, _, Max, K, Max, K).
+max_q_([e(A, Q, N1)|Es], N, Allowed, Max0, K0, Max, K) :-
+    (   N1 == N,
+        allowed_or_any(Allowed, A)
+    ->  K1 is K0 + 1,
+        (   Max0 == none
+        ->  Max1 = Q
+        ;   Max1 is max(Max0, Q)
+        )
+    ;   K1 = K0,
+        Max1 = Max0
+    ),
+    max_q_(Es, N, Allowed, Max1, K1, Max, K).
 
 allowed_or_any([], _) :- !.
 allowed_or_any(Allowed, A) :- memberchk(A, Allowed).
@@ -120,7 +154,7 @@ insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
         qtree_grow(KB, Parent, Branch, D, [e(A, Q, N)], _)
     ;   Where = leaf(Id),
         qtree_leaf(KB, Id, Rep0, Entries0),
-        qtree_entry_q(Entries0, A, N, Qinit, Old),
+        entry_q(Entries0, A, N, Qinit, Old),
         Error is Target - Old,
         (   Rep0 \== none,
             Rep0 =\= D,
@@ -192,7 +226,7 @@ extra_bit(KB, Goal, I-D0, I1-D) :-
     ).
 
 relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
-    engine_config(KB, params, Params0),
+    engine_params(KB, Params0),
     (   Mode == greedy
     ->  Params = [epsilon=0|Params0]
     ;   Params = Params0
@@ -200,7 +234,7 @@ relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
     etg_choose(KB, D, N, Allowed, Params, Action, _).
 
 relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, R, _, D1, N1, Allowed1)) :-
-    engine_config(KB, params, Params),
+    engine_params(KB, Params),
     etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params).
 
 relrl_engine:learner_explain(etg, KB, D, N, etg(Path, Ranked)) :-

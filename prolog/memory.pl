@@ -1,6 +1,10 @@
 :- module(relrl_memory,
           [ wm_insert/2,          % +KB, +Elements
             wm_element/3,         % ?KB, ?Element, ?Age
+            wm_has/2,             % +KB, ?Element
+            wm_has_chk/2,         % +KB, ?Element
+            wm_now/2,             % +KB, ?Element
+            wm_has_stimulus/2,    % +KB, +Stimulus
             wm_elements/2,        % +KB, -Pairs
             wm_clear/1,           % +KB
             wm_span/2,            % +KB, -Span
@@ -39,10 +43,19 @@ argument of every predicate names it. This module is the only one that stores pe
 %   control step free of assert/retract churn.
 
 key(KB, Key) :-
-    atom_concat('$relrl_wm:', KB, Key).
+    (   key_(KB, Key0)
+    ->  Key = Key0
+    ;   atom_concat('$relrl_wm:', KB, Key),
+        assertz(key_(KB, Key))
+    ).
+
+:- dynamic key_/2.                  % KB, the name of its global variable (made once)
 
 get(KB, State) :-
-    key(KB, Key),
+    (   key_(KB, Key)
+    ->  true
+    ;   key(KB, Key)
+    ),
     (   nb_current(Key, State0)
     ->  State = State0
     ;   State = wm(0, default, [])
@@ -100,12 +113,13 @@ wm_clock(KB, Clock) :-
 %   @error instantiation_error if an element is not ground.
 
 wm_insert(KB, New) :-
-    must_be(atom, KB),
-    must_be(list, New),
-    (   ground(New)
+    (   atom(KB), is_list(New), ground(New)
     ->  true
-    ;   member(E, New), \+ ground(E)
+    ;   must_be(atom, KB),
+        must_be(list, New),
+        member(E, New), \+ ground(E)
     ->  instantiation_error(E)
+    ;   true
     ),
     get(KB, wm(Clock0, Span0, Old)),
     (   Span0 == default
@@ -143,6 +157,56 @@ wm_element(KB, Element, Age) :-
     get(KB, wm(Clock, _, Elements)),
     member(Element-Stamp, Elements),
     Age is Clock - Stamp.
+
+%!  wm_has(+KB, ?Element) is nondet.
+%
+%   Element is in KB's memory (any age): wm_element/3 without computing ages, for the
+%   perception predicates the engine runs many times a step.
+
+wm_has(KB, Element) :-
+    get(KB, wm(_, _, Elements)),
+    (   ground(Element)
+    ->  memberchk(Element-_, Elements)
+    ;   member(Element-_, Elements)
+    ).
+
+%!  wm_has_chk(+KB, ?Element) is semidet.
+%
+%   once(wm_has(KB, Element)).
+
+wm_has_chk(KB, Element) :-
+    get(KB, wm(_, _, Elements)),
+    memberchk(Element-_, Elements).
+
+%!  wm_now(+KB, ?Element) is nondet.
+%
+%   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
+
+wm_now(KB, Element) :-
+    get(KB, wm(Clock, _, Elements)),
+    member(Element-Clock, Elements).
+
+%!  wm_has_stimulus(+KB, +Stimulus) is semidet.
+%
+%   Stimulus is perceived through a sense (see(S), hear(S), smell(S), at(S)) or located
+%   (at(S, Place)) in KB's memory.
+
+wm_has_stimulus(KB, S) :-
+    get(KB, wm(_, _, Elements)),
+    member(E-_, Elements),
+    compound(E),
+    (   compound_name_arguments(E, Sense, [S1])
+    ->  S1 == S,
+        sense_name(Sense)
+    ;   E = at(S1, _)
+    ->  S1 == S
+    ),
+    !.
+
+sense_name(see).
+sense_name(hear).
+sense_name(smell).
+sense_name(at).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
 %

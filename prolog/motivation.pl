@@ -35,7 +35,28 @@ W: a satisfying stimulus (the caregiver's attention, a frontal face) lowers the 
 paper's weights are declared as satisfiers with their printed magnitudes.
 */
 
-:- dynamic output_/3.     % KB, Necessity, Y
+%   The units' outputs of KB live in a global variable, a list of Necessity-Y pairs in
+%   declaration order (no assert/retract in the robot's control step).
+
+outputs_key(KB, Key) :-
+    (   outputs_key_(KB, Key0)
+    ->  Key = Key0
+    ;   atom_concat('$relrl_units:', KB, Key),
+        assertz(outputs_key_(KB, Key))
+    ).
+
+:- dynamic outputs_key_/2.
+
+get_outputs(KB, Outputs) :-
+    outputs_key(KB, Key),
+    (   nb_current(Key, Outputs0)
+    ->  Outputs = Outputs0
+    ;   Outputs = []
+    ).
+
+put_outputs(KB, Outputs) :-
+    outputs_key(KB, Key),
+    nb_setval(Key, Outputs).
 
 %!  unit_output(+U, +Delta, -Y) is det.
 %
@@ -61,18 +82,17 @@ weighted(W-I, S0, S) :-
 
 motivation_reset(KB) :-
     must_be(atom, KB),
-    retractall(output_(KB, _, _)),
-    forall(kb_necessity(KB, N),
-           ( unit_parameters(KB, N, Params),
-             memberchk(initial=Y0, Params),
-             assertz(output_(KB, N, Y0)) )).
+    findall(N-Y0, ( kb_necessity(KB, N),
+                    unit_parameters(KB, N, Params),
+                    memberchk(initial=Y0, Params) ), Outputs),
+    put_outputs(KB, Outputs).
 
 %!  motivation_outputs(+KB, -Outputs:list) is det.
 %
 %   Outputs is the list of Necessity-Y pairs of the last step.
 
 motivation_outputs(KB, Outputs) :-
-    findall(N-Y, output_(KB, N, Y), Outputs).
+    get_outputs(KB, Outputs).
 
 %!  motivation_set_outputs(+KB, +Outputs:list) is det.
 %
@@ -80,8 +100,7 @@ motivation_outputs(KB, Outputs) :-
 
 motivation_set_outputs(KB, Outputs) :-
     must_be(list, Outputs),
-    retractall(output_(KB, _, _)),
-    forall(member(N-Y, Outputs), assertz(output_(KB, N, Y))).
+    put_outputs(KB, Outputs).
 
 %!  motivation_step(+KB, -Outputs:list, -Active) is det.
 %
@@ -115,7 +134,9 @@ motivation_units(KB, Units) :-
 %   As motivation_step/3 with the units from motivation_units/2.
 
 motivation_step(KB, Units, Outputs, Active) :-
-    maplist(unit_step(KB), Units, Outputs),
+    get_outputs(KB, Previous),
+    maplist(unit_value(KB, Previous), Units, Outputs),
+    put_outputs(KB, Outputs),
     mediate(Units, Outputs, Active).
 
 %!  motivation_peek(+KB, +Units, -Outputs, -Active) is det.
@@ -123,16 +144,12 @@ motivation_step(KB, Units, Outputs, Active) :-
 %   What motivation_step/4 would give now, without moving the units' state.
 
 motivation_peek(KB, Units, Outputs, Active) :-
-    maplist(unit_value(KB), Units, Outputs),
+    get_outputs(KB, Previous),
+    maplist(unit_value(KB, Previous), Units, Outputs),
     mediate(Units, Outputs, Active).
 
-unit_step(KB, Unit, N-Y) :-
-    unit_value(KB, Unit, N-Y),
-    retractall(output_(KB, N, _)),
-    assertz(output_(KB, N, Y)).
-
-unit_value(KB, unit(N, B, Wr, Delta, _, Y0, Goals), N-Y) :-
-    (   output_(KB, N, Ir)
+unit_value(KB, Previous, unit(N, B, Wr, Delta, _, Y0, Goals), N-Y) :-
+    (   memberchk(N-Ir, Previous)
     ->  true
     ;   Ir = Y0
     ),

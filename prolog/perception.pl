@@ -1,5 +1,6 @@
 :- module(relrl_perception,
           [ perceived/3,          % +KB, +Sense, ?What
+            sensed/3,             % +Sense, +KB, ?What
             perceived_at/3,       % +KB, ?Stimulus, ?Place
             stimulus_present/2,   % +KB, ?Stimulus
             stimulus_perceived/2, % +KB, +Stimulus
@@ -43,19 +44,27 @@ perceived(KB, Sense, What) :-
     ->  true
     ;   domain_error(sense, Sense)
     ),
+    sensed(Sense, KB, What).
+
+%!  sensed(+Sense, +KB, ?What) is nondet.
+%
+%   perceived/3 for a Sense known to be one (no checks): what the perception predicates
+%   of relrl.pl call, many times in every control step.
+
+sensed(Sense, KB, What) :-
     (   var(What)
     ->  Percept =.. [Sense, What],
-        wm_element(KB, Percept, _)
+        wm_has(KB, Percept)
     ;   atomic(What)
     ->  Percept =.. [Sense, What],
-        once(wm_element(KB, Percept, _))
+        wm_has_chk(KB, Percept)
     ;   What =.. [_, Stimulus],
         atomic(Stimulus)
     ->  Percept =.. [Sense, Stimulus],
-        once(wm_element(KB, Percept, _)),
+        wm_has_chk(KB, Percept),
         once(KB:What)
     ;   Percept =.. [Sense, What],
-        once(wm_element(KB, Percept, _))
+        wm_has_chk(KB, Percept)
     ).
 
 %!  perceived_at(+KB, ?Stimulus, ?Place) is nondet.
@@ -63,7 +72,7 @@ perceived(KB, Sense, What) :-
 %   Stimulus is perceived at Place (the at/2 percept).
 
 perceived_at(KB, Stimulus, Place) :-
-    wm_element(KB, at(Stimulus, Place), _).
+    wm_has(KB, at(Stimulus, Place)).
 
 %!  stimulus_present(+KB, ?Stimulus) is nondet.
 %
@@ -79,10 +88,4 @@ stimulus_present(KB, Stimulus) :-
 %   is declared.
 
 stimulus_perceived(KB, Stimulus) :-
-    (   sense(Sense),
-        Percept =.. [Sense, Stimulus],
-        wm_element(KB, Percept, _)
-    ->  true
-    ;   wm_element(KB, at(Stimulus, _), _)
-    ->  true
-    ).
+    wm_has_stimulus(KB, Stimulus).

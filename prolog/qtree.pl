@@ -82,6 +82,8 @@ qtree_restore(Tree, Tests, Nodes) :-
 
 qtree_clear(Tree) :-
     must_be(atom, Tree),
+    memo_key(Tree, Key),
+    nb_setval(Key, none),
     retractall(node_(Tree, _, _)),
     retractall(next_id_(Tree, _)),
     retractall(tests_(Tree, _)).
@@ -119,7 +121,31 @@ first_difference(D1, D2, Index) :-
 %   reaches an empty branch (Branch is yes or no).
 
 qtree_sort(Tree, D, Where) :-
-    sort_from(Tree, 0, D, Where).
+    memo_key(Tree, Key),
+    next_id_(Tree, Version),
+    (   nb_current(Key, memo(Version, D1-W1, D2-W2))
+    ->  (   D1 =:= D
+        ->  Where = W1
+        ;   D2 =:= D
+        ->  Where = W2
+        ;   sort_from(Tree, 0, D, Where),
+            nb_setval(Key, memo(Version, D-Where, D1-W1))
+        )
+    ;   sort_from(Tree, 0, D, Where),
+        nb_setval(Key, memo(Version, D-Where, -1-none))
+    ).
+
+%   The last two states sorted and where they went, valid while the tree's shape is the
+%   same (every grow or split takes a new node id, so the next id is the shape's version):
+%   the control step sorts each state twice (to choose, then to learn from it).
+memo_key(Tree, Key) :-
+    (   memo_key_(Tree, Key0)
+    ->  Key = Key0
+    ;   atom_concat('$relrl_qsort:', Tree, Key),
+        assertz(memo_key_(Tree, Key))
+    ).
+
+:- dynamic memo_key_/2.
 
 sort_from(Tree, Id, D, Where) :-
     (   step_down(Tree, Id, D, _, Branch, Next)

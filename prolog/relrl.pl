@@ -60,29 +60,34 @@ kb(KB) :-
 %
 %   Perception predicates over working memory; see relrl_perception:perceived/3.
 
-see(What)   :- kb(KB), perceived(KB, see, What).
-hear(What)  :- kb(KB), perceived(KB, hear, What).
-smell(What) :- kb(KB), perceived(KB, smell, What).
-at(What)    :- kb(KB), perceived(KB, at, What).
+see(What)   :- context_module(KB), sensed(see, KB, What).
+hear(What)  :- context_module(KB), sensed(hear, KB, What).
+smell(What) :- context_module(KB), sensed(smell, KB, What).
+at(What)    :- context_module(KB), sensed(at, KB, What).
 
 %!  at(?Stimulus, ?Place) is nondet.
 %
 %   Stimulus is perceived at Place.
 
-at(Stimulus, Place) :- kb(KB), perceived_at(KB, Stimulus, Place).
+at(Stimulus, Place) :- context_module(KB), wm_has(KB, at(Stimulus, Place)).
 
 %!  percept(?Element) is nondet.
 %
 %   Element is in working memory (any age). Use it for stimulus properties:
 %   `frontal(face) :- percept(pose(face, frontal)).`
 
-percept(Element) :- kb(KB), wm_element(KB, Element, _).
+percept(Element) :- context_module(KB), wm_has(KB, Element).
 
 %!  memory(?Element, ?Age) is nondet.
 %
 %   Element is in working memory with age Age.
 
-memory(Element, Age) :- kb(KB), wm_element(KB, Element, Age).
+memory(Element, Age) :-
+    context_module(KB),
+    (   Age == 0
+    ->  wm_now(KB, Element)
+    ;   wm_element(KB, Element, Age)
+    ).
 
 %!  remember(+Elements:list) is det.
 %

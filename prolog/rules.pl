@@ -25,7 +25,8 @@ unchanged (it names the innermost rule the engine called).
 %   Goal, a goal of the domain loaded into KB, has a solution.
 
 rule_holds(KB, Goal) :-
-    catch(once(KB:Goal), E, rule_error(KB, Goal, E)).
+    catch(KB:Goal, E, rule_error(KB, Goal, E)),
+    !.
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %

@@ -77,14 +77,22 @@ state_code(KB, Code) :-
 %   (the engine computes it once per run).
 
 features_code(KB, Features, Code) :-
-    foldl(add_active(KB), Features, 0-0, Code-_).
+    features_code_(Features, KB, 1, 0, Code).
 
-add_active(KB, Feature, Code0-X, Code-X1) :-
-    X1 is X + 1,
-    (   feature_active(KB, Feature)
-    ->  Code is Code0 \/ (1 << X)
-    ;   Code = Code0
-    ).
+%   A tight loop: the control step runs it over every feature each time unit.
+features_code_([], _, _, Code, Code).
+features_code_([F|Fs], KB, Bit, Code0, Code) :-
+    (   active(F, KB)
+    ->  Code1 is Code0 \/ Bit
+    ;   Code1 = Code0
+    ),
+    Bit1 is Bit << 1,
+    features_code_(Fs, KB, Bit1, Code1, Code).
+
+active(stimulus(S), KB) :-
+    stimulus_perceived(KB, S).
+active(fact(F), KB) :-
+    rule_holds(KB, F).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %

@@ -69,6 +69,7 @@ _PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
 
 _KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
 _MAX_RECORDS = 4096
+_MAX_ATOMS = 4096
 
 
 class Cached:
@@ -88,11 +89,16 @@ class Cached:
 
 
 def _hashable(value: Term) -> Any:
-    if isinstance(value, list):
-        return ("[]", *map(_hashable, value))
-    if isinstance(value, tuple):
+    # Equal keys must mean equal terms: 1, 1.0 and True are equal in Python but not in
+    # Prolog, and a list is not a compound. A string never equals a number or a tuple.
+    kind = type(value)
+    if kind is str:
+        return value
+    if kind is tuple:
         return tuple(map(_hashable, value))
-    return (type(value).__name__, value)
+    if kind is list:
+        return ("[]", *map(_hashable, value))
+    return (kind.__name__, value)
 
 
 @dataclass(frozen=True)
@@ -138,6 +144,8 @@ class _Engine:
         self.cons_list = fn("PL_cons_list", c_int, T, T, T)
         self.cons_functor_v = fn("PL_cons_functor_v", c_int, T, T, T)
         self.new_atom = fn("PL_new_atom_mbchars", T, c_int, c_size_t, c_char_p)
+        self.put_atom = fn("PL_put_atom", c_int, T, T)
+        self._atoms: dict[str, int] = {}
         self.new_functor = fn("PL_new_functor_sz", T, T, c_size_t)
         self.unregister_atom = fn("PL_unregister_atom", None, T)
         self.chars_to_term = fn("PL_chars_to_term", c_int, c_char_p, T)
@@ -185,9 +193,18 @@ class _Engine:
     def put(self, t: int, value: Term, variables: dict[int, int]) -> None:
         """Write ``value`` into term reference ``t``."""
         if isinstance(value, str):
-            data = value.encode("utf-8")
-            if not self.put_chars(t, _PL_ATOM | _REP_UTF8, len(data), data):
-                raise RelrlError(f"cannot make an atom of {value!r}")
+            atom = self._atoms.get(value)
+            if atom is None:
+                data = value.encode("utf-8")
+                atom = self.new_atom(_REP_UTF8, len(data), data)
+                if not atom:
+                    raise RelrlError(f"cannot make an atom of {value!r}")
+                if len(self._atoms) >= _MAX_ATOMS:   # keep the cache (and what it holds) small
+                    for old in self._atoms.values():
+                        self.unregister_atom(old)
+                    self._atoms.clear()
+                self._atoms[value] = atom          # the reference keeps the atom alive
+            self.put_atom(t, atom)
         elif isinstance(value, bool):
             self.put_chars(t, _PL_ATOM, 4 if value else 5, b"true" if value else b"false")
         elif isinstance(value, int):

@@ -75,3 +75,17 @@ def test_fruit_colours_named_under_varied_light(kind, name, lighting):
         frame = render(SceneView(place, None, {place: kind}, lighting, seed))
         percept = Perceiver().analyse(frame, looking_at=place)
         assert ("colour", "object", name) in percept.facts, (place, percept.facts)
+
+
+def test_summary_reads_every_masked_pixel_whatever_the_mask_type():
+    rng = np.random.default_rng(5)
+    frame = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)
+    mask = np.zeros((60, 80), np.uint8)
+    mask[5:9, 3:7] = 255       # two separate blobs: the bounding box holds unmasked pixels too
+    mask[40:55, 60:78] = 255
+    frame[40:55, 60:78] = (20, 130, 250)
+    pixels = frame[mask > 0]
+    expected = colour_summary(pixels[None], np.full((1, len(pixels)), 255, np.uint8))
+    for m in (mask, mask > 0, (mask > 0) * 256):  # 256 would wrap to 0 as uint8
+        assert colour_summary(frame, m) == expected
+    assert colour_summary(frame, np.zeros_like(mask)).r == 0

@@ -19,3 +19,16 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
         assert 0.99 <= learner["gateway_calls_per_step"] <= 1.01
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
+
+
+def test_perception_photo_target_line(monkeypatch) -> None:
+    import perception.bench as perception_bench
+    from relrl.bench import bench_all
+
+    for fps, met in ((59.9, False), (60.0, True)):
+        monkeypatch.setattr(perception_bench, "bench",
+                            lambda faces=True, fps=fps: {"fps_photos_320x240_cold": fps})
+        figures = bench_all(steps=100)
+        assert figures["targets"]["perception_photos_320x240_fps>=60"] is met
+    monkeypatch.setattr(perception_bench, "bench", lambda faces=True: {"fps_320x240": 1.0})
+    assert "perception_photos_320x240_fps>=60" not in bench_all(steps=100)["targets"]

@@ -1,0 +1,98 @@
+/*  A frozen copy of examples/domains/sis.pl as it was when tests/data/golden_decisions.json
+    was recorded (commit 7550b32, before the engine's speed work). The decision-invariance
+    test (tests/relrl/test_decisions_golden.py) replays recorded percept streams through the
+    engine and compares every choice with the recording; the domain must not change under
+    it, so it does not follow the shipped domain file. Regenerate both together only when a
+    change is meant to change decisions, and say so in the commit. */
+
+/*  The Social Interactive Simulator of Experiment 1 (da Silva & Romero 2012, section 5.1;
+    after Triesch et al. 2006): a caregiver and the robot face to face, up to two toys.
+
+    Load it with relrl (relrl check examples/domains/sis.pl) or in plain SWI-Prolog:
+        swipl prolog/relrl.pl examples/domains/sis.pl
+
+    Places: centre (the caregiver's face), left, left_down, down, right_down, right.
+    The robot perceives only what is in its focus: the caregiver's face with the direction
+    of the caregiver's gaze as pose(face, Place) (`frontal` when the caregiver looks at the
+    robot), a toy at(toy, Place), or nothing (see(environment)); at(Place) is where its own
+    head points. hear(attention) is the caregiver's attention, the reinforcer.
+*/
+
+% ---- Stimuli -----------------------------------------------------------------------------
+
+stimulus(face).
+stimulus(toy).
+stimulus(attention).
+stimulus(environment).
+
+stimulus_property(attention, reinforcer).
+stimulus_property(toy, graspable).
+
+% ---- Facts -------------------------------------------------------------------------------
+
+% Where the caregiver looks (the face's head pose), where the robot's head points, and
+% where the robot has seen a toy (recently, see memory_span/1).
+fact(gaze_frontal(face)).
+fact(gaze_left(face)).
+fact(gaze_left_down(face)).
+fact(gaze_down(face)).
+fact(gaze_right_down(face)).
+fact(gaze_right(face)).
+fact(head_at(centre)).
+fact(head_at(left)).
+fact(head_at(left_down)).
+fact(head_at(down)).
+fact(head_at(right_down)).
+fact(head_at(right)).
+fact(toy_at(left)).
+fact(toy_at(left_down)).
+fact(toy_at(down)).
+fact(toy_at(right_down)).
+fact(toy_at(right)).
+fact(red_toy(toy)).
+fact(green_toy(toy)).
+
+gaze_frontal(face)    :- percept(pose(face, frontal)).
+gaze_left(face)       :- percept(pose(face, left)).
+gaze_left_down(face)  :- percept(pose(face, left_down)).
+gaze_down(face)       :- percept(pose(face, down)).
+gaze_right_down(face) :- percept(pose(face, right_down)).
+gaze_right(face)      :- percept(pose(face, right)).
+
+% Where the robot's head points now (age 0: this step's percept).
+head_at(Place) :- memory(at(Place), 0).
+
+% Where the robot has seen a toy, now or at the previous step.
+toy_at(Place) :- at(toy, Place).
+
+% The colour of the toy in view.
+red_toy(toy)   :- see(toy), percept(colour(toy, red)).
+green_toy(toy) :- see(toy), percept(colour(toy, green)).
+
+% A percept stays in working memory for this many further steps.
+memory_span(1).
+
+% ---- Responses ---------------------------------------------------------------------------
+
+response(look(centre)).
+response(look(left)).
+response(look(left_down)).
+response(look(down)).
+response(look(right_down)).
+response(look(right)).
+
+% ---- Necessities -------------------------------------------------------------------------
+
+necessity(socialize).
+unit(socialize, bias, 1.00).
+unit(socialize, recurrent_weight, 1.00).
+unit(socialize, delta, 0.20).
+unit(socialize, threshold, 0.50).
+
+satisfier(socialize, hear(attention), 1.50).
+satisfier(socialize, see(gaze_frontal(face)), 0.95).
+satisfier(socialize, see(face), 0.50).
+
+% ---- Behaviour rules ---------------------------------------------------------------------
+
+behaviour(see(face), look(centre), socialize, 1.0).
