@@ -13,17 +13,25 @@ session can be typed, or piped in for a test or a repeatable set-up::
 
 While a servo is being calibrated it may be jogged over the whole absolute range
 (500..2500 us), slowly; every other servo stays inside its calibrated limits.
+
+Limits once set are not lost: when the file cannot be written, the port is lost while
+jogging, or the session is interrupted (Ctrl-C), the calibration so far is saved to
+``head-rescued-YYYYMMDD-HHMMSS.toml`` in the current folder (else the temporary folder) and
+the message says where.
 """
 
 from __future__ import annotations
 
+import tempfile
+import time
 from collections.abc import Iterator
 from dataclasses import replace
 from pathlib import Path
 from typing import TextIO
 
 from head.base import Head
-from head.calibration import PULSE_RANGE, Calibration, save_calibration
+from head.calibration import PULSE_RANGE, Calibration, dump_calibration, save_calibration
+from head.errors import CalibrationError, HeadError
 
 __all__ = ["KEYS", "calibrate"]
 
@@ -123,22 +131,48 @@ def calibrate(head: Head, keys: TextIO, out: TextIO, path: str | Path) -> Path |
         "p": lambda: session._select(session.index - 1),
         "?": lambda: session.say(KEYS),
     }
-    for key in _keys(keys):
-        if key == "w":
-            cal = session.finish()
-            written = save_calibration(cal, path)
-            session.say(f"wrote {written}")
-            return written
-        if key == "q":
-            break
-        action = actions.get(key)
-        if action is None:
-            session.say(f"unknown key {key!r}; {KEYS}")
-            continue
-        action()
+    try:
+        for key in _keys(keys):
+            if key == "w":
+                cal = session.finish()
+                try:
+                    written = save_calibration(cal, path)
+                except CalibrationError as exc:
+                    session.changed = False  # rescued below, once
+                    raise CalibrationError(f"{exc}; {_rescue(cal, out)}") from None
+                session.say(f"wrote {written}")
+                return written
+            if key == "q":
+                break
+            action = actions.get(key)
+            if action is None:
+                session.say(f"unknown key {key!r}; {KEYS}")
+                continue
+            action()
+    except HeadError as exc:  # e.g. the port was lost while jogging
+        if not session.changed:
+            raise
+        raise type(exc)(f"{exc}; {_rescue(session.finish(), out)}") from None
+    except KeyboardInterrupt:
+        if session.changed:
+            session.say(_rescue(session.finish(), out))
+        raise
     session.finish()
     session.say("quit without writing" + (" (changes discarded)" if session.changed else ""))
     return None
+
+
+def _rescue(cal: Calibration, out: TextIO) -> str:
+    """Save a calibration that could not be written where asked; says where it went."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for folder in (Path.cwd(), Path(tempfile.gettempdir())):
+        try:
+            where = save_calibration(cal, folder / f"head-rescued-{stamp}.toml")
+        except CalibrationError:
+            continue
+        return f"the limits set so far were saved to {where}"
+    print(dump_calibration(cal), file=out)  # last resort: the text itself
+    return "the limits set so far were printed above (no folder was writable)"
 
 
 def _step(session: _Session, direction: int) -> None:

@@ -264,6 +264,9 @@ def _read_toml(path: Path) -> dict[str, Any]:
         raise CalibrationError(f"{path}: no such calibration file") from None
     except tomllib.TOMLDecodeError as exc:
         raise CalibrationError(f"{path}: not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not a calibration file: byte {exc.start} is not UTF-8 "
+                               "text (a binary file?)") from None
     except OSError as exc:
         raise CalibrationError(f"{path}: cannot read: {exc.strerror}") from None
 
@@ -400,19 +403,36 @@ def save_calibration(cal: Calibration, path: str | Path) -> Path:
 
     Returns:
         The path written.
+
+    Raises:
+        CalibrationError: the file cannot be written (a folder, a missing folder, no
+            permission); nothing is left behind.
     """
     path = Path(path)
     text = dump_calibration(cal)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent or ".")
+    if path.exists() and not path.is_file():  # a folder, or a device such as /dev/null
+        raise CalibrationError(f"cannot write the calibration to {path}: not a regular file")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp",
+                                   dir=path.parent or ".")
+    except OSError as exc:
+        raise CalibrationError(f"cannot write the calibration to {path}: "
+                               f"{exc.strerror or exc}") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
         load_calibration(tmp)
+        mask = os.umask(0o022)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # readable like any file the user writes (0644)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise CalibrationError(f"cannot write the calibration to {path}: "
+                                   f"{exc.strerror or exc}") from None
         raise
     return path

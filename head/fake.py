@@ -18,6 +18,7 @@ test that passes both checks the wire format, not one function against itself.
 from __future__ import annotations
 
 import os
+import random
 import re
 import select
 import threading
@@ -66,6 +67,8 @@ class FakeController:
         protocol: ``ssc32``, ``maestro`` or ``pms5005``.
         limits: channel -> (min, max) microseconds; pulses outside are violations.
         mute: when true, never answer (to test timeouts).
+        garbage: when true, every answer has the right length but random bytes (a wrong
+            baud rate, another device on the port); what it receives is still checked.
         moves: every decoded move, as channel -> pulse in microseconds.
         violations: one line per protocol error or out-of-limit pulse.
         bytes_checked: how many bytes went through the decoder.
@@ -75,6 +78,7 @@ class FakeController:
     protocol: str
     limits: dict[int, tuple[int, int]] = field(default_factory=dict)
     mute: bool = False
+    garbage: bool = False
     clock: Callable[[], float] = time.monotonic
     moves: list[dict[int, int]] = field(default_factory=list)
     violations: list[str] = field(default_factory=list)
@@ -92,6 +96,7 @@ class FakeController:
         self._buf = bytearray()
         self._speeds: dict[int, float] = {}
         self._lock = threading.Lock()
+        self._noise = random.Random(0)
 
     # -- shared -------------------------------------------------------------------------------
 
@@ -102,6 +107,8 @@ class FakeController:
             for byte in data:
                 self.bytes_checked += 1
                 out += self._push(byte)
+            if self.garbage:
+                out = bytearray(self._noise.randrange(256) for _ in out)
         return b"" if self.mute else bytes(out)
 
     def _bad(self, text: str) -> bytes:

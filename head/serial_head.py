@@ -18,7 +18,7 @@ from typing import Any
 
 from head.base import Head, MotionModel
 from head.calibration import Calibration, load_calibration
-from head.errors import HeadTimeout, PortLost, PortUnavailable
+from head.errors import HeadTimeout, PortLost, PortUnavailable, ProtocolError
 from head.protocols import Command, Protocol, get_protocol
 
 __all__ = ["SerialHead", "SerialLink"]
@@ -38,7 +38,13 @@ class SerialLink:
         self.protocol = protocol
         self.timeout = timeout
         self.bytes_written = 0
-        self._serial_errors = (serial.SerialException, OSError)
+        self._serial_errors: tuple[type[BaseException], ...] = (serial.SerialException, OSError)
+        try:  # pyserial's POSIX port lets termios errors through (e.g. a hung-up terminal)
+            import termios
+
+            self._serial_errors += (termios.error,)
+        except ImportError:  # pragma: no cover - Windows
+            pass
         opener = factory or serial.serial_for_url
         try:
             self.serial = opener(port, baudrate=baudrate, timeout=timeout,
@@ -89,6 +95,15 @@ class SerialLink:
                 f"{self.protocol} controller on {self.port!r} did not answer {what} within "
                 f"{self.timeout:g} s (got {len(answer)} of {size} bytes); check power, cable, "
                 "baud rate and --protocol")
+        try:
+            extra = int(getattr(self.serial, "in_waiting", 0) or 0)
+        except self._serial_errors as exc:
+            raise self._lost(exc) from None
+        if extra:
+            raise ProtocolError(
+                f"{self.protocol} controller on {self.port!r} answered {what} with {extra} "
+                f"bytes more than the {size} asked (garbage on the line?); check --protocol "
+                "and the baud rate")
         return bytes(answer)
 
     def close(self) -> None:

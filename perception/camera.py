@@ -30,6 +30,7 @@ from urllib.parse import parse_qs, urlsplit
 import numpy as np
 
 from perception.errors import CameraError, ImageError
+from perception.imagesize import check_frame_size, header_size
 from perception.render import SceneView, render
 
 __all__ = ["SOURCES", "Camera", "SyntheticCamera", "open_camera", "read_image"]
@@ -38,16 +39,39 @@ _IMAGE_EXT = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", 
 
 
 def read_image(path: str | Path) -> np.ndarray:
-    """Read an image file as BGR; raises :class:`ImageError` when missing or unreadable."""
+    """Read an image file as BGR.
+
+    The size in the file's header is checked (:func:`perception.imagesize.check_frame_size`)
+    before the image is decoded, so a small file claiming a huge image costs nothing.
+
+    Raises:
+        ImageError: the file is missing, not an image, too large or too thin, or damaged.
+    """
     import cv2
 
     p = Path(path)
+    if p.is_dir():
+        raise ImageError(f"{str(path)!r} is a folder; give an image file (or --camera DIR)")
+    if p.exists() and not p.is_file():
+        raise ImageError(f"{str(path)!r} is not a regular file (a device or a pipe?)")
     if not p.is_file():
         raise ImageError(f"no such image file: {str(path)!r}")
-    img = cv2.imread(str(p), cv2.IMREAD_COLOR)
+    width, height, kind = header_size(p)
+    check_frame_size(width, height, f"image {str(path)!r}")
+    try:
+        img = cv2.imread(str(p), cv2.IMREAD_COLOR)
+    except cv2.error as exc:
+        raise ImageError(f"cannot decode {str(path)!r}: {_cv_reason(exc)}") from None
     if img is None:
-        raise ImageError(f"cannot decode {str(path)!r} as an image (is it a PNG or JPEG?)")
+        raise ImageError(f"cannot decode {str(path)!r} as a {kind} image (damaged or cut "
+                         "short?)")
     return img
+
+
+def _cv_reason(exc: Exception) -> str:
+    """The one useful line of an OpenCV error."""
+    lines = [x.strip() for x in str(exc).splitlines() if x.strip()]
+    return lines[-1] if lines else type(exc).__name__
 
 
 class Camera(abc.ABC):
@@ -101,6 +125,14 @@ class _Capture(Camera):
             self._closed = True
             raise CameraError(f"cannot open {what}; check the device or path, or use "
                               "synthetic:// for the simulated camera")
+        width = int(self._cap.get(cv2.CAP_PROP_FRAME_WIDTH))
+        height = int(self._cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        if width > 0 and height > 0:  # known before the first frame is decoded
+            try:
+                check_frame_size(width, height, what)
+            except ImageError:
+                self.close()
+                raise
 
     def read(self) -> np.ndarray | None:
         if self._closed:
@@ -130,7 +162,11 @@ class _Folder(Camera):
         if self._closed or self._next >= len(self._files):
             return None
         self._next += 1
-        return read_image(self._files[self._next - 1])
+        path = self._files[self._next - 1]
+        if not path.exists():
+            raise CameraError(f"lost the camera ({self.name}): {path} is gone (moved or "
+                              "deleted while reading)")
+        return read_image(path)
 
 
 class _Image(_Folder):
@@ -177,10 +213,14 @@ def _synthetic(url: str) -> Camera:
         objects = dict(item.split(":", 1) for item in query.get("objects", "").split(",") if item)
         w, h = (int(v) for v in query.get("size", "320x240").lower().split("x"))
         pose = query.get("pose", "frontal")
+        lighting = float(query.get("lighting", 1.0))
+        if not 0.05 <= lighting <= 3.0:  # also refuses nan
+            raise ValueError(f"lighting={query['lighting']} is not within 0.05..3")
         view = SceneView(query.get("looking_at", "centre"), None if pose == "none" else pose,
-                         objects, float(query.get("lighting", 1.0)), int(query.get("seed", 0)))
+                         objects, lighting, int(query.get("seed", 0)))
     except ValueError as exc:
         raise CameraError(f"bad synthetic:// URL {url!r}: {exc}") from None
+    check_frame_size(w, h, f"synthetic:// size={w}x{h}")
     return SyntheticCamera(view, (w, h))
 
 

@@ -23,6 +23,7 @@ from perception.colour import ColourSummary, colour_summary
 from perception.errors import PerceptionError
 from perception.faces import Face, FaceParams, FaceTracker
 from perception.facts import Fact
+from perception.imagesize import check_frame_size
 from perception.saliency import SaliencyParams, SalientArea, most_salient
 from perception.vocab import PLACES
 
@@ -85,6 +86,7 @@ class Perceiver:
             raise PerceptionError(f"a frame must be an (h, w, 3) uint8 BGR array, got {got}")
         if looking_at is not None and looking_at not in PLACES:
             raise PerceptionError(f"unknown place {looking_at!r}; use one of {PLACES}")
+        check_frame_size(frame.shape[1], frame.shape[0], "the frame")
         out = Percept()
         face = self.tracker.detect(frame)
         exclude = []

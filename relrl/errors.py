@@ -22,6 +22,7 @@ __all__ = [
     "PolicyError",
     "DomainError",
     "ConfigError",
+    "OutputError",
 ]
 
 
@@ -108,3 +109,8 @@ class DomainError(UserError):
 
 class ConfigError(UserError):
     """A bad option value: a flag, a parameter, a configuration file entry."""
+
+
+class OutputError(ConfigError):
+    """An output folder or file that cannot be used: a file where a folder is needed, a folder
+    that cannot be created or written, a non-empty folder of another run."""

@@ -56,10 +56,10 @@ class Shell:
         timeout: seconds a query may run.
     """
 
-    def __init__(self, kb: KnowledgeBase, out: TextIO = sys.stdout, *,
+    def __init__(self, kb: KnowledgeBase, out: TextIO | None = None, *,
                  max_solutions: int = 100, timeout: float = 10.0) -> None:
         self.kb = kb
-        self.out = out
+        self.out = sys.stdout if out is None else out  # the stdout of now, not of import
         self.max_solutions = max_solutions
         self.timeout = timeout
         self.errors = 0

@@ -23,7 +23,8 @@ from typing import Protocol as _Interface
 
 from head.errors import HeadError, UnknownProtocol
 
-__all__ = ["PROTOCOLS", "Command", "Link", "Protocol", "check_command", "get_protocol"]
+__all__ = ["PROTOCOLS", "Command", "Link", "Protocol", "check_command", "check_position",
+           "get_protocol"]
 
 #: protocol name -> ``"module:Class"`` (imported on first use).
 PROTOCOLS: dict[str, str] = {
@@ -84,6 +85,22 @@ def check_command(cmd: Command, max_channel: int) -> None:
                         f"(0..{max_channel}); fix the servo's channel in the calibration")
     if not cmd.speed > 0:
         raise HeadError(f"refusing speed {cmd.speed!r} on channel {cmd.channel}: must be > 0")
+
+
+def check_position(protocol: str, link: Link, channel: int, pulse_us: float) -> float:
+    """A position read back from a controller, or :class:`ProtocolError` for garbage.
+
+    0 means the channel sends no pulse (off); anything else outside 500..2500 us is not a
+    servo position relrl could have commanded: a wrong baud rate or another device.
+    """
+    if pulse_us and not ABSOLUTE_RANGE[0] <= pulse_us <= ABSOLUTE_RANGE[1]:
+        from head.errors import ProtocolError
+
+        raise ProtocolError(
+            f"{protocol} on {link.port}: channel {channel} reports position {pulse_us:g} us, "
+            f"outside {ABSOLUTE_RANGE[0]}..{ABSOLUTE_RANGE[1]} (garbage on the line?); check "
+            "--protocol and the baud rate")
+    return pulse_us
 
 
 class Protocol(ABC):

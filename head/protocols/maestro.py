@@ -14,7 +14,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from head.protocols import Command, Link, Protocol, check_command
+from head.errors import ProtocolError
+from head.protocols import Command, Link, Protocol, check_command, check_position
 
 __all__ = ["ERROR_BITS", "Maestro"]
 
@@ -63,11 +64,16 @@ class Maestro(Protocol):
         return bytes(out)
 
     def query_positions(self, link: Link, channels: Sequence[int]) -> dict[int, float]:
-        """``0x90 ch`` for each channel; quarter microseconds, low byte first."""
+        """``0x90 ch`` for each channel; quarter microseconds, low byte first.
+
+        Raises:
+            ProtocolError: a position that is neither 0 (channel off) nor within
+                500..2500 us: not a Maestro answering (wrong baud rate or device).
+        """
         out = {}
         for ch in channels:
             lo, hi = link.transact(bytes((GET_POSITION, ch)), 2, f"position of channel {ch}")
-            out[ch] = (lo | hi << 8) / 4.0
+            out[ch] = check_position(self.name, link, ch, (lo | hi << 8) / 4.0)
         return out
 
     def query_moving(self, link: Link, targets: dict[int, int]) -> bool:
@@ -79,4 +85,8 @@ class Maestro(Protocol):
         """``0xA1``: the error bits, as names."""
         lo, hi = link.transact(bytes((GET_ERRORS,)), 2, "errors")
         bits = lo | hi << 8
-        return [ERROR_BITS.get(b, f"error bit {b}") for b in range(16) if bits >> b & 1]
+        if bits >> (max(ERROR_BITS) + 1):
+            raise ProtocolError(
+                f"maestro on {link.port}: error register {bits:#06x} has bits no Maestro sets "
+                "(garbage on the line?); check --protocol and the baud rate")
+        return [ERROR_BITS[b] for b in range(16) if bits >> b & 1]

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from head.errors import ProtocolError
-from head.protocols import Command, Link, Protocol, check_command
+from head.protocols import Command, Link, Protocol, check_command, check_position
 
 __all__ = ["SSC32"]
 
@@ -49,9 +49,11 @@ class SSC32(Protocol):
                             "'+'; check the protocol and baud rate")
 
     def query_positions(self, link: Link, channels: Sequence[int]) -> dict[int, float]:
-        """Send ``QP`` for each channel; each answer byte is the pulse width / 10."""
+        """Send ``QP`` for each channel; each answer byte is the pulse width / 10 (0: no
+        pulse); anything else outside 500..2500 us is a :class:`ProtocolError`."""
         if not channels:
             return {}
         query = " ".join(f"QP {ch}" for ch in channels) + "\r"
         answer = link.transact(query.encode("ascii"), len(channels), "positions (QP)")
-        return {ch: float(b * 10) for ch, b in zip(channels, answer, strict=True)}
+        return {ch: check_position(self.name, link, ch, float(b * 10))
+                for ch, b in zip(channels, answer, strict=True)}

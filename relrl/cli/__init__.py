@@ -4,13 +4,16 @@ Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EX
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
 pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
 
-Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2.
+Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2 (an
+error that lists several problems -- a bad episode script -- prints one ``file:line: problem``
+line each, then the count).
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import shlex
 import sys
 from collections.abc import Sequence
 
@@ -65,17 +68,24 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``relrl`` command line; returns the exit status."""
     parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(argv)
+    args.command_line = "relrl " + shlex.join(argv)  # for the record of an output folder
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
     try:
         return int(args._run(args) or 0)
     except UserError as exc:
-        print(f"relrl {args.command}: {exc}", file=sys.stderr)
+        *problems, last = str(exc).splitlines() or [type(exc).__name__]
+        for line in problems:  # several problems: "file:line: problem" each, then a count
+            print(line, file=sys.stderr)
+        print(f"relrl {args.command}: {last}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print(f"relrl {args.command}: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        kept = getattr(exc, "kept", None)  # what a run wrote before it stopped
+        print(f"relrl {args.command}: interrupted" + (f"; {kept}" if kept else ""),
+              file=sys.stderr)
         return 130
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()

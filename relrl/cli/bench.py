@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 HELP = "measure gateway call cost, learner steps/s, simulator and perception rates"
 EXAMPLE = "relrl bench --json bench.json"
@@ -35,16 +34,15 @@ def run(args: argparse.Namespace) -> int:
     """Run the benchmarks and print them."""
     from relrl.bench import bench_all
     from relrl.errors import ConfigError
-    from relrl.experiments.report import write_json_atomic
+    from relrl.outdir import check_out_file, write_json_atomic
 
     if args.steps < 100:
         raise ConfigError(f"--steps must be at least 100, not {args.steps}")
+    path = check_out_file(args.json, "--json") if args.json else None  # before an hour's work
     figures = bench_all(steps=args.steps, perception=not args.no_perception,
                         faces=not args.no_faces)
     _print(figures)
-    if args.json:
-        path = Path(args.json)
-        path.parent.mkdir(parents=True, exist_ok=True)
+    if path is not None:
         write_json_atomic(path, figures)
         print(f"wrote {path}")
     json.dumps(figures)  # must be JSON-ready

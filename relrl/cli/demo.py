@@ -11,27 +11,36 @@ EXAMPLE = "relrl demo --out runs/demo"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl demo``."""
-    parser.add_argument("--out", default="runs/demo", help="output folder (default runs/demo)")
+    from relrl.outdir import add_out_options
+
+    add_out_options(parser, default="runs/demo", what="output folder")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the quick Experiment 1 and say where everything is."""
+    from relrl.errors import ConfigError
     from relrl.experiments.main import run_sis
     from relrl.experiments.report import summary_table
     from relrl.experiments.sis import SISConfig
+    from relrl.outdir import OutDir
 
+    if args.workers < 1:
+        raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     config = SISConfig(points=4, eval_runs=5)
     print("relrl demo: Experiment 1 (da Silva & Romero 2012) on the Social Interactive "
           "Simulator,\n  short version: 3 learners x 5 evaluation points x 5 runs of 500 "
           "time units")
     t0 = time.perf_counter()
-    results, files = run_sis(config, args.out, workers=args.workers)
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      default="runs/demo") as out:
+        results, files = run_sis(config, out.path, workers=args.workers)
+        out.status = "complete"
     print()
     print(summary_table(results["summary"]))
     print(f"\n(CGI: correct gaze index, Eq. 5; eye contacts in the first "
           f"{config.opportunities} opportunities; memory in the paper's positions)")
-    print(f"done in {time.perf_counter() - t0:.1f} s; results, CSVs and plots in {args.out}/:")
+    print(f"done in {time.perf_counter() - t0:.1f} s; results, CSVs and plots in {out.path}/:")
     for f in files:
         print(f"  {f}")
     print("The full experiment: relrl experiment sis --out runs/exp1")

@@ -8,6 +8,8 @@ import math
 import os
 from pathlib import Path
 
+from relrl.outdir import add_out_options
+
 HELP = ("run the experiments (sis: the paper's Experiment 1; scaling: every learner in "
         "worlds that grow, with zero-shot transfer)")
 EXAMPLE = ("relrl experiment sis --quick --out runs/exp1-quick\n"
@@ -106,7 +108,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                      help="toy places of the evaluation (default: all); with held-out "
                           "places the CGI is reported for trained and held-out apart")
     sis.add_argument("--domain", default=None, help="domain file (default sis.pl)")
-    sis.add_argument("--out", default="runs/exp1", help="output folder (default runs/exp1)")
+    add_out_options(sis, default="runs/exp1", what="output folder: results.json, CSVs, figures")
     sc = sub.add_parser("scaling", help="every learner in worlds that grow; transfer",
                         description="Time to CGI >= 0.9, final CGI, memory and steps/s of "
                                     "every learner as the world grows (P toy places), and "
@@ -127,7 +129,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                     help="sizes with transfer jobs (default: all; --quick: 5,9)")
     sc.add_argument("--holdout", type=float, default=0.4,
                     help="share of places (or kinds) held out (default 0.4)")
-    sc.add_argument("--out", default="runs/scaling", help="output folder")
+    add_out_options(sc, default="runs/scaling",
+                    what="output folder: results.json, CSVs, figures, domains")
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -251,31 +254,39 @@ def build_scaling_config(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the experiment, write the outputs, print the summary."""
+    """Check everything, claim the output folder, run the experiment, print the summary."""
+    from relrl.experiments import main as sis_main
+    from relrl.experiments.report import summary_table
+    from relrl.outdir import OutDir
+
     if args.name == "scaling":
         return _run_scaling(args)
-    from relrl.experiments.main import run_sis
-    from relrl.experiments.report import summary_table
-
     config = build_config(args)
-    results, files = run_sis(config, args.out, workers=args.workers, engine=args.engine,
-                             address=args.address)
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      default="runs/exp1") as out:
+        results, files = sis_main.run_sis(config, out.path, workers=args.workers,
+                                          engine=args.engine, address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
     print(summary_table(results["summary"]))
-    return _finish(results, files, args.out)
+    return _finish(results, files, out.path)
 
 
 def _run_scaling(args: argparse.Namespace) -> int:
     from relrl.experiments.scaling_report import run_scaling, scaling_table
+    from relrl.outdir import OutDir
 
     config = build_scaling_config(args)
-    results, files = run_scaling(config, args.out, workers=args.workers, engine=args.engine,
-                                 address=args.address)
-    timing = json.loads((Path(args.out) / "timing.json").read_text())
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      default="runs/scaling") as out:
+        results, files = run_scaling(config, out.path, workers=args.workers,
+                                     engine=args.engine, address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
+    timing = json.loads((out.path / "timing.json").read_text())
     print(scaling_table(results, timing))
-    return _finish(results, files, args.out)
+    return _finish(results, files, out.path)
 
 
-def _finish(results: dict, files: list, out: str) -> int:
+def _finish(results: dict, files: list, out: Path) -> int:
     print(f"\nwrote {len(files)} files to {out}/:")
     for f in files:
         print(f"  {f}")

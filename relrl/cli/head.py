@@ -59,8 +59,19 @@ def run(args: argparse.Namespace) -> int:
     """Open the head, do the action, close it (back to centre unless ``look --stay``)."""
     from head import open_head
     from head.calibration import DEFAULT_CALIBRATION, load_calibration
+    from relrl.errors import ConfigError
+    from relrl.outdir import check_out_file
 
+    if not 0 < args.timeout <= 60:  # also refuses nan
+        raise ConfigError(f"--timeout must be more than 0 and at most 60 seconds, not "
+                          f"{args.timeout}")
     cal = load_calibration(args.calibration)
+    out = None
+    if args.action == "calibrate":
+        out = args.output or args.calibration
+        if out is None or (not args.output and Path(out).resolve() == DEFAULT_CALIBRATION):
+            out = "head.toml"  # never overwrite the shipped example by default
+        check_out_file(out, "--output", devices=False)  # before any servo is jogged
     options = {} if args.port in ("sim", "sim://") else {"timeout": args.timeout}
     head = open_head(args.port, args.protocol, cal, **options)
     centre = True
@@ -80,9 +91,6 @@ def run(args: argparse.Namespace) -> int:
         else:
             from head.calibrate import calibrate
 
-            out = args.output or args.calibration
-            if out is None or (not args.output and Path(out).resolve() == DEFAULT_CALIBRATION):
-                out = "head.toml"  # never overwrite the shipped example by default
             calibrate(head, sys.stdin, sys.stdout, out)
     except BaseException:
         _quiet_close(head)

@@ -6,6 +6,8 @@ import argparse
 
 HELP = "print the perception facts of an image (or camera frames) as Prolog terms"
 EXAMPLE = "relrl perceive photo.png --annotate out.png"
+#: the file types --annotate writes.
+IMAGE_OUT = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,39 +26,53 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Print one fact per line; frames from a camera are separated by a ``% frame N`` line."""
+    """Print one fact per line; with ``--frames N`` (N > 1) each frame starts with a
+    ``% frame I`` line. Frames are read and analysed one at a time."""
     import cv2
 
     from perception.camera import open_camera, read_image
     from perception.errors import PerceptionError
     from perception.facts import format_fact
     from perception.pipeline import Perceiver, annotate
+    from perception.vocab import PLACES
+    from relrl.outdir import check_out_file, write_atomic
 
     if (args.image is None) == (args.camera is None):
         raise PerceptionError("give either an IMAGE or --camera SRC (not both)")
     if args.frames < 1:
         raise PerceptionError(f"--frames must be at least 1, got {args.frames}")
+    if args.looking_at is not None and args.looking_at not in PLACES:
+        raise PerceptionError(f"--looking-at {args.looking_at!r}: use one of "
+                              f"{', '.join(PLACES)}")
+    annotate_to = check_out_file(args.annotate, "--annotate", suffixes=IMAGE_OUT) \
+        if args.annotate else None  # before reading a single frame
     perceiver = Perceiver()
-    if args.image is not None:
-        frames = [read_image(args.image)]
-    else:
+
+    def frames():  # one at a time: --frames 1000000 holds one frame, not a million
+        if args.image is not None:
+            yield read_image(args.image)
+            return
         with open_camera(args.camera) as cam:
-            frames = []
             for _ in range(args.frames):
                 frame = cam.read()
                 if frame is None:
-                    break
-                frames.append(frame)
-        if not frames:
-            raise PerceptionError(f"camera {args.camera!r} gave no frame")
-    percept = None
-    for i, frame in enumerate(frames):
-        if len(frames) > 1:
+                    return
+                yield frame
+
+    last = percept = None
+    for i, frame in enumerate(frames()):
+        if args.frames > 1:
             print(f"% frame {i}")
         percept = perceiver.analyse(frame, args.looking_at)
         for fact in percept.facts:
             print(format_fact(fact))
-    if args.annotate and not cv2.imwrite(args.annotate, annotate(frames[-1], percept)):
-        raise PerceptionError(f"cannot write {args.annotate!r}; use a .png or .jpg path in "
-                              "an existing folder")
+        last = frame
+    if last is None:
+        raise PerceptionError(f"camera {args.camera!r} gave no frame")
+    if annotate_to is not None:
+        ext = annotate_to.suffix.lower() if annotate_to.suffix.lower() in IMAGE_OUT else ".png"
+        ok, data = cv2.imencode(ext, annotate(last, percept))
+        if not ok:
+            raise PerceptionError(f"--annotate {annotate_to}: OpenCV cannot write {ext} files")
+        write_atomic(annotate_to, data.tobytes())
     return 0

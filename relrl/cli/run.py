@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import math
+import re
 import sys
-from pathlib import Path
+
+from relrl.outdir import add_out_options
 
 HELP = "run a scripted interaction episode (simulator by default, or camera and head)"
 EXAMPLE = "relrl run examples/episodes/experiment2.toml --out runs/exp2"
@@ -13,11 +16,13 @@ EXAMPLE = "relrl run examples/episodes/experiment2.toml --out runs/exp2"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl run``."""
     parser.add_argument("episode", help="episode script (.toml)")
-    parser.add_argument("--out", default=None,
-                        help="output folder: trace.jsonl, summary.json, policy, plots")
+    add_out_options(parser, default=None,
+                    what="output folder: trace.jsonl, summary.json, policy, plots")
     parser.add_argument("--head", default=None, metavar="PORT",
                         help="drive a head: sim, /dev/ttyUSB0, loop://, socket://HOST:PORT")
     parser.add_argument("--protocol", default=None, help="head protocol (ssc32, maestro, ...)")
+    parser.add_argument("--calibration", default=None, metavar="FILE",
+                        help="the head's calibration TOML (default: examples/heads/wha8030.toml)")
     parser.add_argument("--camera", default=None, metavar="SRC",
                         help="perceive from a camera: 0, video, folder, synthetic://...")
     parser.add_argument("--live", action="store_true",
@@ -32,22 +37,34 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="only check the script and print what it would run")
 
 
+_WORD = re.compile(r"[a-z][a-z0-9_]*")
+
+
 def _reader(queue) -> None:
-    for line in sys.stdin:
+    """Typed words into ``queue``; bytes that are not UTF-8 or not words are skipped, said."""
+    stream = getattr(sys.stdin, "buffer", sys.stdin)
+    for raw in stream:
+        line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else raw
         for word in line.strip().lower().split():
-            queue.put(word)
+            if _WORD.fullmatch(word):
+                queue.put(word)
+            else:
+                print(f"relrl run: ignored {word!r}: type words of letters, digits and _",
+                      file=sys.stderr, flush=True)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the script, run it, print the summary; 130 when stopped by Ctrl-C."""
+    """Check the script, run it, print the summary; 128 + N when stopped by signal N."""
     import queue
     import threading
 
-    from relrl.episodes import RunOptions, StopRequest, load_episode, run_episode
+    from relrl.episodes import RunOptions, StopRequest, load_episode
     from relrl.errors import ConfigError
 
     episode = load_episode(args.episode)
     if args.seed is not None:
+        if args.seed < 0:
+            raise ConfigError(f"--seed must be an integer >= 0, not {args.seed}")
         episode.seed = args.seed
     if args.check:
         print(f"{args.episode}: ok - {episode.name}: {len(episode.phases)} phases, "
@@ -56,32 +73,63 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.protocol and not args.head:
         raise ConfigError("--protocol needs --head PORT")
+    if args.calibration and not args.head:
+        raise ConfigError("--calibration needs --head PORT")
     step = args.step_seconds
     if step is None:
         step = 0.5 if args.live and args.camera is None else 0.0
-    if step < 0:
-        raise ConfigError(f"--step-seconds must be >= 0, not {step}")
+    if not (math.isfinite(step) and 0 <= step <= 60):
+        raise ConfigError(f"--step-seconds must be a number of seconds from 0 to 60, not "
+                          f"{step}")
     words = None
     if args.live:
         words = queue.Queue()
         threading.Thread(target=_reader, args=(words,), daemon=True).start()
         print("live session: type words (e.g. apple, attention) and Enter; Ctrl-C stops",
               flush=True)
-    opts = RunOptions(out=Path(args.out) if args.out else None, head=args.head,
-                      protocol=args.protocol, camera=args.camera, live=args.live,
-                      step_seconds=step, words=words, plots=not args.no_plots)
+    opts = RunOptions(head=args.head, protocol=args.protocol, calibration=args.calibration,
+                      camera=args.camera, live=args.live, step_seconds=step, words=words,
+                      plots=not args.no_plots)
     stop = StopRequest()
-    with stop.installed():
-        summary = run_episode(episode, opts, stop)
+    if args.out is None:
+        summary = _run(episode, opts, stop)
+    else:
+        from relrl.outdir import OutDir
+
+        with OutDir.claim(args.out, command=args.command_line,
+                          overwrite=args.overwrite) as out:
+            opts.out = out.path
+            summary = _run(episode, opts, stop)
+            if not summary["partial"]:
+                out.status = "complete"
     print(_report(summary))
     if args.out:
         policy = f", {summary['policy']}" if "policy" in summary else ""
         print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
+        if "policy_error" in summary:
+            print(f"relrl run: the policy was not saved: {summary['policy_error']}",
+                  file=sys.stderr)
     if summary["stopped_early"]:
-        print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}; "
+        print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}"
+              f"{' by ' + summary['stopped_by'] if summary['stopped_by'] else ''}; "
               "everything up to it is written", file=sys.stderr)
-        return 130
+        return 128 + (stop.signum or 2)
     return 0
+
+
+def _run(episode, opts, stop) -> dict:
+    """Run the episode; a user's error ends with one line that says what was kept."""
+    from relrl.episodes import run_episode
+    from relrl.errors import UserError
+
+    try:
+        with stop.installed():
+            return run_episode(episode, opts, stop)
+    except UserError as exc:
+        kept = getattr(exc, "kept", None)
+        if kept is None:
+            raise
+        raise UserError(f"{exc}; {kept}") from None
 
 
 def _report(s: dict) -> str:

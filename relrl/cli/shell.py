@@ -36,6 +36,8 @@ def run(args: argparse.Namespace) -> int:
             policy.load_policy(shell, args.policy)
         elif args.learner:
             policy.attach_learner(shell, args.learner)
+        if hasattr(sys.stdin, "reconfigure"):  # bytes that are not UTF-8 become U+FFFD
+            sys.stdin.reconfigure(errors="replace")
         if sys.stdin.isatty():
             shell.interact()
             return 0

@@ -1,9 +1,11 @@
 """Episode scripts: TOML files that script a caregiver, a world and a learner over time.
 
 :func:`load_episode` reads and checks a script and returns an :class:`Episode`. Every problem
-is an :class:`EpisodeError` naming ``file:line`` and the problem; syntax errors come from
-``tomllib`` (which gives the line), problems of meaning (an unknown key, a place that does not
-exist, a negative number of steps) are located by finding the key's line in the text.
+is a line ``file:line: problem`` and one :class:`EpisodeError` lists them all; syntax errors
+come from ``tomllib`` (which gives the line, and stops at the first), problems of meaning (an
+unknown key, a place that does not exist, a negative number of steps) are located by finding
+the key's line in the text, through an index built once, so checking is linear in the length
+of the script.
 
 See ``docs/episodes.md`` for the format, with examples.
 """
@@ -11,10 +13,11 @@ See ``docs/episodes.md`` for the format, with examples.
 from __future__ import annotations
 
 import difflib
+import math
 import re
 import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 from relrl.errors import UserError
@@ -41,7 +44,15 @@ _PERCEPTION = ("render", "symbolic")
 
 
 class EpisodeError(UserError):
-    """A problem in an episode script: ``file:line: problem``."""
+    """Problems in an episode script, one ``file:line: problem`` line each.
+
+    Attributes:
+        problems: every problem found (the message lists the first :data:`MAX_LISTED`).
+    """
+
+    def __init__(self, message: str, problems: list[str] | None = None) -> None:
+        super().__init__(message)
+        self.problems = problems or [message]
 
 
 @dataclass
@@ -133,45 +144,73 @@ class Episode:
 # ---- locating keys in the text -----------------------------------------------------------------
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+#: the most evaluation runs per point, and naming executions, a script may ask for.
+MAX_RUNS = 10_000
+#: problems listed in full before the rest are counted.
+MAX_LISTED = 20
+#: names in --out that belong to the run itself (a policy may not take them).
+RESERVED = ("trace.jsonl", "summary.json", "timing.json", "rewards.png", "cgi.png",
+            "table1.png", ".relrl-run.json")
 
 
-def _locate(text: str, path: tuple[str | int, ...]) -> int:
-    """The 1-based line of the key at ``path`` (table, [array index], key...); best effort."""
-    lines = text.splitlines()
-    table = path[0]
-    index = path[1] if len(path) > 1 and isinstance(path[1], int) else None
-    rest = [p for p in path[1:] if not isinstance(p, int)]
-    seen = -1
-    start = None
-    for i, line in enumerate(lines):
-        m = _HEADER.match(line)
-        if m and m.group(2) == table:
-            seen += 1
-            if index is None or seen == index:
-                start = i
-                break
-    if start is None:
-        return 1
-    key = rest[0] if rest else None
-    if key is None:
+class _Lines:
+    """Where each table header and key is in the text, indexed once (linear in the text)."""
+
+    def __init__(self, text: str) -> None:
+        self.lines = text.splitlines()
+        self.headers: dict[str, list[int]] = {}
+        starts = []
+        for i, line in enumerate(self.lines):
+            m = _HEADER.match(line)
+            if m:
+                self.headers.setdefault(m.group(2), []).append(i)
+                starts.append(i)
+        self.section_end = dict(zip(starts, [*starts[1:], len(self.lines)], strict=False))
+        #: lines examined by :meth:`locate` (checking stays linear in the text)
+        self.scanned = 0
+
+    def locate(self, path: tuple[str | int, ...]) -> int:
+        """The 1-based line of the key at ``path`` (table, [array index], key...); best effort:
+        the table's header when the key is not found, line 1 when the table is not."""
+        index = path[1] if len(path) > 1 and isinstance(path[1], int) else 0
+        rest = [p for p in path[1:] if not isinstance(p, int)]
+        starts = self.headers.get(str(path[0]), [])
+        if index >= len(starts):
+            return 1
+        start = starts[index]
+        if rest:
+            key = re.compile(rf"^\s*{re.escape(str(rest[0]))}\s*=")
+            for j in range(start + 1, self.section_end[start]):
+                self.scanned += 1
+                if key.match(self.lines[j]):
+                    return j + 1
         return start + 1
-    for j in range(start + 1, len(lines)):
-        if _HEADER.match(lines[j]):
-            break
-        if re.match(rf"^\s*{re.escape(str(key))}\s*=", lines[j]):
-            return j + 1
-    return start + 1
 
 
 class _Checker:
-    """Reads values out of the parsed TOML, raising located errors."""
+    """Reads values out of the parsed TOML and collects every located problem."""
 
     def __init__(self, path: Path, text: str) -> None:
         self.path = path
-        self.text = text
+        self.where = _Lines(text)
+        self.problems: list[tuple[int, str]] = []
 
-    def fail(self, where: tuple[str | int, ...], problem: str) -> EpisodeError:
-        return EpisodeError(f"{self.path}:{_locate(self.text, where)}: {problem}")
+    def fail(self, where: tuple[str | int, ...], problem: str) -> None:
+        """Record a problem at the key ``where``; checking goes on."""
+        line = self.where.locate(where)
+        self.problems.append((line, f"{self.path}:{line}: {problem}"))
+
+    def raise_problems(self) -> None:
+        """Raise one :class:`EpisodeError` listing every problem in line order (if any)."""
+        if not self.problems:
+            return
+        problems = [text for _, text in sorted(self.problems, key=lambda p: p[0])]
+        shown = problems[:MAX_LISTED]
+        if len(problems) > MAX_LISTED:
+            shown.append(f"... and {len(problems) - MAX_LISTED} more")
+        if len(problems) > 1:
+            shown.append(f"{len(problems)} problems in {self.path}")
+        raise EpisodeError("\n".join(shown), problems)
 
     def keys(self, table: dict[str, Any], allowed: tuple[str, ...], where: tuple) -> None:
         for key in table:
@@ -179,10 +218,12 @@ class _Checker:
                 close = difflib.get_close_matches(key, allowed, n=1)
                 hint = f" (did you mean {close[0]!r}?)" if close else \
                     f" (known: {', '.join(allowed)})"
-                raise self.fail(where + (key,), f"unknown key {key!r} in [{where[0]}]{hint}")
+                self.fail(where + (key,), f"unknown key {key!r} in [{where[0]}]{hint}")
 
     def get(self, table: dict[str, Any], key: str, kind: type | tuple, default: Any,
             where: tuple) -> Any:
+        """``table[key]`` when it has the type ``kind`` (a float must be finite); else the
+        problem is recorded and ``default`` returned."""
         if key not in table:
             return default
         value = table[key]
@@ -191,22 +232,53 @@ class _Checker:
             ok, value = True, float(value)
         if not ok:
             name = kind.__name__ if isinstance(kind, type) else "/".join(k.__name__ for k in kind)
-            raise self.fail(where + (key,), f"{key} must be a {name}, not {value!r}")
+            self.fail(where + (key,), f"{key} must be a {name}, not {value!r}")
+            return default
+        if isinstance(value, float) and not math.isfinite(value):
+            self.fail(where + (key,), f"{key} must be a finite number, not {value!r}")
+            return default
         return value
 
     def positive(self, table: dict[str, Any], key: str, default: int, where: tuple,
-                 minimum: int = 1) -> int:
+                 minimum: int = 1, maximum: int | None = None) -> int:
         value = self.get(table, key, int, default, where)
-        if value < minimum:
-            raise self.fail(where + (key,), f"{key} must be at least {minimum}, not {value}")
+        if value < minimum or (maximum is not None and value > maximum):
+            bound = f"at least {minimum}" if maximum is None else \
+                f"from {minimum} to {maximum}"
+            self.fail(where + (key,), f"{key} must be {bound}, not {value}")
+            return default
         return value
 
-    def choice(self, value: str, choices: tuple[str, ...], what: str, where: tuple) -> str:
-        if value not in choices:
-            close = difflib.get_close_matches(str(value), choices, n=1)
-            hint = f"did you mean {close[0]!r}?" if close else f"use one of {', '.join(choices)}"
-            raise self.fail(where, f"unknown {what} {value!r}; {hint}")
+    def choice(self, value: str, choices: tuple[str, ...], what: str, where: tuple) -> bool:
+        """Whether ``value`` is one of ``choices`` (recording the problem when not)."""
+        if value in choices:
+            return True
+        close = difflib.get_close_matches(str(value), choices, n=1)
+        hint = f"did you mean {close[0]!r}?" if close else f"use one of {', '.join(choices)}"
+        self.fail(where, f"unknown {what} {value!r}; {hint}")
+        return False
+
+    def table(self, data: dict[str, Any], key: str) -> dict[str, Any]:
+        """A top-level table (a problem and ``{}`` when it is something else)."""
+        value = data.get(key, {})
+        if not isinstance(value, dict):
+            self.fail((key,), f"{key} must be a table [{key}], not {value!r}")
+            return {}
         return value
+
+    def policy_file(self, value: str, where: tuple) -> str | None:
+        """A policy file name to write inside the run's output folder, or None when bad."""
+        parts = PurePosixPath(value.replace("\\", "/"))
+        if value.endswith(("/", "\\")) or parts.is_absolute() or Path(value).is_absolute() \
+                or ".." in parts.parts or value in (".", ""):
+            self.fail(where, f"policy_save must be a file name inside --out (a relative path "
+                             f"without '..'), not {value!r}")
+            return None
+        if str(parts) in RESERVED:
+            self.fail(where, f"policy_save {value!r} is a file of the run itself; choose "
+                             "another name (e.g. policy.pl)")
+            return None
+        return str(parts)
 
 
 _TOP = ("episode", "learner", "world", "caregiver", "phase", "event", "evaluation", "naming",
@@ -214,7 +286,12 @@ _TOP = ("episode", "learner", "world", "caregiver", "phase", "event", "evaluatio
 
 
 def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
-    """Parse and check an episode script given as text (``path`` names it in errors)."""
+    """Parse and check an episode script given as text (``path`` names it in errors).
+
+    Raises:
+        EpisodeError: every problem of the script, one ``file:line: problem`` line each (a
+            TOML syntax error stops at the first).
+    """
     path = Path(path)
     try:
         data = tomllib.loads(text)
@@ -228,39 +305,64 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
         if key not in _TOP:
             close = difflib.get_close_matches(key, _TOP, n=1)
             hint = f" (did you mean [{close[0]}]?)" if close else ""
-            raise c.fail((key,), f"unknown table [{key}]{hint}")
-    base = path.parent
+            c.fail((key,), f"unknown table [{key}]{hint}")
     ep = Episode(path=path)
+    _episode_table(c, c.table(data, "episode"), ep)
+    _learner_table(c, c.table(data, "learner"), ep)
+    _world_table(c, c.table(data, "world"), ep)
+    _caregiver_table(c, c.table(data, "caregiver"), ep)
+    before = len(c.problems)
+    _phases(c, data.get("phase", []), ep)
+    # a bad phase length would make every later event look late: say so only once
+    _events(c, data.get("event", []), ep, check_end=len(c.problems) == before)
+    _optional_tables(c, data, ep)
+    c.raise_problems()
+    return ep
 
-    head = data.get("episode", {})
+
+def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
     w = ("episode",)
+    base = ep.path.parent
     c.keys(head, ("name", "domain", "seed", "learner", "policy_load", "policy_save"), w)
-    ep.name = c.get(head, "name", str, path.stem, w)
+    ep.name = c.get(head, "name", str, ep.path.stem, w)
     domain = c.get(head, "domain", str, None, w)
     if domain is None:
-        raise c.fail(w, "[episode] needs domain = \"path/to/domain.pl\"")
-    ep.domain = (base / domain).resolve()
-    if not ep.domain.exists():
-        raise c.fail(w + ("domain",), f"domain file {domain!r} not found (looked for "
-                     f"{ep.domain})")
+        c.fail(w, "[episode] needs domain = \"path/to/domain.pl\"")
+    else:
+        ep.domain = (base / domain).resolve()
+        if not ep.domain.is_file():
+            c.fail(w + ("domain",), f"domain file {domain!r} not found (looked for "
+                   f"{ep.domain})")
     ep.seed = c.get(head, "seed", int, 0, w)
+    if ep.seed < 0:
+        c.fail(w + ("seed",), f"seed must be an integer >= 0, not {ep.seed}")
+        ep.seed = 0
     ep.learner = c.get(head, "learner", str, "etg", w)
     from relrl.learners import LEARNERS
 
-    c.choice(ep.learner, tuple(sorted(LEARNERS)), "learner", w + ("learner",))
+    if not c.choice(ep.learner, tuple(sorted(LEARNERS)), "learner", w + ("learner",)):
+        ep.learner = ""
     load = c.get(head, "policy_load", str, "", w)
     if load:
         ep.policy_load = (base / load).resolve()
-        if not ep.policy_load.exists():
-            raise c.fail(w + ("policy_load",), f"policy file {load!r} not found")
-    ep.policy_save = c.get(head, "policy_save", str, "policy.pl", w) or None
+        if not ep.policy_load.is_file():
+            c.fail(w + ("policy_load",), f"policy file {load!r} not found")
+    save = c.get(head, "policy_save", str, "policy.pl", w)
+    ep.policy_save = c.policy_file(save, w + ("policy_save",)) if save else None
 
-    params = data.get("learner", {})
+
+def _learner_table(c: _Checker, params: dict[str, Any], ep: Episode) -> None:
+    ok = True
     for key, value in params.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise c.fail(("learner", key), f"learner parameter {key} must be a number, "
-                         f"not {value!r}")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value):
+            c.fail(("learner", key), f"learner parameter {key} must be a finite number, "
+                   f"not {value!r}")
+            ok = False
+            continue
         ep.learner_params[key] = float(value)
+    if not (ok and ep.learner):
+        return
     from relrl.errors import ConfigError
     from relrl.learners import make_learner
 
@@ -268,37 +370,43 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
         make_learner(ep.learner, **ep.learner_params)
     except ConfigError as exc:
         bad = [k for k in params if re.search(rf"\b{re.escape(k)}\b", str(exc))]
-        where = ("learner", bad[0]) if bad else ("learner",)
-        raise c.fail(where, str(exc)) from None
+        c.fail(("learner", bad[0]) if bad else ("learner",), str(exc))
 
-    world = data.get("world", {})
+
+def _world_table(c: _Checker, world: dict[str, Any], ep: Episode) -> None:
     w = ("world",)
     c.keys(world, ("perception", "lighting", "fruits", "names", "places"), w)
-    ep.perception = c.choice(c.get(world, "perception", str, "render", w), _PERCEPTION,
-                             "perception mode", w + ("perception",))
+    mode = c.get(world, "perception", str, "render", w)
+    if c.choice(mode, _PERCEPTION, "perception mode", w + ("perception",)):
+        ep.perception = mode
     light = c.get(world, "lighting", (float, int, list), [0.9, 1.1], w)
     light = [light, light] if not isinstance(light, list) else light
     if len(light) != 2 or not all(isinstance(x, (int, float)) and 0.05 <= x <= 3.0
                                   for x in light) or light[0] > light[1]:
-        raise c.fail(w + ("lighting",), f"lighting must be a number or [low, high] within "
-                     f"0.05..3.0, not {world.get('lighting')!r}")
-    ep.lighting = (float(light[0]), float(light[1]))
+        c.fail(w + ("lighting",), f"lighting must be a number or [low, high] within "
+               f"0.05..3.0, not {world.get('lighting')!r}")
+    else:
+        ep.lighting = (float(light[0]), float(light[1]))
     fruits = c.get(world, "fruits", list, list(ep.fruits), w)
-    for kind in fruits:
-        c.choice(kind, _KINDS, "object", w + ("fruits",))
-    ep.fruits = tuple(fruits)
+    if all([c.choice(kind, _KINDS, "object", w + ("fruits",)) for kind in fruits]) and fruits:
+        ep.fruits = tuple(fruits)
+    elif not fruits:
+        c.fail(w + ("fruits",), "fruits must name at least one object")
     names = c.get(world, "names", dict, {}, w)
     for kind, word in names.items():
         if not isinstance(word, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", word):
-            raise c.fail(w + ("names",), f"the name of {kind} must be a lower-case word, "
-                         f"not {word!r}")
-    ep.names = dict(names)
+            c.fail(w + ("names",), f"the name of {kind} must be a lower-case word, "
+                   f"not {word!r}")
+    ep.names = {k: v for k, v in names.items() if isinstance(v, str)}
     places = c.get(world, "places", list, list(OBJECT_PLACES), w)
-    for place in places:
-        c.choice(place, OBJECT_PLACES, "object place", w + ("places",))
-    ep.places = tuple(places)
+    if all([c.choice(p, OBJECT_PLACES, "object place", w + ("places",)) for p in places]) \
+            and places:
+        ep.places = tuple(places)
+    elif not places:
+        c.fail(w + ("places",), "places must name at least one place")
 
-    care = data.get("caregiver", {})
+
+def _caregiver_table(c: _Checker, care: dict[str, Any], ep: Episode) -> None:
     w = ("caregiver",)
     c.keys(care, ("contact_hold", "contact_timeout", "timeout", "joint", "latency",
                   "gaze_attention"), w)
@@ -311,72 +419,83 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
         "gaze_attention": c.get(care, "gaze_attention", bool, True, w),
     }
 
-    phases = data.get("phase", [])
-    if not isinstance(phases, list) or not phases:
-        raise c.fail(("phase",), "the script needs at least one [[phase]] with steps = N")
+
+def _phases(c: _Checker, phases: Any, ep: Episode) -> None:
+    if not isinstance(phases, list) or not phases or \
+            not all(isinstance(ph, dict) for ph in phases):
+        c.fail(("phase",), "the script needs at least one [[phase]] with steps = N")
+        return
     for i, ph in enumerate(phases):
         w = ("phase", i)
         c.keys(ph, ("name", "steps", "caregiver", "objects", "learning"), w)
         if "steps" not in ph:
-            raise c.fail(w, f"[[phase]] number {i + 1} needs steps = N")
+            c.fail(w, f"[[phase]] number {i + 1} needs steps = N")
+        caregiver = c.get(ph, "caregiver", str, "protocol", w)
+        if not c.choice(caregiver, _CAREGIVERS, "caregiver", w + ("caregiver",)):
+            caregiver = "protocol"
         ep.phases.append(Phase(
             name=c.get(ph, "name", str, f"phase {i + 1}", w),
-            steps=c.positive(ph, "steps", 1, w),
-            caregiver=c.choice(c.get(ph, "caregiver", str, "protocol", w), _CAREGIVERS,
-                               "caregiver", w + ("caregiver",)),
+            steps=c.positive(ph, "steps", 1, w), caregiver=caregiver,
             objects=c.get(ph, "objects", bool, True, w),
             learning=c.get(ph, "learning", bool, True, w)))
 
-    for i, ev in enumerate(data.get("event", [])):
+
+def _events(c: _Checker, events: Any, ep: Episode, *, check_end: bool) -> None:
+    if not isinstance(events, list) or not all(isinstance(ev, dict) for ev in events):
+        c.fail(("event",), "events must be [[event]] tables")
+        return
+    last = ep.steps
+    for i, ev in enumerate(events):
         w = ("event", i)
         c.keys(ev, ("t", "look", "show", "remove", "say", "attention"), w)
         if "t" not in ev:
-            raise c.fail(w, "[[event]] needs t = TIME_UNIT")
+            c.fail(w, "[[event]] needs t = TIME_UNIT")
         t = c.positive(ev, "t", 1, w)
-        if t > ep.steps:
-            raise c.fail(w + ("t",), f"t = {t} is after the last time unit ({ep.steps})")
+        if check_end and t > last:
+            c.fail(w + ("t",), f"t = {t} is after the last time unit ({last})")
         look = c.get(ev, "look", str, None, w)
-        if look is not None:
-            c.choice(look, PLACES, "place", w + ("look",))
+        if look is not None and not c.choice(look, PLACES, "place", w + ("look",)):
+            look = None
         show = c.get(ev, "show", dict, {}, w)
-        for place, kind in show.items():
-            c.choice(place, OBJECT_PLACES, "object place", w + ("show",))
-            c.choice(kind, _KINDS, "object", w + ("show",))
+        show = {place: kind for place, kind in show.items()
+                if c.choice(place, OBJECT_PLACES, "object place", w + ("show",))
+                and c.choice(kind, _KINDS, "object", w + ("show",))}
         remove = c.get(ev, "remove", (list, str), [], w)
         remove = [remove] if isinstance(remove, str) else remove
-        for place in remove:
-            c.choice(place, OBJECT_PLACES + ("all",), "place", w + ("remove",))
+        remove = [p for p in remove
+                  if c.choice(p, OBJECT_PLACES + ("all",), "place", w + ("remove",))]
         say = c.get(ev, "say", (list, str), [], w)
         say = say.split() if isinstance(say, str) else say
         for word in say:
             if not isinstance(word, str) or not re.fullmatch(r"[a-z][a-z0-9_]*", word):
-                raise c.fail(w + ("say",), f"say: {word!r} is not a lower-case word")
-        ep.events.append(Event(t, look, dict(show), list(remove), list(say),
-                               c.get(ev, "attention", bool, False, w),
-                               _locate(c.text, w)))
+                c.fail(w + ("say",), f"say: {word!r} is not a lower-case word")
+        ep.events.append(Event(t, look, dict(show), list(remove),
+                               [x for x in say if isinstance(x, str)],
+                               c.get(ev, "attention", bool, False, w), c.where.locate(w)))
     ep.events.sort(key=lambda e: e.t)
 
+
+def _optional_tables(c: _Checker, data: dict[str, Any], ep: Episode) -> None:
     if "evaluation" in data:
-        ev = data["evaluation"]
+        ev = c.table(data, "evaluation")
         w = ("evaluation",)
         c.keys(ev, ("every", "runs", "steps"), w)
         ep.evaluation = {"every": c.positive(ev, "every", 10, w),
-                         "runs": c.positive(ev, "runs", 5, w),
+                         "runs": c.positive(ev, "runs", 5, w, maximum=MAX_RUNS),
                          "steps": c.positive(ev, "steps", 100, w)}
     if "naming" in data:
-        nm = data["naming"]
+        nm = c.table(data, "naming")
         w = ("naming",)
         c.keys(nm, ("executions", "presentations", "confident_after", "max_steps"), w)
-        ep.naming = {"executions": c.positive(nm, "executions", 5, w),
+        ep.naming = {"executions": c.positive(nm, "executions", 5, w, maximum=MAX_RUNS),
                      "presentations": c.positive(nm, "presentations", 40, w),
                      "confident_after": c.positive(nm, "confident_after", 3, w),
                      "max_steps": c.positive(nm, "max_steps", 1000, w)}
-    sp = data.get("speech", {})
+    sp = c.table(data, "speech")
     w = ("speech",)
     c.keys(sp, ("say", "voice"), w)
     ep.speech = {"say": c.get(sp, "say", bool, False, w),
                  "voice": c.get(sp, "voice", str, "en", w)}
-    return ep
 
 
 def load_episode(path: str | Path) -> Episode:
@@ -386,10 +505,19 @@ def load_episode(path: str | Path) -> Episode:
         EpisodeError: the file is missing or has a problem (``file:line: problem``).
     """
     path = Path(path)
+    if path.is_dir():
+        raise EpisodeError(f"{path}: is a folder, not an episode script (.toml)")
     try:
-        text = path.read_text(encoding="utf-8")
+        raw = path.read_bytes()
     except FileNotFoundError:
         raise EpisodeError(f"{path}: no such episode script") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise EpisodeError(f"{path}: cannot read the episode script ({exc})") from None
+    except OSError as exc:
+        raise EpisodeError(f"{path}: cannot read the episode script ({exc.strerror or exc})") \
+            from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise EpisodeError(f"{path}:{line}: not UTF-8 text (byte {raw[exc.start]:#04x}); "
+                           "save the script as UTF-8") from None
     return parse_episode(text, path)

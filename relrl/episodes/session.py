@@ -5,8 +5,11 @@
 :class:`~relrl.episodes.devices.DeviceWorld` on a camera and a head) and runs the phases one
 time unit at a time. With an output folder it writes, as it goes, ``trace.jsonl`` (one line
 per time unit, flushed) and at the end ``summary.json`` (atomic), ``timing.json``, the learned
-policy and plots. A stop request (Ctrl-C or SIGTERM) ends the run after the current time unit
-with everything up to it written.
+policy and plots. A stop request (Ctrl-C, SIGTERM, SIGHUP) ends the run after the current time
+unit with everything up to it written. Nothing learned is lost on an error either: a lost
+serial port or camera, a fault in a domain's rules, a second Ctrl-C -- the summary and the
+policy so far are written, marked ``"partial": true``, before the error goes on
+(:func:`keep_partial`).
 """
 
 from __future__ import annotations
@@ -27,21 +30,32 @@ import numpy as np
 from relrl.episodes.script import Episode
 from relrl.terms import format_term
 
-__all__ = ["RunOptions", "StopRequest", "run_episode"]
+__all__ = ["STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial", "run_episode"]
+
+
+#: signals that stop a run after the current time unit (SIGHUP: the terminal was closed).
+STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
+                     if hasattr(signal, name))
 
 
 class StopRequest:
-    """A flag set by SIGINT/SIGTERM (a second SIGINT raises KeyboardInterrupt)."""
+    """A flag set by SIGINT, SIGTERM or SIGHUP (a second SIGINT raises KeyboardInterrupt).
+
+    Attributes:
+        requested: a stop was asked for.
+        signum: the signal that asked (``None`` when set by code).
+    """
 
     def __init__(self) -> None:
         self.requested = False
+        self.signum: int | None = None
 
     def __call__(self) -> bool:
         return self.requested
 
     @contextmanager
     def installed(self):
-        """Catch SIGINT and SIGTERM while the block runs (main thread only)."""
+        """Catch the :data:`STOP_SIGNALS` while the block runs (main thread only)."""
         if threading.current_thread() is not threading.main_thread():
             yield self
             return
@@ -50,8 +64,9 @@ class StopRequest:
             if self.requested and signum == signal.SIGINT:
                 raise KeyboardInterrupt
             self.requested = True
+            self.signum = self.signum or signum
 
-        old = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+        old = {s: signal.signal(s, handler) for s in STOP_SIGNALS}
         try:
             yield self
         finally:
@@ -67,6 +82,7 @@ class RunOptions:
         out: output folder (``None``: nothing written).
         head: head port (``sim``, a serial device, a pyserial URL) or ``None``.
         protocol: head protocol name.
+        calibration: the head's calibration file (default: the shipped example).
         camera: camera source (perception's ``open_camera``) or ``None`` for the simulator.
         live: print what the robot perceives, wants and does; read typed words.
         step_seconds: pause per time unit (a live session on the simulator is slowed down so
@@ -79,6 +95,7 @@ class RunOptions:
     out: Path | None = None
     head: str | None = None
     protocol: str | None = None
+    calibration: str | None = None
     camera: str | None = None
     live: bool = False
     step_seconds: float = 0.0
@@ -136,6 +153,7 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.executions: list[dict[str, Any]] = []
         self.t = 0
+        self.done = 0  # learning time units finished (traced)
         self.in_view = None
 
     def close(self) -> None:
@@ -164,6 +182,7 @@ TRACE_WANTS = ("memory_size", "explain")
 
 def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
     """Trace, naming and live output of one time unit."""
+    run.done += 1
     info = record.info
     said = None
     if record.out.action == "name_object":
@@ -230,6 +249,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     run = _Run(episode, opts)
     trace = _Trace(out / "trace.jsonl" if out is not None else None)
     env = actuator = None
+    written = failed = False
     try:
         env, actuator = _world(episode, opts)
         phase_name = episode.phase_at(1).name
@@ -244,6 +264,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         def evaluate() -> None:
             point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
             point["learning_steps"] = run.t
+            _flag_cut_short(point, "cgi_runs", len(eval_seeds))
             run.curve.append(point)
             if opts.live:
                 print(f"evaluation after {run.t} time units: CGI {point['cgi_mean']:.3f} +- "
@@ -271,22 +292,48 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                     break
                 res = fruits.naming_execution(run.agent, episode, episode.seed * 1000 + k,
                                               stop=stop)
+                if stop():
+                    res["interrupted"] = True  # kept, flagged, left out of the rates
                 run.executions.append(res)
                 if opts.live:
                     print(f"naming execution {k + 1}: {res['counts']} "
                           f"({res['presentations']} presentations)", file=opts.stream,
                           flush=True)
-        summary = _summary(run, stopped=stop())
+        summary = _summary(run, stopped=stop(), why=_signal_name(stop))
         timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t}
         if out is not None:
+            written = True
             _write_outputs(run, out, summary, timing)
         return summary
+    except BaseException as exc:  # a lost device, a fault, a second Ctrl-C
+        failed = True
+        if out is not None and not written:
+            keep_partial(run, out, t0, exc)
+        raise
     finally:
         trace.close()
-        for thing in (actuator, env):
-            if thing is not None:
-                thing.close()
-        run.close()
+        try:
+            _release(actuator, env, quiet=failed)
+        finally:
+            run.close()
+
+
+def _release(*things: Any, quiet: bool) -> None:
+    """Close the head and the camera (each, even when one fails). After an error (``quiet``)
+    their errors are dropped: a lost port cannot centre the head, and the first error is
+    the one to report."""
+    from relrl.errors import UserError
+
+    first: UserError | None = None
+    for thing in things:
+        if thing is None:
+            continue
+        try:
+            thing.close()
+        except UserError as exc:
+            first = first or exc
+    if first is not None and not quiet:
+        raise first
 
 
 def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
@@ -296,7 +343,7 @@ def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
     if opts.head is not None:
         from head import open_head
 
-        actuator = HeadActuator(open_head(opts.head, opts.protocol))
+        actuator = HeadActuator(open_head(opts.head, opts.protocol, opts.calibration))
     if opts.camera is not None:
         from perception import open_camera
 
@@ -306,7 +353,20 @@ def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
     return EpisodeWorld(episode), actuator
 
 
-def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
+def _signal_name(stop: StopRequest) -> str | None:
+    if not stop():
+        return None
+    return signal.Signals(stop.signum).name if stop.signum else "stop request"
+
+
+def _flag_cut_short(point: dict[str, Any], runs_key: str, planned: int) -> None:
+    """Mark an evaluation point that a stop request cut short (kept, never silently)."""
+    done = len(point[runs_key])
+    point["runs"] = {"done": done, "planned": planned}
+    point["interrupted"] = done < planned
+
+
+def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, Any]:
     from relrl.experiments import fruits
 
     m = run.metrics
@@ -317,6 +377,7 @@ def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
         "episode": ep.name, "script": str(ep.path), "seed": ep.seed,
         "learner": {"name": ep.learner, "params": run.learner.params},
         "steps": run.t, "planned_steps": ep.steps, "stopped_early": stopped,
+        "partial": stopped or run.t < ep.steps, "stopped_by": why,
         "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
         "eye_contacts": e.established, "opportunities": e.opportunities,
         "mutual_gaze_events": m.mutual_gaze_events,
@@ -324,27 +385,64 @@ def _summary(run: _Run, *, stopped: bool) -> dict[str, Any]:
                     "mean": float(np.mean(run.rewards)) if run.rewards else 0.0},
         "phases": run.phase_stats,
         "naming": {"outcomes": run.naming.counts(), "presentations": len(run.naming.outcomes)},
-        "memory": run.learner.size(),
+        "memory": _memory(run),
     }
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
+        complete = [x for x in run.executions if not x.get("interrupted")]
         summary["table1"] = {"executions": run.executions,
-                             "rates": fruits.rates(run.executions),
+                             "rates": fruits.rates(complete) if complete else {},
                              "paper": fruits.PAPER["table1"]}
     return summary
 
 
+def _memory(run: _Run) -> dict[str, Any]:
+    from relrl.errors import RelrlError
+
+    try:
+        return run.learner.size()
+    except RelrlError as exc:  # the knowledge base failed: the summary is still written
+        return {"error": str(exc)}
+
+
+def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
+    """Write the summary and the policy learned so far, marked partial, after ``exc`` ended
+    the run early; ``exc.kept`` then says what was written (the command line adds it to
+    its one-line message). Never raises: the original error is what the user must see."""
+    ep = run.episode
+    run.t = min(run.t, run.done)  # the time unit in progress did not finish
+    try:
+        summary = _summary(run, stopped=True, why=type(exc).__name__)
+        summary["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        _write_outputs(run, out, summary, {"seconds": time.perf_counter() - t0,
+                                           "learning_steps": run.t})
+    except Exception as inner:  # whatever it is, the first error is the one that goes on
+        exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore[attr-defined]
+        return
+    policy = f" and {summary['policy']}" if "policy" in summary else ""
+    exc.kept = (f"learned up to time unit {run.t} of {ep.steps}: summary.json"  # type: ignore
+                f"{policy} written to {out} (partial)")
+
+
 def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
                    timing: dict[str, Any]) -> None:
+    from relrl.errors import RelrlError
     from relrl.experiments.report import write_json_atomic
 
     ep = run.episode
     if ep.policy_save:
         path = out / ep.policy_save
-        run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
-                               f"seed {ep.seed}, {run.t} time units")
-        summary["policy"] = path.name
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            if not path.resolve().is_relative_to(out.resolve()):
+                raise OSError(f"{ep.policy_save} leads outside {out}")
+            run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
+                                   f"seed {ep.seed}, {run.t} time units"
+                                   + (" (partial)" if summary.get("partial") else ""))
+            summary["policy"] = ep.policy_save
+        except (RelrlError, OSError) as exc:  # the summary is written all the same
+            summary["policy_error"] = f"{ep.policy_save}: {exc}"
     write_json_atomic(out / "summary.json", summary)
     write_json_atomic(out / "timing.json", timing)
     if run.opts.plots:

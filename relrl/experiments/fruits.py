@@ -92,7 +92,10 @@ def _zero_nan(x: float) -> float:
 
 def evaluate_cgi(agent: Any, episode: Any, seeds: list[int],
                  stop: Callable[[], bool] = lambda: False) -> dict[str, Any]:
-    """Evaluate gaze following: one greedy run without learning per seed; CGI per run."""
+    """Evaluate gaze following: one greedy run without learning per seed; CGI per run.
+
+    A stop request ends the evaluation at once; only the runs that finished are counted
+    (fewer ``cgi_runs`` than seeds tell the caller the point was cut short)."""
     from relrl.episodes.world import EpisodeWorld
     from relrl.loop import Interaction
     from relrl.sim.metrics import GazeMetrics
@@ -110,8 +113,11 @@ def evaluate_cgi(agent: Any, episode: Any, seeds: list[int],
             if stop():
                 break
             run.run(1, learning=False, keep=False)
-        values.append(_zero_nan(metrics.cgi().value))
-        contacts.append(metrics.eye_contacts().established)
+        else:
+            values.append(_zero_nan(metrics.cgi().value))
+            contacts.append(metrics.eye_contacts().established)
+            continue
+        break  # a run cut short by a stop request is not counted
     agent.end_episode()
     return {"cgi_mean": float(np.mean(values)) if values else 0.0,
             "cgi_std": float(np.std(values)) if values else 0.0,

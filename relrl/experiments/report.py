@@ -8,9 +8,6 @@ version; it is byte-identical for the same configuration and seeds. Wall-clock f
 from __future__ import annotations
 
 import csv
-import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -21,13 +18,11 @@ __all__ = ["aggregate", "pyplot_or_note", "skip_plots", "summary_table", "write_
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
-    """Write JSON to ``path`` through a temporary file and a rename."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(data, fh, indent=1, sort_keys=True)
-        fh.write("\n")
-    os.chmod(tmp, 0o644)  # mkstemp makes it private; results are for sharing
-    os.replace(tmp, path)
+    """Write JSON to ``path`` through a temporary file and a rename (mode 0644; see
+    :func:`relrl.outdir.write_json_atomic`)."""
+    from relrl.outdir import write_json_atomic as write
+
+    write(path, data)
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:

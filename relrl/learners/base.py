@@ -9,6 +9,7 @@ state, necessity, reward and allowed responses from that same call and chooses i
 from __future__ import annotations
 
 import abc
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -94,6 +95,9 @@ class Learner(abc.ABC):
             except (TypeError, ValueError):
                 raise ConfigError(f"parameter {key} of learner {self.name!r} must be a number, "
                                   f"not {value!r}") from None
+            if not math.isfinite(self.params[key]):
+                raise ConfigError(f"parameter {key} of learner {self.name!r} must be a finite "
+                                  f"number, not {value!r}")
         self._check_params()
         self.engine: Engine | None = None
         self.rng = np.random.default_rng(0)

@@ -2,8 +2,7 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
+import io
 from pathlib import Path
 from typing import Any
 
@@ -12,6 +11,7 @@ import numpy as np
 from relrl.engine import Engine
 from relrl.errors import PolicyError
 from relrl.learners.base import Learner, StepOut, register
+from relrl.outdir import write_atomic
 from relrl.terms import Term, format_term
 
 __all__ = ["QLearner"]
@@ -119,15 +119,12 @@ class QLearner(Learner):
         path = Path(path)
         keys = sorted(self._rows, key=self._rows.get)  # type: ignore[arg-type]
         rows = [self._rows[k] for k in keys]
-        fd, tmp = tempfile.mkstemp(dir=path.parent or ".", suffix=".npz.tmp")
-        os.close(fd)
-        with open(tmp, "wb") as fh:
-            np.savez(fh, q=self._q[rows], codes=np.array([str(k[0]) for k in keys]),
-                     necessities=np.array([k[1] for k in keys]),
-                     responses=np.array([format_term(r) for r in self.responses]),
-                     header=np.array(header or "relrl policy: qlearning"))
-        os.replace(tmp, path)
-        return path
+        buf = io.BytesIO()
+        np.savez(buf, q=self._q[rows], codes=np.array([str(k[0]) for k in keys]),
+                 necessities=np.array([k[1] for k in keys]),
+                 responses=np.array([format_term(r) for r in self.responses]),
+                 header=np.array(header or "relrl policy: qlearning"))
+        return write_atomic(path, buf.getvalue())  # temp file + rename, mode 0644
 
     def load(self, path: str | Path) -> None:
         """Load a table saved by :meth:`save` (its responses must match the domain's)."""

@@ -106,3 +106,100 @@ def test_cli_check(tmp_path: Path, capsys) -> None:
     good.write_text(GOOD)
     assert main(["run", str(good), "--check"]) == 0
     assert "9 time units" in capsys.readouterr().out
+
+
+def test_every_problem_is_reported_with_its_line() -> None:
+    text = (GOOD.replace("seed = 3", "seed = -1\nsed = 4")
+            .replace('look = "left"', 'look = "lfet"')
+            .replace("steps = 5", "steps = 0")
+            + '\n[[event]]\nt = 2\nsay = "Hello there!"\nremove = "middle"\n')
+    with pytest.raises(EpisodeError) as err:
+        parse_episode(text, "bad.toml")
+    lines = str(err.value).splitlines()
+    assert lines[-1] == "7 problems in bad.toml", lines
+    expected = [("bad.toml:3:", "seed must be an integer >= 0, not -1"),
+                ("bad.toml:4:", "unknown key 'sed'"),
+                ("bad.toml:11:", "steps must be at least 1, not 0"),
+                ("bad.toml:21:", "did you mean 'left'"),
+                ("bad.toml:26:", "say: 'Hello' is not a lower-case word"),
+                ("bad.toml:26:", "say: 'there!' is not a lower-case word"),
+                ("bad.toml:27:", "unknown place 'middle'")]
+    for line, (where, words) in zip(lines, expected, strict=False):
+        assert line.startswith(where) and words in line, (line, where, words)
+    assert len(err.value.problems) == 7
+
+
+def test_a_bad_phase_length_does_not_flag_every_event() -> None:
+    with pytest.raises(EpisodeError) as err:
+        parse_episode(GOOD.replace("steps = 4", "steps = -4"), "bad.toml")
+    assert err.value.problems == ["bad.toml:14: steps must be at least 1, not -4"]
+
+
+def test_many_problems_are_listed_up_to_a_limit() -> None:
+    from relrl.episodes.script import MAX_LISTED
+
+    events = "".join(f'[[event]]\nt = {t}\nlook = "nowhere"\n' for t in range(1, 31))
+    with pytest.raises(EpisodeError) as err:
+        parse_episode(GOOD.replace("steps = 4", "steps = 40") + events, "bad.toml")
+    lines = str(err.value).splitlines()
+    assert len(err.value.problems) == 30
+    assert len(lines) == MAX_LISTED + 2 and lines[-2] == f"... and {30 - MAX_LISTED} more"
+
+
+@pytest.mark.parametrize("value, words", [
+    ('"../../x.pl"', "without '..'"), ('"/tmp/x.pl"', "without '..'"),
+    ('"policies/"', "without '..'"), ('"summary.json"', "file of the run itself"),
+    ('"trace.jsonl"', "file of the run itself")])
+def test_policy_save_stays_inside_the_output_folder(value: str, words: str) -> None:
+    with pytest.raises(EpisodeError, match=words) as err:
+        parse_episode(GOOD.replace("seed = 3", f"seed = 3\npolicy_save = {value}"), "e.toml")
+    assert str(err.value).startswith("e.toml:4: policy_save")
+
+
+def test_policy_save_may_name_a_subfolder() -> None:
+    ep = parse_episode(GOOD.replace("seed = 3", 'seed = 3\npolicy_save = "p/q/policy.pl"'))
+    assert ep.policy_save == "p/q/policy.pl"
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ("seed = 3", "seed = 3\n[learner]\nalpha = nan", "must be a finite number, not nan"),
+    ("seed = 3", "seed = 3\n[learner]\nq_init = inf", "must be a finite number, not inf"),
+    ('perception = "symbolic"', 'perception = "symbolic"\nlighting = nan', "lighting"),
+])
+def test_numbers_must_be_finite(old: str, new: str, words: str) -> None:
+    with pytest.raises(EpisodeError, match=words):
+        parse_episode(GOOD.replace(old, new), "e.toml")
+
+
+def test_a_script_that_is_not_utf8_names_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.toml"
+    path.write_bytes('[episode]\n\nname = "caf\xe9"\n'.encode("latin-1"))
+    with pytest.raises(EpisodeError, match=r"latin1.toml:3: not UTF-8 text \(byte 0xe9\)"):
+        load_episode(path)
+
+
+def test_checking_is_linear_in_the_events() -> None:
+    """The key lines are found through an index: examined lines grow with the script, not
+    with its square (the old search scanned from the top for every event)."""
+    from relrl.episodes import script
+
+    seen = []
+    real = script._Lines.__init__
+
+    def spy(self, text):
+        real(self, text)
+        seen.append(self)
+
+    body = GOOD.replace("steps = 4", "steps = 5000")
+    events = "".join(f'[[event]]\nt = {t}\nlook = "left"\nsay = "apple"\n'
+                     for t in range(1, 5001))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(script._Lines, "__init__", spy)
+        ep = parse_episode(body + events, "many.toml")
+    assert len(ep.events) == 5001 and ep.events[-1].line == 1 + body.count("\n") + 4 * 4999
+    assert seen[0].scanned <= 2 * len(seen[0].lines)
+
+
+def test_evaluation_runs_are_bounded() -> None:
+    with pytest.raises(EpisodeError, match="runs must be from 1 to 10000, not 1000000000"):
+        parse_episode(GOOD + "[evaluation]\nruns = 1000000000\n", "e.toml")

@@ -1,0 +1,190 @@
+"""The bad-input corpus of issue 14, every subcommand: one line naming the value, exit 2.
+
+Each case is ``relrl ARGV`` run in this process (an escaping exception fails the test with its
+traceback) and the words the one line must contain. ``{d}`` is the corpus folder
+(``conftest.corpus``), ``{fruits}`` the fruits domain. Outputs that must *not* be written are
+checked in ``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
+"""
+
+from __future__ import annotations
+
+import io
+import sys
+
+import pytest
+
+from relrl.cli import main
+from tests.cli.conftest import FRUITS, one_line_exit_2
+
+#: a tiny Experiment 1 (seconds, one process), for cases that must fail before running it.
+EXP = ["experiment", "sis", "--learners", "etg", "--points", "1", "--eval-runs", "1",
+       "--eval-steps", "10", "--block", "10", "--workers", "1"]
+BENCH = ["bench", "--steps", "100", "--no-perception", "--no-faces"]
+SMALL = "synthetic://?size=64x48"
+
+CASES: list[tuple[str, list[str], list[str]]] = [
+    # ---- shell -----------------------------------------------------------------------------
+    ("shell-missing-domain", ["shell", "{d}/nope.pl"], ["nope.pl"]),
+    ("shell-missing-policy", ["shell", "{fruits}", "--policy", "{d}/nope.pl"], ["nope.pl"]),
+    ("shell-unknown-learner", ["shell", "{fruits}", "--learner", "nope"], ["nope"]),
+    # ---- bench -----------------------------------------------------------------------------
+    ("bench-steps", BENCH[:1] + ["--steps", "-1"], ["--steps", "-1"]),
+    ("bench-json-dir", BENCH + ["--json", "{d}/adir"], ["adir", "folder"]),
+    ("bench-json-proc", BENCH + ["--json", "/proc/relrl-bench.json"], ["/proc"]),
+    ("bench-json-file-as-dir", BENCH + ["--json", "{d}/afile/b.json"], ["afile"]),
+    # ---- experiment ------------------------------------------------------------------------
+    ("experiment-out-file", EXP + ["--out", "{d}/afile"], ["afile", "not a folder"]),
+    ("experiment-out-dev-null", EXP + ["--out", "/dev/null"], ["/dev/null", "not a folder"]),
+    ("experiment-out-proc", EXP + ["--out", "/proc/foo"], ["/proc/foo"]),
+    ("experiment-out-under-file", EXP + ["--out", "{d}/afile/x"], ["afile"]),
+    ("experiment-negative-seed", EXP + ["--seeds", "0,-1"], ["--seeds", "-1"]),
+    ("experiment-bad-seed", EXP + ["--seeds", "one"], ["--seeds", "one"]),
+    ("experiment-points", EXP + ["--points", "0"], ["--points", "0"]),
+    ("experiment-workers", EXP + ["--workers", "0"], ["--workers", "0"]),
+    ("experiment-unknown-learner", EXP + ["--learners", "nope"], ["nope"]),
+    ("experiment-nan-param", EXP + ["--param", "etg.q_init=nan"], ["q_init", "nan"]),
+    ("experiment-inf-param", EXP + ["--param", "etg.alpha=inf"], ["alpha", "inf"]),
+    # ---- run -------------------------------------------------------------------------------
+    ("run-missing", ["run", "{d}/nope.toml"], ["nope.toml"]),
+    ("run-directory", ["run", "{d}/adir"], ["adir"]),
+    ("run-random-bytes", ["run", "{d}/random.toml"], ["random.toml"]),
+    ("run-latin1", ["run", "{d}/latin1.toml"], ["latin1.toml", "UTF-8"]),
+    ("run-negative-seed-flag", ["run", "{d}/ok.toml", "--seed", "-5"], ["--seed", "-5"]),
+    ("run-negative-seed-script", ["run", "{d}/negative_seed.toml"],
+     ["negative_seed.toml:3", "seed", "-1"]),
+    ("run-step-seconds-nan", ["run", "{d}/ok.toml", "--step-seconds", "nan"],
+     ["--step-seconds", "nan"]),
+    ("run-step-seconds-inf", ["run", "{d}/ok.toml", "--step-seconds", "inf"],
+     ["--step-seconds", "inf"]),
+    ("run-step-seconds-negative", ["run", "{d}/ok.toml", "--step-seconds", "-1"],
+     ["--step-seconds", "-1"]),
+    ("run-out-file", ["run", "{d}/ok.toml", "--out", "{d}/afile"], ["afile", "not a folder"]),
+    ("run-out-dev-null", ["run", "{d}/ok.toml", "--out", "/dev/null"], ["/dev/null"]),
+    ("run-out-proc", ["run", "{d}/ok.toml", "--out", "/proc/foo"], ["/proc/foo"]),
+    ("run-policy-traversal", ["run", "{d}/traversal.toml", "--out", "{d}/out-trav"],
+     ["traversal.toml:4", "policy_save", "../../escaped-policy.pl"]),
+    ("run-policy-absolute", ["run", "{d}/absolute.toml", "--out", "{d}/out-abs"],
+     ["absolute.toml:4", "policy_save", "abs-policy.pl"]),
+    ("run-policy-reserved", ["run", "{d}/reserved.toml", "--out", "{d}/out-res"],
+     ["reserved.toml:4", "summary.json"]),
+    ("run-policy-folder", ["run", "{d}/dir_policy.toml", "--out", "{d}/out-dirp"],
+     ["dir_policy.toml:4", "policies/"]),
+    ("run-protocol-without-head", ["run", "{d}/ok.toml", "--protocol", "ssc32"],
+     ["--protocol"]),
+    ("run-missing-head", ["run", "{d}/ok.toml", "--head", "/dev/ttyNOPE0", "--protocol",
+                          "ssc32"], ["/dev/ttyNOPE0"]),
+    ("run-missing-camera", ["run", "{d}/ok.toml", "--camera", "{d}/no-frames/"],
+     ["no-frames"]),
+    ("run-huge-synthetic-camera", ["run", "{d}/ok.toml", "--camera",
+                                   "synthetic://?size=100000x100000"], ["100000"]),
+    ("run-missing-calibration", ["run", "{d}/ok.toml", "--head", "sim", "--calibration",
+                                 "{d}/nope.toml"], ["nope.toml"]),
+    # ---- perceive --------------------------------------------------------------------------
+    ("perceive-missing", ["perceive", "{d}/nope.png"], ["nope.png"]),
+    ("perceive-directory", ["perceive", "{d}/adir"], ["adir"]),
+    ("perceive-random-bytes", ["perceive", "{d}/random.bin"], ["random.bin"]),
+    ("perceive-text-as-png", ["perceive", "{d}/text.png"], ["text.png"]),
+    ("perceive-truncated-png", ["perceive", "{d}/truncated.png"], ["truncated.png"]),
+    ("perceive-header-100000x100000", ["perceive", "{d}/huge.png"],
+     ["huge.png", "100000x100000"]),
+    ("perceive-1x10000", ["perceive", "{d}/tall.png"], ["tall.png", "1x10000"]),
+    ("perceive-jpeg-60000x60000", ["perceive", "{d}/huge.jpg"], ["huge.jpg", "60000x60000"]),
+    ("perceive-annotate-weird", ["perceive", "--camera", SMALL, "--annotate", "{d}/x.weird"],
+     ["x.weird"]),
+    ("perceive-annotate-dir", ["perceive", "--camera", SMALL, "--annotate", "{d}/adir"],
+     ["adir"]),
+    ("perceive-frames", ["perceive", "--camera", SMALL, "--frames", "0"], ["--frames", "0"]),
+    ("perceive-looking-at", ["perceive", "--camera", SMALL, "--looking-at", "up"], ["up"]),
+    ("perceive-both", ["perceive", "{d}/tall.png", "--camera", SMALL], ["IMAGE", "--camera"]),
+    ("perceive-missing-folder", ["perceive", "--camera", "dir://{d}/no-frames"],
+     ["no-frames"]),
+    ("perceive-synthetic-huge", ["perceive", "--camera", "synthetic://?size=100000x100000"],
+     ["100000"]),
+    ("perceive-synthetic-empty", ["perceive", "--camera", "synthetic://?size=0x0"], ["0x0"]),
+    ("perceive-synthetic-nan", ["perceive", "--camera", "synthetic://?lighting=nan"],
+     ["lighting", "nan"]),
+    ("perceive-synthetic-place", ["perceive", "--camera", "synthetic://?looking_at=up"],
+     ["up"]),
+    # ---- head ------------------------------------------------------------------------------
+    ("head-missing-port", ["head", "--port", "/dev/ttyNOPE0", "--protocol", "ssc32", "look",
+                           "left"], ["/dev/ttyNOPE0"]),
+    ("head-binary-calibration", ["head", "--calibration", "{d}/calibration.bin", "status"],
+     ["calibration.bin"]),
+    ("head-latin1-calibration", ["head", "--calibration", "{d}/latin1.toml", "status"],
+     ["latin1.toml"]),
+    ("head-calibration-dir", ["head", "--calibration", "{d}/adir", "status"], ["adir"]),
+    ("head-timeout-nan", ["head", "--port", "/dev/ttyNOPE0", "--protocol", "ssc32",
+                          "--timeout", "nan", "status"], ["--timeout", "nan"]),
+    ("head-timeout-negative", ["head", "--port", "/dev/ttyNOPE0", "--protocol", "ssc32",
+                               "--timeout", "-1", "status"], ["--timeout", "-1"]),
+    ("head-unknown-direction", ["head", "look", "up"], ["up"]),
+    ("head-unknown-response", ["head", "emit", "look("], ["look("]),
+    ("head-calibrate-dir", ["head", "calibrate", "-o", "{d}/adir"], ["adir"]),
+    ("head-calibrate-proc", ["head", "calibrate", "-o", "/proc/head.toml"], ["/proc"]),
+    # ---- demo ------------------------------------------------------------------------------
+    ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
+    ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
+    ("demo-out-proc", ["demo", "--out", "/proc/foo"], ["/proc/foo"]),
+    ("demo-workers", ["demo", "--workers", "0"], ["--workers", "0"]),
+]
+
+
+@pytest.mark.parametrize("argv, needles", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, needles):
+    monkeypatch.setattr(sys, "stdin", io.StringIO(""))  # nothing typed, nothing jogged
+    argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
+    needles = [n.format(d=corpus) for n in needles]
+    one_line_exit_2(capsys, argv, *needles)
+
+
+def test_every_subcommand_is_in_the_corpus():
+    from relrl.cli import SUBCOMMANDS
+
+    # check has its own format (one line per problem, then a count): tested below
+    assert {c[1][0] for c in CASES} | {"check"} == set(SUBCOMMANDS)
+
+
+@pytest.mark.parametrize("name, words", [
+    ("nope.pl", "no such file"), ("adir", ""), ("random.bin", ""), ("latin1.pl", ""),
+    ("afile", ""), ("/dev/null", "")])
+def test_check_a_file_that_is_no_domain(capsys, corpus, name, words):
+    """``relrl check`` lists every problem, one line each naming the file, then a count."""
+    code = main(["check", str(corpus / name)])
+    err = capsys.readouterr().err
+    assert code == 2 and "Traceback" not in err
+    lines = err.splitlines()
+    assert lines[-1].endswith(("problem", "problems")) and len(lines) >= 2
+    assert all(line.startswith(str(corpus / name)) for line in lines[:-1]), lines
+    assert words in lines[0]
+
+
+def test_an_episode_file_reports_all_its_errors(capsys, corpus):
+    assert main(["run", str(corpus / "empty.toml")]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == f'{corpus}/empty.toml:1: [episode] needs domain = "path/to/domain.pl"'
+    assert err[1] == (f"{corpus}/empty.toml:1: the script needs at least one [[phase]] "
+                      "with steps = N")
+    assert err[2] == f"relrl run: 2 problems in {corpus}/empty.toml" and len(err) == 3
+
+
+def test_bytes_typed_under_live_that_are_not_utf8_are_skipped(capsys, monkeypatch, corpus):
+    typed = io.TextIOWrapper(io.BytesIO(b"\xff\xfe\n apple caf\xc3 Lemon!\n"), encoding="utf-8")
+    monkeypatch.setattr(sys, "stdin", typed)
+    assert main(["run", str(corpus / "ok.toml"), "--live", "--step-seconds", "0.05"]) == 0
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err and "hear(apple)" in captured.out
+    assert "ignored '\ufffd\ufffd'" in captured.err and "ignored 'lemon!'" in captured.err
+
+
+def test_bytes_piped_into_the_shell_that_are_not_utf8(capsys, monkeypatch):
+    piped = io.TextIOWrapper(io.BytesIO(b"response(R).\n\xff\xfe.\n"), encoding="utf-8")
+    monkeypatch.setattr(sys, "stdin", piped)
+    assert main(["shell", str(FRUITS)]) == 2  # the second query is an error, said in a line
+    captured = capsys.readouterr()
+    assert "Traceback" not in captured.err + captured.out and "R = look(centre)" in captured.out
+
+
+def test_an_image_path_that_is_a_device(capsys, tmp_path):
+    (tmp_path / "zero.png").symlink_to("/dev/zero")
+    one_line_exit_2(capsys, ["perceive", str(tmp_path / "zero.png")], "zero.png",
+                    "not a regular file")
