@@ -18,7 +18,7 @@ from relrl.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SIS = ROOT / "examples" / "domains" / "sis.pl"
-LONG = ["--seeds", "0", "--learners", "qlearning,etg", "--points", "500", "--eval-runs", "2",
+LONG = ["--seeds", "0", "--learners", "qlearning,etg", "--points", "100000", "--eval-runs", "2",
         "--eval-steps", "100", "--block", "200", "--workers", "2"]
 
 
@@ -66,7 +66,7 @@ def test_a_signal_stops_the_run_and_its_workers_within_2_s_keeping_points(sig, t
     results = json.loads((out / "results.json").read_text())
     assert results["partial"] is True and results["interrupted_by"] == sig.name
     points = [len(j["curve"]) for j in results["jobs"]]
-    assert points and min(points) >= 1 and max(points) < 501
+    assert points and min(points) >= 1 and max(points) < 100001
     assert all(j.get("partial") for j in results["jobs"])
     assert (out / "fig5_cgi.csv").exists() and b"partial" in stdout
 
