@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from relrl.experiments.report import aggregate, write_outputs
-from relrl.experiments.runner import run_jobs
+from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.sis import PAPER, SISConfig, job_from_curve, run_job
 
 __all__ = ["run_sis"]
@@ -23,7 +23,8 @@ def run_sis(config: SISConfig, out_dir: str | Path, *, workers: int = 1,
     """Run every (learner, seed) job of Experiment 1 and write the outputs to ``out_dir``.
 
     Stopped by Ctrl-C or SIGTERM, it writes what finished: every evaluation point that all
-    parts of a job completed, with ``"partial": true`` in results.json.
+    parts of a job completed, with ``"partial": true`` in results.json. A job that fails
+    stops the run the same way, and then :class:`~relrl.errors.UserError` names the failure.
     """
     from relrl import __version__
 
@@ -74,5 +75,9 @@ def run_sis(config: SISConfig, out_dir: str | Path, *, workers: int = 1,
     }
     if outcome.interrupted:
         results["interrupted_by"] = outcome.interrupted
+    if outcome.error:
+        results["error"] = outcome.error
     files = write_outputs(out, results, timing)
+    if outcome.error:
+        raise_kept(outcome.error, out)
     return results, files

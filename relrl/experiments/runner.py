@@ -16,10 +16,11 @@ the caller writes them (marked partial). Workers ignore SIGINT (Ctrl-C in a term
 the whole process group; the parent alone decides) and die with the parent (Linux
 ``PR_SET_PDEATHSIG``), so no worker outlives the run.
 
-Failures. A job that raises a relrl error (a bad domain file, a runaway rule) stops the run
-with that error's one line; a worker that dies (a domain calling ``halt/0``, a crash in
-Prolog) stops it with :class:`WorkerLost`. Anything else is a bug and keeps its traceback
-(:class:`JobCrashed`).
+Failures. A job that raises a relrl error (a bad domain file, a runaway rule) stops the run;
+so does a worker that dies (a domain calling ``halt/0``, a crash in Prolog: :class:`WorkerLost`).
+The jobs finished so far are kept: the :class:`Outcome` carries the error's one line in
+``error`` and the caller writes what finished (marked partial) before reporting it. Anything
+else is a bug and keeps its traceback (:class:`JobCrashed`).
 """
 
 from __future__ import annotations
@@ -36,7 +37,8 @@ from typing import Any
 
 from relrl.errors import ConfigError, UserError
 
-__all__ = ["ENGINES", "JobCrashed", "Outcome", "ProgressBar", "WorkerLost", "run_jobs"]
+__all__ = ["ENGINES", "JobCrashed", "Outcome", "ProgressBar", "WorkerLost", "raise_kept",
+           "run_jobs"]
 
 #: a job function: ``fn(*args, report=callable) -> dict``.
 JobFn = Callable[..., dict[str, Any]]
@@ -58,12 +60,14 @@ class Outcome:
         results: per job (in input order) its result, or ``None`` if it did not finish.
         events: per job the events it reported, in order (finished jobs included).
         interrupted: the run was stopped by a signal (the name, e.g. ``SIGINT``), or None.
+        error: the one line of the relrl error that stopped the run, or None.
         seconds: wall-clock time of the run.
     """
 
     results: list[dict[str, Any] | None]
     events: list[list[dict[str, Any]]]
     interrupted: str | None = None
+    error: str | None = None
     seconds: float = 0.0
     info: dict[str, Any] = field(default_factory=dict)
 
@@ -101,6 +105,16 @@ class ProgressBar:
         if self.active:
             self.stream.write("\n")
             self.stream.flush()
+
+
+def raise_kept(error: str, out: Any) -> None:
+    """Raise the one line of a job's failure, saying where the finished jobs were kept."""
+    raise UserError(f"{error} (the run stopped; what finished is in {out}/results.json, "
+                    "marked partial)")
+
+
+class _JobFailed(UserError):
+    """A job's relrl error (or a lost worker), raised inside an engine to stop the run."""
 
 
 class _Stop(Exception):
@@ -155,10 +169,12 @@ def run_jobs(fn: JobFn, arglist: list[tuple], *, workers: int = 1, engine: str =
         on_event: called in this process with ``(job index, event)`` as events arrive.
 
     Returns:
-        An :class:`Outcome` (``interrupted`` set when a signal stopped the run).
+        An :class:`Outcome`: ``interrupted`` set when a signal stopped the run, ``error`` when
+        a job failed with a relrl error or a worker was lost (the other jobs are stopped; the
+        finished ones are kept).
 
     Raises:
-        UserError: a job failed with a relrl error (its one line), or a worker was lost.
+        UserError: a bad engine, worker count or address (before any job runs).
         JobCrashed: a job failed with another exception (a bug; the worker's traceback).
     """
     try:
@@ -186,6 +202,8 @@ def run_jobs(fn: JobFn, arglist: list[tuple], *, workers: int = 1, engine: str =
                       label=label, stopped=stopped)
             except _Stop as stop:
                 outcome.interrupted = stop.name
+            except _JobFailed as failed:
+                outcome.error = str(failed)
             if stopped.is_set() and outcome.interrupted is None:
                 outcome.interrupted = getattr(stopped, "signal_name", "SIGINT")
     finally:
@@ -301,11 +319,11 @@ def _run_local(fn: JobFn, arglist: list[tuple], outcome: Outcome,
                     open_conns.discard(w)
                     if w in busy:
                         procs[w].join(2.0)
-                        raise WorkerLost(
+                        raise _JobFailed(str(WorkerLost(
                             f"the worker running {label(arglist[busy[w]])} ended without a "
                             f"result (exit status {procs[w].exitcode}): a domain that calls "
                             "halt/0 or crashes Prolog ends its worker; check it with relrl "
-                            "check") from None
+                            "check"))) from None
                     continue
                 kind, index = msg[0], msg[1]
                 if kind == "event":
@@ -314,7 +332,7 @@ def _run_local(fn: JobFn, arglist: list[tuple], outcome: Outcome,
                     outcome.results[index] = msg[2]
                     give(w)
                 elif kind == "error":
-                    raise UserError(msg[3])
+                    raise _JobFailed(msg[3])
                 else:
                     raise JobCrashed(f"job {label(arglist[index])} failed with {msg[2]} "
                                      f"(a bug in relrl; the worker's traceback follows)\n"

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from relrl.experiments.report import pyplot_or_note, skip_plots, write_json_atomic
-from relrl.experiments.runner import run_jobs
+from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
 
 __all__ = ["run_scaling", "scaling_table"]
@@ -29,7 +29,10 @@ def _label(args: tuple) -> str:
 def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
                 engine: str = "local", address: str | None = None
                 ) -> tuple[dict[str, Any], list[Path]]:
-    """Run every job of the scaling benchmark and write the outputs to ``out_dir``."""
+    """Run every job of the scaling benchmark and write the outputs to ``out_dir``.
+
+    Stopped by a signal or a failing job, it writes what finished (``"partial": true``);
+    a failing job then raises :class:`~relrl.errors.UserError` naming it."""
     from relrl import __version__
 
     out = Path(out_dir)
@@ -68,10 +71,15 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
                "growth": growth(summary), "jobs": jobs}
     if outcome.interrupted:
         results["interrupted_by"] = outcome.interrupted
+    if outcome.error:
+        results["error"] = outcome.error
     timing = {"wall_seconds": outcome.seconds, "workers": workers, "engine": engine,
               "python": platform.python_version(), "machine": platform.machine(),
               "jobs": timings}
-    return results, write_outputs(out, results, timing)
+    files = write_outputs(out, results, timing)
+    if outcome.error:
+        raise_kept(outcome.error, out)
+    return results, files
 
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:

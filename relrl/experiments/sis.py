@@ -170,35 +170,41 @@ def job_from_curve(learner: str, seed: int, parts: list[list[dict[str, Any]]],
                    eval_states: set[int] | None = None) -> dict[str, Any] | None:
     """One (learner, seed) job from the curves its parts computed (possibly unfinished).
 
-    A point counts when every part has finished it; the learning phase is the same in every
-    part (it never depends on the evaluation), so the learning figures come from any part,
-    and the evaluation runs are concatenated in order. ``None`` when no point is finished.
+    The learning phase is the same in every part (it never depends on the evaluation), so
+    the learning figures come from any part that reached a point, and the evaluation runs
+    are concatenated in order. A run stopped part-way keeps every evaluation run that
+    finished: a point some part did not reach is kept with the runs it has and marked
+    ``"incomplete": true``. ``None`` when no part finished a point.
     """
-    parts = sorted(parts, key=lambda c: c[0]["runs"][0] if c else 0)
-    n = min(len(c) for c in parts) if parts else 0
-    if n == 0:
+    expected = len(parts)
+    parts = sorted((c for c in parts if c), key=lambda c: c[0]["runs"][0])
+    if not parts:
         return None
-    first = parts[0]
-    for c in parts[1:]:
+    common = min(len(c) for c in parts)
+    longest = max(parts, key=len)
+    for c in parts:
         for key in ("memory", "eye_contacts", "learning"):
-            if c[n - 1][key] != first[n - 1][key]:
+            if common and c[common - 1][key] != parts[0][common - 1][key]:
                 raise RuntimeError(f"parts of {learner} seed {seed} disagree on {key}: the "
                                    "learning phase is not repeatable")
     curve = []
-    for i in range(n):
-        runs = {k: [v for c in parts for v in c[i][k]]
+    for i in range(len(longest)):
+        have = [c[i] for c in parts if len(c) > i]
+        runs = {k: [v for entry in have for v in entry[k]]
                 for k in ("cgi_runs", "cgi_literal_runs", "eye_contacts_runs")}
-        curve.append({"point": first[i]["point"], "learning_steps": first[i]["learning_steps"],
+        curve.append({"point": have[0]["point"], "learning_steps": have[0]["learning_steps"],
                       "cgi_mean": float(np.mean(runs["cgi_runs"])),
                       "cgi_std": float(np.std(runs["cgi_runs"])),
                       "cgi_literal_mean": float(np.mean(runs["cgi_literal_runs"])),
                       "cgi_literal_std": float(np.std(runs["cgi_literal_runs"])),
-                      "memory": first[i]["memory"], **runs})
-        if "place_runs" in first[i]:
+                      "memory": have[0]["memory"], **runs})
+        if len(have) < expected:
+            curve[-1]["incomplete"] = True
+        if "place_runs" in have[0]:
             curve[-1]["cgi_places"] = {
-                g: _pooled([r for c in parts for r in c[i]["place_runs"][g]])
-                for g in first[i]["place_runs"]}
-    last = first[n - 1]
+                g: _pooled([r for entry in have for r in entry["place_runs"][g]])
+                for g in have[0]["place_runs"]}
+    last = longest[-1]
     job = {"learner": learner, "seed": seed, "curve": curve,
            "eye_contacts": last["eye_contacts"],
            "mutual_gaze_events": last["learning"]["mutual_gaze_events"],

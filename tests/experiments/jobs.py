@@ -31,3 +31,9 @@ def slow(x: int, *, report) -> dict:
         time.sleep(0.05)
         report({"kind": "point", "point": point})
     return {"x": x}
+
+
+def square_or_fail(x: int, *, report) -> dict:
+    if x == 2:
+        raise ConfigError(f"x={x}: not a good value")
+    return square(x, report=report)
