@@ -139,3 +139,22 @@ def test_a_misbehaving_domain_stops_the_run_with_one_line(extra, after, message,
     assert len(err.strip().splitlines()) == 1, err
     assert "Traceback" not in err and "BrokenProcessPool" not in err
     assert re.search(message, err), err
+
+
+def test_a_job_failing_part_way_keeps_the_points_finished_before(tmp_path, capsys) -> None:
+    # the rule recurses without end from its 2,000th call on (a global flag counts calls)
+    domain = _domain(tmp_path, "trap(face) :- flag(trap_calls, N, N + 1), N > 2000, "
+                               "deeper(face).\ndeeper(X) :- deeper(X), true.\n",
+                     "fact(trap(face)).")
+    out = tmp_path / "out"
+    code = main(["experiment", "sis", "--domain", str(domain), "--learners", "qlearning",
+                 "--points", "50", "--eval-runs", "1", "--eval-steps", "100", "--block",
+                 "100", "--workers", "1", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert "ran out of stack" in err and "marked partial" in err and str(out) in err
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] is True and "ran out of stack" in results["error"]
+    curve = results["jobs"][0]["curve"]
+    assert 3 <= len(curve) < 51
+    assert json.loads((out / ".relrl-run.json").read_text())["status"] == "partial"
