@@ -11,14 +11,16 @@ STAMP  := $(VENV)/.installed
 setup: swipl $(STAMP)
 
 # Debian packages: SWI-Prolog (the knowledge layer) and espeak-ng (the robot's voice, and
-# the synthetic caregiver words the speech tests recognise). Installed only when missing.
+# the synthetic caregiver words the speech tests recognise). Installed only when missing, without
+# recommended packages (swi-prolog-nox recommends a build tool chain relrl does not need).
 swipl:
 	@missing=""; \
 	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
 	command -v espeak-ng >/dev/null 2>&1 || missing="$$missing espeak-ng"; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing$$missing from Debian's packages"; \
-	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+	    apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
 $(STAMP): pyproject.toml Makefile

@@ -18,8 +18,7 @@ from collections import defaultdict
 import gymnasium as gym
 import numpy as np
 
-import relrl  # noqa: F401  (registers relrl/SharedAttention-v0 and -v1)
-from relrl.sim import evaluate
+from relrl.sim import evaluate  # importing relrl.sim registers relrl/SharedAttention-v0, -v1
 from relrl.sim.wrappers import RelationalObservation, relational_facts
 
 

@@ -35,11 +35,13 @@ import tempfile
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from importlib.resources import files
 from pathlib import Path
 from typing import Any, NoReturn
 
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
 from head.scripts import MotorScript, normalise_response, parse_scripts
+from perception.vocabulary import PLACES
 
 __all__ = [
     "DEFAULT_CALIBRATION",
@@ -52,16 +54,18 @@ __all__ = [
     "save_calibration",
 ]
 
-#: the six directions of the paper's head; ``centre`` looks forward, at the caregiver.
-DIRECTIONS: tuple[str, ...] = ("left", "left_down", "down", "right_down", "right", "centre")
+#: the six directions of the paper's head (the shared vocabulary's places); ``centre`` looks
+#: forward, at the caregiver.
+DIRECTIONS: tuple[str, ...] = PLACES
 #: the absolute range of pulse widths any hobby servo accepts, in microseconds.
 PULSE_RANGE: tuple[int, int] = (500, 2500)
 #: the fastest a servo may be calibrated to move, in microseconds per second.
 MAX_SPEED = 20_000.0
 #: the slowest speed, microseconds per second (one unit of the Maestro's speed setting).
 MIN_SPEED = 25.0
-#: the calibration used when none is given.
-DEFAULT_CALIBRATION = Path(__file__).resolve().parent.parent / "examples/heads/wha8030.toml"
+#: the calibration used when none is given: package data of ``head`` (in the source tree
+#: ``head/calibrations`` links to ``examples/heads``).
+DEFAULT_CALIBRATION = Path(str(files("head") / "calibrations" / "wha8030.toml"))
 
 _NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 _HEAD_KEYS = frozenset({"name", "protocol", "baudrate", "tolerance_us", "scripts"})

@@ -1,12 +1,11 @@
 """Errors raised by the head package, all in one place.
 
-Each subclasses :class:`relrl.errors.UserError` (the command line prints one line and exits 2)
-and says what was wrong and how to fix it.
+The head package stands alone: it imports nothing from relrl. :class:`HeadError` is the base
+of every error here; each says what was wrong and how to fix it. relrl's command line counts
+it among the errors a user can cause (``relrl.errors.USER_ERRORS``): one line, exit status 2.
 """
 
 from __future__ import annotations
-
-from relrl.errors import ConfigError, UserError
 
 __all__ = [
     "CalibrationError",
@@ -23,15 +22,15 @@ __all__ = [
 ]
 
 
-class HeadError(UserError):
+class HeadError(Exception):
     """Base class of every error of the robotic head."""
 
 
-class CalibrationError(HeadError, ConfigError):
+class CalibrationError(HeadError, ValueError):
     """A calibration (or motor script) file does not validate; names the file and the key."""
 
 
-class UnknownProtocol(HeadError, ConfigError):
+class UnknownProtocol(HeadError, ValueError):
     """No servo-controller protocol is registered under that name."""
 
 

@@ -1,13 +1,16 @@
-"""Errors the perception package raises on purpose (all are :class:`relrl.errors.UserError`)."""
+"""Errors the perception package raises on purpose.
+
+The perception package stands alone: it imports nothing from relrl. :class:`PerceptionError`
+is the base of every error here; relrl's command line counts it among the errors a user can
+cause (``relrl.errors.USER_ERRORS``): one line, exit status 2.
+"""
 
 from __future__ import annotations
-
-from relrl.errors import UserError
 
 __all__ = ["CameraError", "ImageError", "PerceptionError"]
 
 
-class PerceptionError(UserError):
+class PerceptionError(Exception):
     """A bad perception input or parameter (the message shows the value and the fix)."""
 
 

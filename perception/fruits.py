@@ -14,11 +14,11 @@ import numpy as np
 
 from perception.art2 import OUTCOMES, ART2Params, FruitNamer, colour_features
 from perception.render import SceneView, render
+from perception.vocab import OBJECT_PLACES
 
 __all__ = ["FRUITS", "fruit_session", "table1"]
 
 FRUITS: tuple[str, ...] = ("apple", "lemon", "orange")
-_PLACES = ("left", "left_down", "down", "right_down", "right")
 
 
 def fruit_session(presentations: int = 60, seed: int = 0, light: tuple[float, float] = (0.6, 1.3),
@@ -36,7 +36,7 @@ def fruit_session(presentations: int = 60, seed: int = 0, light: tuple[float, fl
     missed = 0
     for _ in range(presentations):
         fruit = FRUITS[int(rng.integers(len(FRUITS)))]
-        place = _PLACES[int(rng.integers(len(_PLACES)))]
+        place = OBJECT_PLACES[int(rng.integers(len(OBJECT_PLACES)))]
         view = SceneView(place, None, {place: fruit}, float(rng.uniform(*light)),
                          int(rng.integers(2**31)))
         percept = perceiver.analyse(render(view, size), looking_at=place)

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from perception.errors import PerceptionError
-from perception.vocab import COLOURS, PLACES, POSES
+from perception.vocab import COLOURS, OBJECT_PLACES, PLACES, POSES
 
 __all__ = ["OBJECT_KINDS", "SceneView", "render"]
 
@@ -65,8 +65,9 @@ class SceneView:
             raise PerceptionError(f"unknown face pose {self.face_pose!r}; use one of {POSES} "
                                   "or None")
         for place, kind in self.objects.items():
-            if place not in PLACES or place == "centre":
-                raise PerceptionError(f"objects cannot be at {place!r}; use one of {PLACES[:-1]}")
+            if place not in OBJECT_PLACES:
+                raise PerceptionError(f"objects cannot be at {place!r}; use one of "
+                                      f"{OBJECT_PLACES}")
             if kind not in OBJECT_KINDS and kind not in _PALETTE:
                 raise PerceptionError(f"unknown object {kind!r}; use one of "
                                       f"{sorted(OBJECT_KINDS) + sorted(_PALETTE)}")

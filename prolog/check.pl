@@ -1,6 +1,9 @@
 :- module(relrl_check,
           [ check_domain/2,       % +KB, -Problems
-            rule_listing/2        % +KB, -Rules
+            rule_listing/2,       % +KB, -Rules
+            body_goal/2,          % +Body, -Goal
+            data_goal/2,          % +Declaration, -Goal
+            clause_location/3     % +ClauseRef, -File, -Line
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -44,7 +47,9 @@ problem(KB, P) :- bad_unit(KB, P).
 problem(KB, P) :- undeclared_reference(KB, P).
 problem(KB, P) :- empty_declaration(KB, P).
 
-%   Where a clause of KB came from.
+%!  clause_location(+Ref, -File, -Line) is det.
+%
+%   Where the clause Ref came from ('' and 0 when unknown).
 
 clause_location(Ref, File, Line) :-
     (   clause_property(Ref, file(File0))
@@ -83,11 +88,21 @@ undefined_call(KB, problem(File, Line, Msg)) :-
     functor(Head, HN, HA),
     format(string(Msg), "~q calls undefined predicate ~q", [HN/HA, PI]).
 
+%!  data_goal(+Declaration, -Goal) is semidet.
+%
+%   Goal is the goal a declaration holds as data: fact(G), unit_input(_, G, _),
+%   satisfier(_, G, _), behaviour(G, _, _, _), etg_test(G).
+
 data_goal(fact(G), G).
 data_goal(unit_input(_, G, _), G).
 data_goal(satisfier(_, G, _), G).
 data_goal(behaviour(G, _, _, _), G).
 data_goal(etg_test(G), G).
+
+%!  body_goal(+Body, -Goal) is nondet.
+%
+%   Goal is a goal of the clause body Body, through control constructs and meta-calls
+%   (not through module-qualified goals).
 
 body_goal(Var, _) :- var(Var), !, fail.
 body_goal(true, _) :- !, fail.

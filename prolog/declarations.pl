@@ -9,7 +9,8 @@
             unit_parameters/3,      % +KB, +Necessity, -Params:dict-like list
             necessity_inputs/3,     % +KB, +Necessity, -Inputs
             unit_parameter_name/1,  % ?Param
-            behaviour_rule/5        % +KB, ?Antecedent, ?Response, ?Necessity, ?Fitness
+            behaviour_rule/5,       % +KB, ?Antecedent, ?Response, ?Necessity, ?Fitness
+            declaration_predicate/1 % ?PredicateIndicator
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -35,6 +36,11 @@ A domain file declares, as plain Prolog clauses:
 This module enumerates those declarations for a knowledge base KB (the module the domain
 was loaded into; `user` when it was consulted at the swipl prompt). A declaration the domain
 does not define at all is simply absent (no existence errors).
+
+Declarations and definitions may interleave, and a domain may be spread over several files:
+before a file is loaded into a knowledge base, relrl declares the declaration predicates
+(declaration_predicate/1) discontiguous and multifile in it, so `fact(frontal(face)).` may
+sit right above `frontal(face) :- ...` and a `response/1` may come at the end of the file.
 */
 
 %!  declared(+KB, ?Declaration) is nondet.
@@ -129,3 +135,52 @@ necessity_inputs(KB, N, Inputs) :-
 
 behaviour_rule(KB, A, R, N, F) :-
     declared(KB, behaviour(A, R, N, F)).
+
+%!  declaration_predicate(?PI) is nondet.
+%
+%   PI (Name/Arity) is a predicate a domain declares with: its clauses may be spread over
+%   the file and over several files of one knowledge base.
+
+declaration_predicate(stimulus/1).
+declaration_predicate(stimulus_property/2).
+declaration_predicate(fact/1).
+declaration_predicate(response/1).
+declaration_predicate(necessity/1).
+declaration_predicate(unit/3).
+declaration_predicate(unit_input/3).
+declaration_predicate(satisfier/3).
+declaration_predicate(behaviour/4).
+declaration_predicate(forbidden/1).
+declaration_predicate(memory_span/1).
+declaration_predicate(etg_test/1).
+declaration_predicate(relation/1).
+declaration_predicate(rmode/1).
+declaration_predicate(rconst/2).
+
+%   A domain file loaded into a knowledge base (a module that imports relrl, see
+%   relrl_gateway:gw_new_kb/1) starts with the declarations relrl needs. Module files (a
+%   library autoloaded while a query runs in a knowledge base) are left alone.
+
+:- multifile user:term_expansion/2.
+:- dynamic user:term_expansion/2.
+
+user:term_expansion(begin_of_file, [begin_of_file|Directives]) :-
+    prolog_load_context(module, Module),
+    Module \== relrl,
+    import_module(Module, relrl),
+    prolog_load_context(file, File),
+    \+ module_file(File),
+    findall((:- Declaration),
+            (   declaration_predicate(PI),
+                member(Declaration, [discontiguous(Module:PI), multifile(Module:PI)])
+            ),
+            Directives).
+
+module_file(File) :-
+    access_file(File, read),
+    exists_file(File),
+    setup_call_cleanup(
+        open(File, read, Stream),
+        read_term(Stream, First, [syntax_errors(quiet)]),
+        close(Stream)),
+    First = (:- module(_, _)).

@@ -150,6 +150,8 @@ python_api(relrl_responses:allowed_responses/2).
 python_api(relrl_declarations:necessity_inputs/3).
 python_api(relrl_check:check_domain/2).
 python_api(relrl_check:rule_listing/2).
+python_api(relrl_percepts:world_problems/3).
+python_api(relrl_percepts:unread_percepts/3).
 python_api(relrl_gateway:gw_new_kb/1).
 python_api(relrl_gateway:gw_drop_kb/1).
 python_api(relrl_gateway:gw_load/4).
@@ -341,8 +343,9 @@ gw_load(File, Module, Limit, Problems) :-
         ),
         findall(P, retract(collected(Key, P)), Problems0),
         exclude(cancelled_halt_warning(Result), Problems0, Problems)
-    ;   format(string(Msg), "no such file", []),
-        Problems = [problem(error, File, 0, Msg)]
+    ;   exists_directory(File)
+    ->  Problems = [problem(error, File, 0, "a directory, not a Prolog file")]
+    ;   Problems = [problem(error, File, 0, "no such file")]
     ).
 
 %   The directive whose halt was cancelled also "failed": one problem for it is enough.
@@ -370,7 +373,7 @@ note_exception(Key, File, Limit, E) :-
     ->  error_result(E, error(_, Msg)),
         F = File, L = 0
     ;   message_string(E, Msg),
-        (   E = error(_, file(F, L, _, _))
+        (   E = error(_, Context), nonvar(Context), Context = file(F, L, _, _)
         ->  true
         ;   F = File, L = 0
         )
@@ -388,7 +391,10 @@ user:message_hook(Term, Kind, Lines) :-
     strip_location(Msg0, Msg),
     assertz(collected(Key, problem(Kind, File, Line, Msg))).
 
-message_location(error(_, file(File, Line, _, _)), File, Line) :- !.
+message_location(error(_, Context), File, Line) :-
+    nonvar(Context),
+    Context = file(File, Line, _, _),
+    !.
 message_location(_, File, Line) :-
     source_location(File, Line), !.
 message_location(_, '', 0).
@@ -448,11 +454,35 @@ print_bindings(Named, All, Printed) :-
 
 print_binding(All, _=Value, String) :-
     format(string(String), "~W",
-           [Value, [quoted(true), portray(true), variable_names(All), max_depth(0),
+           [Value, [quoted(true), portray(true), variable_names(All), max_depth(50),
+                    cycles(true),
                     spacing(next_argument)]]).
 
 solution_triples(Named-Printed, Triples) :-
-    maplist([Name=Value, P, Name-Value-P]>>true, Named, Printed, Triples).
+    maplist(solution_triple, Named, Printed, Triples).
+
+%   A value too deep (or cyclic) for Python's side of the gateway goes as its printed text.
+solution_triple(Name=Value, Printed, Name-Value1-Printed) :-
+    (   acyclic_term(Value),
+        depth_within(Value, 300)
+    ->  Value1 = Value
+    ;   Value1 = Printed
+    ).
+
+%   Term nests at most Max compound levels (list elements count a level; the list's own
+%   spine does not, as Python reads lists as sequences).
+depth_within(Term, Max) :-
+    (   var(Term)
+    ->  true
+    ;   atomic(Term)
+    ->  true
+    ;   Max > 0,
+        Max1 is Max - 1,
+        (   is_list(Term)
+        ->  forall(member(X, Term), depth_within(X, Max1))
+        ;   forall(arg(_, Term, X), depth_within(X, Max1))
+        )
+    ).
 
 %!  gw_findall(+Module, +Template, -List) is det.
 %
@@ -469,3 +499,179 @@ gw_findall(Module, Template, List) :-
 gw_parse(Module, Text, Terms) :-
     term_string(Term, Text, [module(Module)]),
     comma_list(Term, Terms).
+
+                /*******************************
+                *  ONE ANSWER AT A TIME (shell) *
+                *******************************/
+
+%   relrl shell keeps a query open between its answers, as swipl's toplevel does: kb.py
+%   opens gw_answer/5 with PL_open_query/4 and asks for the next answer with
+%   PL_next_solution/1 only when the user types ; (both are transport, called by kb.py
+%   directly, not through gw_run/3). Each answer runs under the time limit (the clock
+%   stops between answers), output of the goal goes out as it is written, and the
+%   answer is written by Prolog's own writer after the toplevel's translation of the
+%   bindings (cycles factorized, depth limited), so no term crosses the bridge.
+
+%!  gw_answer(+Module, +Text, +TimeLimit, +Mode, -Answer) is nondet.
+%
+%   Answer is one answer of the query Text, read in Module: answer(Printed, Det) with
+%   Printed the bindings as swipl's toplevel writes them (a string, "" when there are
+%   none, without the final `.` or `;`) and Det `true` when no further answer can follow,
+%   `false` when there may be one; or error(Kind, Message) (see error_result/2) for a
+%   syntax error, an exception or a time-out, after which there are no more answers.
+%   TimeLimit (seconds, > 0) bounds the work for each answer. Mode is `print` (terms
+%   written to depth 10, the toplevel's default) or `write` (whole terms).
+
+gw_answer(Module, Text, Limit, Mode, Answer) :-
+    must_be(atom, Module),
+    (   number(Limit), Limit > 0, Limit =\= inf
+    ->  true
+    ;   domain_error(positive_time_limit, Limit)
+    ),
+    must_be(oneof([write, print]), Mode),
+    nb_setval(relrl_answer_mode, Mode),
+    nb_setval(relrl_answer_again, none),
+    catch(term_string(Goal, Text, [variable_names(Bindings), module(Module)]), E, true),
+    (   var(E)
+    ->  answers(Module:Goal, Bindings, Limit, Answer)
+    ;   error_result(E, Answer)
+    ).
+
+answers(Goal, Bindings, Limit, Answer) :-
+    watchdog(Alarm),
+    (   catch(answer(Goal, Bindings, Alarm, Limit, Answer0), E0,
+              ( pause(Alarm, _), toplevel_error(E0, E), error_result(E, Answer0) ))
+    *-> Answer = Answer0
+    ;   pause(Alarm, Halt),
+        Halt \== none,
+        halt_message(Halt, Message),
+        Answer = error(halt_called(Halt), Message)
+    ).
+
+answer(Goal, Bindings, Alarm, Limit, Answer) :-
+    resume(Alarm, Limit),
+    call_cleanup(Goal, Det = true),
+    (   var(Det)
+    ->  Det = false
+    ;   true
+    ),
+    deliver(Bindings, Det, Alarm, Limit, Answer).
+
+%   Write the answer (again, after gw_answer_again/1); on backtracking for the next
+%   answer, restart the clock and fail into the goal (the cuts stay in this clause).
+deliver(Bindings, Det, Alarm, Limit, Answer) :-
+    repeat,
+    answer_text(Bindings, Text),
+    pause(Alarm, Halt),
+    (   Halt \== none
+    ->  !,
+        halt_message(Halt, Message),
+        Answer = error(halt_called(Halt), Message)
+    ;   Answer = answer(Text, Det)
+    ;   nb_getval(relrl_answer_again, Again),
+        Again \== none
+    ->  resume(Alarm, Limit),
+        fail
+    ;   !,
+        resume(Alarm, Limit),
+        fail
+    ).
+
+%   The goal runs inside call_cleanup/2: an error's context names the query itself, as
+%   at the toplevel, not the wrapper.
+toplevel_error(error(Formal, context(Wrapper, Message)), error(Formal, context(_, Message))) :-
+    nonvar(Wrapper),
+    strip_module(Wrapper, _, setup_call_catcher_cleanup/4),
+    !.
+toplevel_error(E, E).
+
+%   The clock runs and halt/0,1 is cancelled (see halt_hook/0) while an answer is sought;
+%   between answers the clock stops and what the goal wrote is flushed.
+resume(Alarm, Limit) :-
+    nb_setval(relrl_active, true),
+    nb_setval(relrl_halt, none),
+    install_alarm(Alarm, Limit).
+
+pause(Alarm, Halt) :-
+    uninstall_alarm(Alarm),
+    flush_output(user_output),          % the goal's output comes before the answer
+    nb_setval(relrl_active, false),
+    nb_getval(relrl_halt, Halt),
+    nb_setval(relrl_halt, none).
+
+%!  gw_answer_again(+Mode) is det.
+%
+%   Called by kb.py while a gw_answer/5 query is open, before asking for its next
+%   solution: write the current answer again, in Mode `write` (whole terms, as the
+%   toplevel's w) or `print` (depth-limited, as p and the default); later answers too.
+
+gw_answer_again(Mode) :-
+    must_be(oneof([write, print]), Mode),
+    nb_setval(relrl_answer_mode, Mode),
+    nb_setval(relrl_answer_again, Mode).
+
+answer_text(Bindings0, Text) :-
+    nb_setval(relrl_answer_again, none),
+    exclude(anonymous, Bindings0, Bindings1),
+    prolog:translate_bindings(Bindings1, Bindings, [], [], _:Residuals),
+    name_variables(Bindings-Residuals),
+    answer_mode(Options),
+    (   catch(toplevel_text(Bindings, Residuals, Options, Text0), _, fail)
+    ->  true
+    ;   format(string(Text0), "~W", [Bindings-Residuals, Options])
+    ),
+    split_string(Text0, "", " \n", [Text]).
+
+answer_mode(Options) :-
+    (   nb_current(relrl_answer_mode, write)
+    ->  Options = [quoted(true), numbervars(true), spacing(next_argument),
+                   max_depth(MaxDepth)],
+        safe_write_depth(MaxDepth)
+    ;   Options = [quoted(true), portray(true), numbervars(true), max_depth(10),
+                   spacing(next_argument)]
+    ).
+
+%   Writing a term recurses in C: beyond some thousands of levels the host's C stack
+%   overflows, so even `w` writes at most this deep.
+safe_write_depth(5000).
+
+%   The toplevel's own rendering (boot/messages.pl), with Options as answer_write_options.
+toplevel_text(Bindings, Residuals, Options, Text) :-
+    (   current_prolog_flag(answer_write_options, Old)
+    ->  Restore = set_prolog_flag(answer_write_options, Old)
+    ;   Restore = true
+    ),
+    setup_call_cleanup(
+        create_prolog_flag(answer_write_options, Options, [type(term)]),
+        '$messages':translate_message(query(more(Bindings, true, Residuals)), Lines, []),
+        Restore),
+    with_output_to(string(Text), print_message_lines(current_output, '', Lines)).
+
+%   As the toplevel does: a variable that occurs once is written _, the others _A, _B, ...
+name_variables(Term) :-
+    term_singletons(Term, Singletons),
+    maplist(=('$VAR'('_')), Singletons),
+    term_variables(Term, Vars),
+    foldl(name_variable, Vars, 0, _).
+
+name_variable('$VAR'(Name), N0, N) :-
+    Letter is 0'A + N0 mod 26,
+    (   N0 < 26
+    ->  format(atom(Name), "_~c", [Letter])
+    ;   Index is N0 // 26,
+        format(atom(Name), "_~c~d", [Letter, Index])
+    ),
+    N is N0 + 1.
+
+%   relrl shell's trace. sets trace points (library(prolog_trace)) on the domain's
+%   predicates; their ports are written as swipl writes them, without the knowledge base's
+%   internal module name.
+user:message_hook(frame(Module:Goal, trace(Port, _Frame-Level)), debug, _) :-
+    atom(Module),
+    kb_module_(Module),
+    upcase_atom(Port, Upper),
+    sub_atom(Upper, 0, 1, _, First),
+    sub_atom(Port, 1, _, 0, Rest),
+    format(user_error, " T [~w] ~w~w: ~W~n",
+           [Level, First, Rest, Goal, [quoted(true), portray(true), max_depth(10),
+                                      spacing(next_argument)]]).

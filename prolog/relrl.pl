@@ -18,12 +18,14 @@
             allowed/1,            % ?Response
             allowed_responses/1   % -Responses
           ]).
+:- use_module(library(arithmetic)).   % the same arithmetic checks for every load
 :- use_module(memory).
 :- use_module(declarations).
 :- use_module(perception).
 :- use_module(state).
 :- use_module(responses).
 :- use_module(check).
+:- use_module(percepts).
 :- use_module(engine).
 :- use_module(learners).
 :- use_module(policy).

@@ -75,6 +75,9 @@ GOALS: dict[str, str] = {
     "necessity_inputs": "relrl_declarations:necessity_inputs",
     "check_domain": "relrl_check:check_domain",
     "rule_listing": "relrl_check:rule_listing",
+    # percepts against a world's vocabulary (prolog/percepts.pl)
+    "world_problems": "relrl_percepts:world_problems",
+    "unread_percepts": "relrl_percepts:unread_percepts",
     "findall": "relrl_gateway:gw_findall",
     "parse": "relrl_gateway:gw_parse",
 }

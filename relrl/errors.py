@@ -4,8 +4,11 @@ Every error a user can cause (a bad Prolog file, a bad episode script, a bad fla
 device) is a :class:`UserError`. The command line prints such an error as one line and exits
 with status 2; anything else is a bug and keeps its traceback.
 
-Other packages of the project (``perception``, ``head``) subclass these so one ``except`` in
-the command line catches them all.
+The lower layers stand alone: ``head`` and ``perception`` import nothing from relrl and have
+their own error bases (:class:`head.errors.HeadError`, :class:`perception.errors.PerceptionError`).
+:data:`USER_ERRORS` gathers the three bases, so one ``except USER_ERRORS`` (the command line's)
+catches every error a user can cause. It is looked up lazily: importing this module does not
+import ``head`` or ``perception``.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 from typing import Any
 
 __all__ = [
+    "USER_ERRORS",  # noqa: F822 (module __getattr__: imports head and perception lazily)
     "RelrlError",
     "UserError",
     "PrologError",
@@ -114,3 +118,20 @@ class ConfigError(UserError):
 class OutputError(ConfigError):
     """An output folder or file that cannot be used: a file where a folder is needed, a folder
     that cannot be created or written, a non-empty folder of another run."""
+
+
+#: built on first use by :func:`__getattr__` (the lower layers are imported only then).
+_user_errors: tuple[type[Exception], ...] | None = None
+
+
+def __getattr__(name: str) -> Any:
+    """``USER_ERRORS``: UserError, HeadError and PerceptionError, for one ``except``."""
+    global _user_errors
+    if name == "USER_ERRORS":
+        if _user_errors is None:
+            from head.errors import HeadError
+            from perception.errors import PerceptionError
+
+            _user_errors = (UserError, HeadError, PerceptionError)
+        return _user_errors
+    raise AttributeError(f"module 'relrl.errors' has no attribute {name!r}")

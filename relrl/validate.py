@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase, _display_path
-from relrl.terms import Var, format_term
+from relrl.terms import Term, Var, format_term
 
-__all__ = ["validate", "describe"]
+__all__ = ["validate", "describe", "world_warnings", "unread_percepts", "vocabulary_terms"]
 
 
 def validate(kb: KnowledgeBase) -> list[str]:
@@ -21,6 +22,47 @@ def validate(kb: KnowledgeBase) -> list[str]:
         where = f"{_display_path(path)}:{line}" if path else "domain"
         lines.append(f"{where}: {message}")
     return lines
+
+
+def vocabulary_terms(world: str) -> list[Term]:
+    """The percepts of a world (:mod:`perception.vocabulary`) as terms, a :class:`Var` for
+    any value.
+
+    Raises:
+        ConfigError: no world of that name.
+    """
+    from perception.vocabulary import ANY
+    from perception.vocabulary import world as vocabulary
+
+    try:
+        vocab = vocabulary(world)
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
+    return [tuple(Var() if a is ANY else a for a in t) for t in vocab.terms()]
+
+
+def world_warnings(kb: KnowledgeBase, world: str) -> list[str]:
+    """One line per fact of the domain that can never hold in ``world`` (its percepts lack
+    one the fact's definition needs) and per stimulus the world never perceives.
+
+    ``world`` names a vocabulary of :data:`perception.vocabulary.WORLDS` (``sis``,
+    ``episodes``, ...).
+    """
+    from relrl.engine import one
+
+    lines = []
+    for _, path, line, message in one(kb, "world_problems", kb.module,
+                                      vocabulary_terms(world)):
+        where = f"{_display_path(path)}:{line}" if path else "domain"
+        lines.append(f"{where}: warning: {message} (world {world})")
+    return lines
+
+
+def unread_percepts(kb: KnowledgeBase, percepts: list[Term]) -> list[Term]:
+    """The ``percepts`` no stimulus, fact or rule of the domain perceives."""
+    from relrl.engine import one
+
+    return one(kb, "unread_percepts", kb.module, list(percepts))
 
 
 def describe(kb: KnowledgeBase) -> str:

@@ -4,9 +4,10 @@ Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EX
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
 pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
 
-Errors a user can cause (:class:`relrl.errors.UserError`) print one line and exit 2 (an
-error that lists several problems -- a bad episode script -- prints one ``file:line: problem``
-line each, then the count).
+Errors a user can cause (:data:`relrl.errors.USER_ERRORS`: relrl's ``UserError`` and the error
+bases of the ``head`` and ``perception`` packages) print one line and exit 2 (an error that
+lists several problems -- a bad episode script -- prints one ``file:line: problem`` line
+each, then the count).
 """
 
 from __future__ import annotations
@@ -16,8 +17,6 @@ import importlib
 import shlex
 import sys
 from collections.abc import Sequence
-
-from relrl.errors import UserError
 
 __all__ = ["main", "SUBCOMMANDS"]
 
@@ -31,6 +30,7 @@ SUBCOMMANDS: dict[str, str] = {
     "perceive": "relrl.cli.perceive",
     "head": "relrl.cli.head",
     "demo": "relrl.cli.demo",
+    "examples": "relrl.cli.examples",
 }
 
 
@@ -74,9 +74,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
+    from relrl.errors import USER_ERRORS
+
     try:
         return int(args._run(args) or 0)
-    except UserError as exc:
+    except USER_ERRORS as exc:
         *problems, last = str(exc).splitlines() or [type(exc).__name__]
         for line in problems:  # several problems: "file:line: problem" each, then a count
             print(line, file=sys.stderr)

@@ -15,13 +15,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="domain file(s) to load, in order")
     parser.add_argument("-q", "--quiet", action="store_true",
                         help="print only problems, not the declarations")
+    from perception.vocabulary import WORLDS
+
+    parser.add_argument("--world", choices=list(WORLDS),
+                        help="also warn about facts that can never hold and stimuli never "
+                             "perceived with this world's percepts (" + "; ".join(
+                                 f"{name}: {v.description}" for name, v in WORLDS.items())
+                        + ")")
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the domain; exit status 0 when valid, 2 when it has problems."""
+    """Check the domain; exit status 0 when valid, 2 when it has problems (load warnings
+    and, with ``--world``, facts the world can never make hold count as problems)."""
     from relrl.errors import PrologLoadError
     from relrl.kb import KnowledgeBase
-    from relrl.validate import describe, validate
+    from relrl.validate import describe, validate, world_warnings
 
     kb = KnowledgeBase()
     problems: list[str] = []
@@ -37,6 +45,8 @@ def run(args: argparse.Namespace) -> int:
                 _print_problems(problems)
                 return 2
         problems.extend(validate(kb))
+        if args.world:
+            problems.extend(world_warnings(kb, args.world))
         if not args.quiet:
             print(describe(kb))
         if problems:

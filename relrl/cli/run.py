@@ -120,12 +120,12 @@ def run(args: argparse.Namespace) -> int:
 def _run(episode, opts, stop) -> dict:
     """Run the episode; a user's error ends with one line that says what was kept."""
     from relrl.episodes import run_episode
-    from relrl.errors import UserError
+    from relrl.errors import USER_ERRORS, UserError
 
     try:
         with stop.installed():
             return run_episode(episode, opts, stop)
-    except UserError as exc:
+    except USER_ERRORS as exc:
         kept = getattr(exc, "kept", None)
         if kept is None:
             raise

@@ -17,19 +17,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--learner", metavar="NAME",
                         help="start a fresh learner (etg, contingency, qlearning) for :step")
     parser.add_argument("--timeout", type=float, default=10.0, metavar="S",
-                        help="seconds a query may run (default 10)")
+                        help="seconds each answer may take (default 10; positive: the limit "
+                             "cannot be switched off)")
     parser.add_argument("--max", type=int, default=100, metavar="N",
-                        help="solutions printed per query (default 100)")
+                        help="answers printed per piped query (default 100; at a terminal "
+                             "you ask for each answer)")
 
 
 def run(args: argparse.Namespace) -> int:
     """Run the shell; exit status 2 if a piped query failed with an error."""
+    from relrl.errors import ConfigError
     from relrl.kb import KnowledgeBase
-    from relrl.shell import Shell
+    from relrl.shell import Shell, check_timeout
 
+    try:
+        timeout = check_timeout(args.timeout)
+    except ConfigError as exc:
+        raise ConfigError(f"--timeout: {exc}") from None
+    if args.max < 1:
+        raise ConfigError(f"--max {args.max}: use a whole number >= 1")
     kb = KnowledgeBase(*args.domain)
     try:
-        shell = Shell(kb, max_solutions=args.max, timeout=args.timeout)
+        shell = Shell(kb, max_solutions=args.max, timeout=timeout)
         from relrl import policy
 
         if args.policy:

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+from perception.vocabulary import OBJECT_PLACES, PLACES
 from relrl.errors import UserError
 
 __all__ = [
@@ -33,10 +34,6 @@ __all__ = [
     "parse_episode",
 ]
 
-#: where the head (and the caregiver) can look; ``centre`` is the other's face.
-PLACES: tuple[str, ...] = ("centre", "left", "left_down", "down", "right_down", "right")
-#: where objects can appear.
-OBJECT_PLACES: tuple[str, ...] = PLACES[1:]
 _KINDS = ("apple", "lemon", "orange", "lime", "red", "orange", "yellow", "green", "blue",
           "purple")
 _CAREGIVERS = ("protocol", "script")

@@ -322,15 +322,15 @@ def _release(*things: Any, quiet: bool) -> None:
     """Close the head and the camera (each, even when one fails). After an error (``quiet``)
     their errors are dropped: a lost port cannot centre the head, and the first error is
     the one to report."""
-    from relrl.errors import UserError
+    from relrl.errors import USER_ERRORS
 
-    first: UserError | None = None
+    first: Exception | None = None
     for thing in things:
         if thing is None:
             continue
         try:
             thing.close()
-        except UserError as exc:
+        except USER_ERRORS as exc:
             first = first or exc
     if first is not None and not quiet:
         raise first

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from perception.vocabulary import FRUIT_COLOURS, GAZE_POSE
 from relrl.episodes.script import PLACES, Episode, Event
 from relrl.interfaces import Environment
 from relrl.sim.metrics import StepRecord
@@ -28,12 +29,10 @@ from relrl.terms import Term, format_term
 
 __all__ = ["GAZE_POSE", "KIND_COLOUR", "EpisodeWorld", "ProtocolCaregiver", "Scene"]
 
-#: the head pose a caregiver shows while looking at each place (perception's vocabulary).
-GAZE_POSE: dict[str, str] = {"centre": "frontal", "left": "left_2", "left_down": "left_1",
-                             "down": "down", "right_down": "right_1", "right": "right_2"}
+# GAZE_POSE: the head pose a caregiver shows while looking at each place (the episode world's
+# vocabulary, from percepts).
 #: the colour perception reports for each object kind (symbolic mode).
-KIND_COLOUR: dict[str, str] = {"apple": "red", "orange": "orange", "lemon": "yellow",
-                               "lime": "green"}
+KIND_COLOUR: dict[str, str] = FRUIT_COLOURS
 
 
 @dataclass

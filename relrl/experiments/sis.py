@@ -23,14 +23,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from relrl.resources import example
+
 __all__ = ["SISConfig", "run_job", "job_from_curve", "DEFAULT_DOMAIN", "PAPER"]
 
-DEFAULT_DOMAIN = Path(__file__).resolve().parents[2] / "examples" / "domains" / "sis.pl"
+#: the SIS domain shipped with relrl (package data).
+DEFAULT_DOMAIN = example("domains/sis.pl")
 
 #: What the paper reports for Experiment 1 (section 5.1, Figs. 4 and 5).
 PAPER: dict[str, Any] = {

@@ -13,6 +13,7 @@ See ``docs/simulator.md`` and ``docs/benchmark.md``. Quick start::
 
 from __future__ import annotations
 
+from relrl.envs import register_envs
 from relrl.sim.caregiver import (
     EVALUATION_SEQUENCE,
     Caregiver,
@@ -39,6 +40,10 @@ from relrl.sim.places import PLACES, TOY_PLACES, Layout, layout, place_names
 from relrl.sim.reward import PAPER_REWARD, Reward
 from relrl.sim.sis import ENV_ID, ENV_ID_V1, RESPONSES, SharedAttentionEnv
 from relrl.sim.world import World
+
+# Gymnasium 1.x does not read the gymnasium.envs entry point: importing the simulator
+# registers its environments (relrl.envs).
+register_envs()
 
 __all__ = [
     "CGI",

@@ -39,6 +39,8 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 
+from perception.vocabulary import OBJECT_PLACES
+
 __all__ = [
     "ANGLE_BETWEEN",
     "CAREGIVER_PAN_TILT",
@@ -62,7 +64,8 @@ DISTANCE_CM = 50.0
 #: the most toy places a world may have.
 MAX_PLACES = 99
 
-_PAPER_NAMES = ("left", "left_down", "down", "right_down", "right")
+#: the paper's five toy places come from the project's shared vocabulary.
+_PAPER_NAMES: tuple[str, ...] = OBJECT_PLACES
 _EDGE = ((25.0, 40.0, -10.0), (25.0, 20.0, -25.0), (25.0, 0.0, -25.0), (25.0, -20.0, -25.0),
          (25.0, -40.0, -10.0))
 

@@ -45,6 +45,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from perception.vocabulary import SIS_POSES
 from relrl.interfaces import Environment
 from relrl.sim.caregiver import Caregiver, CaregiverParams, make_caregiver
 from relrl.sim.errors import InvalidResponse, SimError, did_you_mean
@@ -55,7 +56,7 @@ from relrl.sim.reward import PAPER_REWARD
 from relrl.sim.world import World
 
 __all__ = ["ENV_ID", "ENV_ID_V1", "OBSERVATION_FIELDS", "POSES", "RESPONSES",
-           "SharedAttentionEnv", "observation_fields"]
+           "SharedAttentionEnv", "SharedAttentionEnvV1", "observation_fields"]
 
 #: the registered Gymnasium id (focus-only observation).
 ENV_ID = "relrl/SharedAttention-v0"
@@ -63,8 +64,9 @@ ENV_ID = "relrl/SharedAttention-v0"
 ENV_ID_V1 = "relrl/SharedAttention-v1"
 #: action index -> response term (the paper's world).
 RESPONSES: tuple[tuple[str, str], ...] = tuple(("look", p) for p in PLACES)
-#: caregiver gaze (place index) -> the face's pose as the robot perceives it (paper's world).
-POSES: tuple[str, ...] = ("frontal",) + PLACES[1:]
+#: caregiver gaze (place index) -> the face's pose as the robot perceives it in the paper's
+#: world (the shared vocabulary: the place looked at, ``frontal`` for the robot).
+POSES: tuple[str, ...] = SIS_POSES
 #: the v0 observation vector, field by field.
 OBSERVATION_FIELDS: tuple[tuple[str, str], ...] = (
     ("head_at", "where the robot's head points: index into the places (0 = centre)"),
@@ -412,3 +414,11 @@ class SharedAttentionEnv(gym.Env, Environment):
                     cells[j - 1] = 1 + ci * n_kinds + ki
                 fields += cells
         return np.array(fields, dtype=np.int64), tuple(percepts)
+
+
+class SharedAttentionEnvV1(SharedAttentionEnv):
+    """``relrl/SharedAttention-v1``: :class:`SharedAttentionEnv` with the version-1
+    observation (the toy's kind and, in whole-scene worlds, every toy in view)."""
+
+    def __init__(self, *args: Any, observation: int = 1, **kwargs: Any) -> None:
+        super().__init__(*args, observation=observation, **kwargs)

@@ -164,6 +164,24 @@ class World:
         os.replace(tmp, path)
         return path
 
+    def vocabulary(self) -> Any:
+        """The percepts this world produces, as a
+        :class:`perception.vocabulary.Vocabulary` (what ``relrl check --world`` compares a
+        domain with): the simulator's for these places, plus ``kind(toy, K)`` and
+        ``in_view(P, C, K)`` where the world has them."""
+        from perception.vocabulary import Vocabulary, sis_vocabulary
+
+        places = self.layout.places
+        base = sis_vocabulary(places, name=self.name,
+                              description=f"the simulator, {self.places} toy places")
+        extra: tuple = ()
+        if self.kinds:
+            extra += (("kind", "toy", self.kind_names),)
+        if self.scene:
+            extra += (("in_view", places[1:], self.colour_names or ("none",),
+                       self.kind_names or ("none",)),)
+        return Vocabulary(base.name, base.description, base.patterns + extra)
+
     # ---- (de)serialising -------------------------------------------------------------------
 
     def to_dict(self) -> dict[str, Any]:

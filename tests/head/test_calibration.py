@@ -15,7 +15,7 @@ from head.calibration import (
     save_calibration,
 )
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
-from relrl.errors import UserError
+from relrl.errors import USER_ERRORS
 
 
 def test_shipped_wha8030_loads_with_five_servos_six_directions_and_scripts():
@@ -77,7 +77,7 @@ def test_bad_calibration_is_one_line_naming_file_and_key(tmp_path, fast_toml, ol
     assert "\n" not in message
     assert message.startswith(f"{path}: ")
     assert key in message and text in message
-    assert isinstance(info.value, UserError)
+    assert isinstance(info.value, USER_ERRORS)  # the command line prints one line, exit 2
 
 
 def test_missing_file_is_a_calibration_error(tmp_path):

@@ -275,3 +275,28 @@ def test_random_bytes_and_other_domains_are_refused(tmp_path: Path) -> None:
         with pytest.raises(PolicyError, match=r"learned by etg, not by contingency"):
             contingency.learner.load(path)
     kb.close()
+
+
+def test_arithmetic_errors_load_the_same_before_and_after_a_save(tmp_path: Path) -> None:
+    """Regression: saving a policy (portray_clause) loaded library(arithmetic), after which
+    `X is foo + 1` in a domain became a load error reported as "Var:Var" — before a save it
+    loaded. Now it is always a load error at its line."""
+    path = domain(tmp_path, BASE + "zz(X) :- X is foo + 1.\n")
+    for _ in range(2):
+        with pytest.raises(PrologLoadError, match=r"d\.pl:4: Arithmetic: `foo' is not a "
+                                                  r"function"):
+            KnowledgeBase(path)
+        kb, agent, _ = _etg_policy(tmp_path)
+        kb.close()
+
+
+def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
+    with KnowledgeBase(TINY) as kb:
+        (answer,), _ = kb.query("X = f(X)")
+        name, value, printed = answer[0]
+        assert name == "X" and value == printed and printed.startswith("f(f(")
+        (answer,), _ = kb.query("numlist(1, 100000, L), foldl([_, A, f(A)]>>true, L, z, T)")
+        deep = {name: value for name, value, _ in answer}["T"]
+        assert isinstance(deep, str) and "(...)" in deep
+        (answer,), _ = kb.query("X = [1, 2, f(a)]")
+        assert answer[0][1] == [1, 2, ("f", "a")]

@@ -1,10 +1,17 @@
-"""``relrl shell``: queries print like the swipl top level; commands; piped input."""
+"""``relrl shell``: answers as at the swipl toplevel (one at a time at a terminal, tested on a
+pseudo-terminal), commands, piped input, make, :load all or nothing, trace, time limits."""
 
 from __future__ import annotations
 
 import io
+import os
+import re
+import select
+import signal
 import subprocess
 import sys
+import time
+from pathlib import Path
 
 import pytest
 
@@ -75,3 +82,243 @@ def test_piped_shell_process() -> None:
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines()[0] == "R = look(centre) ;"
     assert proc.stdout.splitlines()[-1] == "R = name_object."
+
+
+# -- the toplevel's habits (issue 14) -------------------------------------------------------
+
+def _shell_proc(stdin: str, *args: str, domain: Path = FRUITS,
+                timeout: float = 300) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "relrl.cli", "shell", str(domain), *args],
+                          input=stdin, capture_output=True, text=True, cwd=ROOT,
+                          timeout=timeout)
+
+
+def test_piped_output_comes_in_order_with_the_answers() -> None:
+    proc = _shell_proc("write(a), X = 1 ; write(b), X = 2.\n"
+                       "member(X, [1, 2]), format(\"hello ~w~n\", [X]).\n")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "aX = 1 ;\nbX = 2.\nhello 1\nX = 1 ;\nhello 2\nX = 2.\n"
+
+
+def test_a_choice_point_left_after_the_last_answer_reads_false() -> None:
+    proc = _shell_proc("(X = 1 ; fail).\n")
+    assert proc.stdout == "X = 1 ;\nfalse.\n"
+
+
+def test_cyclic_and_deep_answers_are_written_as_swipl_writes_them() -> None:
+    proc = _shell_proc("X = f(X).\n"
+                       "X = [a|X], Y = g(X, Y).\n"
+                       "numlist(1, 100000, L), foldl([_, A, f(A)]>>true, L, a, T).\n"
+                       "length(L, 3).\n")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines() == [
+        "X = f(X).",
+        "X = [a|X],", "Y = g(X, Y).",
+        "L = [1, 2, 3, 4, 5, 6, 7, 8, 9|...],",
+        "T = f(f(f(f(f(f(f(f(f(f(...)))))))))).",
+        "L = [_, _, _]."]
+
+
+def test_answers_write_whole_terms_on_request(shell) -> None:
+    sh, out = shell
+    sh.run_lines([":set answers write\n", "numlist(1, 12, L).\n", ":set answers print\n",
+                  "numlist(1, 12, L).\n"])
+    assert out.getvalue().splitlines() == [
+        "answers = write", "L = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12].",
+        "answers = print", "L = [1, 2, 3, 4, 5, 6, 7, 8, 9|...]."]
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "-inf", "soon", ""])
+def test_the_time_limit_cannot_be_switched_off(shell, value: str) -> None:
+    sh, out = shell
+    sh.run_lines([f":set timeout {value}\n", "repeat, fail.\n"])
+    assert sh.timeout == 0.5
+    lines = out.getvalue().splitlines()
+    assert "cannot be switched off" in lines[0]
+    assert lines[1] == "error: query ran longer than 0.5 s (a rule that never ends?)"
+
+
+@pytest.mark.parametrize("value", ["-5", "0", "nan", "inf"])
+def test_timeout_flag_is_checked(value: str) -> None:
+    proc = _shell_proc("true.\n", "--timeout", value)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.count("\n") == 1 and "--timeout" in proc.stderr
+    assert "cannot be switched off" in proc.stderr
+
+
+def test_endless_answers_stop_at_max_when_piped() -> None:
+    proc = _shell_proc("between(1, inf, X).\n", "--max", "3")
+    assert proc.stdout.splitlines() == ["X = 1 ;", "X = 2 ;", "X = 3 ;",
+                                        "... (more than 3 answers; see :set max N)"]
+
+
+def test_load_is_all_or_nothing(shell, write_domain) -> None:
+    sh, out = shell
+    bad = write_domain("extra(1).\nextra(2).\nbroken(X) :- foo(.\nextra(3).\n", "bad.pl")
+    good = write_domain("extra(10).\n", "good.pl")
+    sh.run_lines([f":load {bad}\n", "catch(extra(X), E, (print_message(silent, E), fail)).\n",
+                  f":load {good}\n", "extra(X).\n"])
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("error: ") and "bad.pl:3" in lines[0]
+    assert "nothing loaded" in lines[0]
+    assert lines[1] == "false."                # not one clause of bad.pl is there
+    assert lines[2] == f"loaded {good}" and lines[3] == "X = 10."
+
+
+def test_make_reloads_changed_files_and_keeps_a_broken_one(shell, write_domain) -> None:
+    sh, out = shell
+    extra = write_domain("extra(1).\n", "extra.pl")
+    sh.run_lines([f":load {extra}\n", "make.\n", "extra(X).\n"])
+    assert out.getvalue().splitlines()[1:] == ["true.", "X = 1."]
+    out.truncate(0), out.seek(0)
+    extra.write_text("extra(2).\nextra(3).\n")
+    os.utime(extra, (1, 1))                    # a different time stamp, whatever the clock
+    sh.run_lines(["make.\n", "extra(X).\n"])
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("% ") and lines[0].endswith("extra.pl reloaded")
+    assert lines[1:] == ["true.", "X = 2 ;", "X = 3."]
+    out.truncate(0), out.seek(0)
+    extra.write_text("extra(4) :- .\n")
+    os.utime(extra, (2, 2))
+    sh.run_lines(["make.\n", "extra(X).\n"])
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("error: ") and "extra.pl:1" in lines[0]
+    assert lines[0].endswith("(not reloaded: its last good version stays)")
+    assert lines[1:] == ["X = 2 ;", "X = 3."]   # the last good version stays
+
+
+def test_trace_prints_the_ports_of_the_domain_rules() -> None:
+    proc = _shell_proc("trace.\nlooking_frontal(face).\nnotrace.\nlooking_frontal(face).\n")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.splitlines()[0].startswith("% tracing every port")
+    assert proc.stderr.splitlines() == [" T [7] Call: looking_frontal(face)",
+                                        " T [7] Fail: looking_frontal(face)"]
+
+
+def test_the_interactive_debugger_says_it_is_not_available(shell) -> None:
+    sh, out = shell
+    sh.run_lines(["debug.\n", "gtrace.\n"])
+    assert out.getvalue().count("% not available:") == 2
+    assert sh.errors == 0
+
+
+# -- at a terminal: one answer at a time ----------------------------------------------------
+
+class _Terminal:
+    """A process on a pseudo-terminal: send keys, wait for text."""
+
+    def __init__(self, args: list[str], env: dict[str, str]) -> None:
+        import pty  # noqa: F401  (POSIX only, like the shell's key reading)
+
+        self.master, slave = os.openpty()
+        self.proc = subprocess.Popen(args, stdin=slave, stdout=slave, stderr=slave, env=env,
+                                     cwd=ROOT, start_new_session=True)
+        os.close(slave)
+        self.seen = ""
+
+    def expect(self, pattern: str, timeout: float = 120) -> str:
+        """Wait for ``pattern`` (a regex); return the text up to its end and drop it."""
+        end = time.monotonic() + timeout
+        while True:
+            m = re.search(pattern, self.seen)
+            if m:
+                text, self.seen = self.seen[:m.end()], self.seen[m.end():]
+                return text.replace("\r\n", "\n")
+            ready, _, _ = select.select([self.master], [], [], max(0, end - time.monotonic()))
+            if not ready:
+                raise AssertionError(f"{pattern!r} not seen; the terminal shows {self.seen!r}")
+            try:
+                self.seen += os.read(self.master, 4096).decode()
+            except OSError:
+                raise AssertionError(f"{pattern!r} not seen before the end: "
+                                     f"{self.seen!r}") from None
+
+    def quiet(self, seconds: float = 0.5) -> str:
+        """What arrives within ``seconds`` (the process should be waiting for a key)."""
+        ready, _, _ = select.select([self.master], [], [], seconds)
+        return os.read(self.master, 4096).decode() if ready else ""
+
+    def send(self, text: str) -> None:
+        os.write(self.master, text.encode())
+
+    def close(self) -> int:
+        try:
+            return self.proc.wait(120)
+        finally:
+            os.close(self.master)
+
+
+@pytest.fixture
+def terminal(tmp_path: Path):
+    env = dict(os.environ, RELRL_HISTORY=str(tmp_path / "history"), TERM="dumb")
+    term = _Terminal([sys.executable, "-m", "relrl.cli", "shell", "--timeout", "2",
+                      str(FRUITS)], env)
+    term.expect(r"\?- ")
+    yield term
+    if term.proc.poll() is None:
+        term.proc.kill()
+        term.close()
+
+
+def test_terminal_one_answer_at_a_time(terminal) -> None:
+    terminal.send("stimulus(S).\n")
+    assert terminal.expect(r"S = face ").endswith("\nS = face ")
+    assert terminal.quiet() == ""                      # waits: no second answer yet
+    terminal.send(";")
+    assert terminal.expect(r"S = object ") == ";\nS = object "
+    terminal.send("\r")                                # Enter: stop, as swipl
+    assert terminal.expect(r"\?- ") == ".\n\n?- "
+    terminal.send("between(1, inf, X).\n")             # an endless generator: one at a time
+    terminal.expect(r"X = 1 ")
+    terminal.send(" ")
+    assert terminal.expect(r"X = 2 ") == ";\nX = 2 "
+    terminal.send("c")
+    terminal.expect(r"\?- ")
+    terminal.send("\x04")                              # end of input leaves
+    assert terminal.close() == 0
+
+
+def test_terminal_output_in_order_and_last_answer_without_prompt(terminal) -> None:
+    terminal.send("member(X, [1, 2]), write(hello(X)), nl.\n")
+    assert terminal.expect(r"X = 1 ").endswith("\nhello(1)\nX = 1 ")
+    terminal.send(";")
+    assert terminal.expect(r"\?- ") == ";\nhello(2)\nX = 2.\n\n?- "
+    terminal.send("X = f(X).\n")
+    assert terminal.expect(r"\?- ").endswith("\nX = f(X).\n\n?- ")
+    terminal.send("stimulus(dog).\n")
+    assert terminal.expect(r"\?- ").endswith("\nfalse.\n\n?- ")
+
+
+def test_terminal_write_help_and_unknown_keys(terminal) -> None:
+    terminal.send("numlist(1, 12, L), member(X, [a, b]).\n")
+    assert terminal.expect(r"X = a ").endswith("L = [1, 2, 3, 4, 5, 6, 7, 8, 9|...],\nX = a ")
+    terminal.send("w")
+    assert terminal.expect(r"X = a ") == ("[write]\nL = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, "
+                                          "12],\nX = a ")
+    terminal.send("h")
+    assert "; (n, r, space, tab): next answer" in terminal.expect(r"X = a ")
+    terminal.send("x")
+    assert terminal.expect(r"Action\? ") == "\nunknown action 'x' (h for help)\nAction? "
+    terminal.send(";")
+    assert terminal.expect(r"\?- ").startswith(";\nL = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12],"
+                                               "\nX = b.")
+    terminal.send(":quit\n")
+    assert terminal.close() == 0
+
+
+def test_terminal_time_limit_per_answer(terminal) -> None:
+    terminal.send("(X = 1 ; repeat, fail).\n")
+    terminal.expect(r"X = 1 ")
+    time.sleep(2.5)                                    # thinking time is not query time
+    terminal.send(";")
+    text = terminal.expect(r"\?- ")
+    assert "error: query ran longer than 2 s" in text
+
+
+def test_terminal_ctrl_c_returns_to_the_prompt(terminal) -> None:
+    terminal.send("repeat, fail.\n")
+    time.sleep(0.5)
+    terminal.proc.send_signal(signal.SIGINT)     # as Ctrl-C: noticed when Prolog returns
+    assert "% interrupted" in terminal.expect(r"\?- ")
+    terminal.send("stimulus(face).\n")
+    assert terminal.expect(r"\?- ").endswith("\ntrue.\n\n?- ")

@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import relrl  # noqa: F401  (registers the ids)
 from relrl.kb import KnowledgeBase
 from relrl.sim import ENV_ID, ENV_ID_V1, GazeMetrics, World
 from relrl.sim.policies import GazeFollower, RandomPolicy

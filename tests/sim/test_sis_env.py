@@ -49,7 +49,7 @@ def test_passes_gymnasium_env_checker_without_warnings(mode: str | None) -> None
         check_env(env)
 
 
-def test_registered_when_relrl_is_imported() -> None:
+def test_registered_when_the_simulator_is_imported() -> None:
     assert relrl.__version__ and ENV_ID == "relrl/SharedAttention-v0"
     env = gym.make(ENV_ID, caregiver="unreliable", max_steps=7)
     assert isinstance(env.unwrapped, SharedAttentionEnv)

@@ -107,8 +107,14 @@ def test_every_world_runs_and_a_gaze_follower_solves_it(world: World) -> None:
     assert {c for _, c in toys} <= (set(world.colour_names) or {""})
     assert {k for rec in trace for k in rec.kinds} <= set(world.kind_names)
     assert all(len(rec.toys) == world.toys for rec in trace if rec.toys)
-    random = rollout(world.env(max_steps=None), RandomPolicy(1, env.places), 1500, seed=1)
+    random_env = world.env(max_steps=None)
+    random = rollout(random_env, RandomPolicy(1, env.places), 1500, seed=1)
     assert {rec.focus for rec in random} == places           # every response is a place
+    vocabulary = world.vocabulary()                           # the shared vocabulary's form
+    _, info = random_env.reset(seed=2)
+    for _ in range(500):
+        assert all(vocabulary.allows(p) for p in info["percepts"]), info["percepts"]
+        _, _, _, _, info = random_env.step(random_env.action_space.sample())
 
 
 def test_whole_scene_perception_sees_the_toys_in_the_field_only() -> None:
