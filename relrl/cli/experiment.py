@@ -95,7 +95,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     sub = parser.add_subparsers(dest="name", metavar="EXPERIMENT", required=True,
                                 parser_class=type(parser))
-    sis = sub.add_parser("sis", help="the paper's Experiment 1 (three learners in the SIS)",
+    sis = sub.add_parser("sis", help="the paper's Experiment 1 (the learners in the SIS)",
                          description="The paper's Experiment 1: learning curves (CGI), eye "
                                      "contacts and memory of each learner in the simulator.")
     _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
