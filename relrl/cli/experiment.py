@@ -254,7 +254,15 @@ def build_scaling_config(args: argparse.Namespace):
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check everything, claim the output folder, run the experiment, print the summary."""
+    """Check everything, claim the output folder, run the experiment, print the summary.
+
+    ``kill -USR1 PID`` prints the stack of every thread to stderr (for a sweep that seems
+    stuck); Ctrl-C or SIGTERM stops it keeping what finished."""
+    import faulthandler
+    import signal
+
+    if hasattr(signal, "SIGUSR1"):
+        faulthandler.register(signal.SIGUSR1, all_threads=True)
     from relrl.experiments import main as sis_main
     from relrl.experiments.report import summary_table
     from relrl.outdir import OutDir

@@ -86,7 +86,13 @@ def test_a_signal_stops_the_run_and_its_workers_within_2_s_keeping_points(sig, t
         assert len(group(proc.pid)) >= 3                 # the parent and its workers
         t0 = time.monotonic()
         proc.send_signal(sig)
-        proc.wait(timeout=10)
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:       # say where it is stuck: every thread's stack
+            proc.send_signal(signal.SIGUSR1)
+            time.sleep(2)
+            raise AssertionError("no exit within 10 s; stacks:\n" + b"".join(drained).decode(
+                errors="replace")[-6000:]) from None
         elapsed = time.monotonic() - t0
     finally:
         if proc.poll() is None:
