@@ -4,6 +4,7 @@
 * steps per second of each learner driving the Social Interactive Simulator (a fixed,
   seeded synthetic environment), learning on, and the gateway calls per step;
 * the simulator's own step rate;
+* ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
 * the perception pipeline's frames per second (perception.bench), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
@@ -67,6 +68,9 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     for figures in out["learners"].values():
         figures["step_in_gateway_calls"] = figures["us_per_step"] / out["gateway_call_us"]
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
+    from relrl.monitor.bench import bench_monitor
+
+    out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
     if perception:
         try:
             import perception as perception_pkg
@@ -78,6 +82,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     out["targets"] = {
         "etg_calls_per_step<=1.5": etg["gateway_calls_per_step"] <= 1.5,
         "etg_step<=3_gateway_calls": etg["step_in_gateway_calls"] <= 3.0,
+        "monitor_steps_ratio>=0.9": out["monitor"]["ratio"] >= 0.9,
     }
     photos = out.get("perception", {}).get("fps_photos_320x240_cold")
     if photos is not None:  # issue 13: real photos, full search, one OpenCV thread

@@ -28,7 +28,8 @@ from pathlib import Path
 from typing import TextIO
 
 from relrl.errors import ConfigError, PrologLoadError, RelrlError, UserError
-from relrl.kb import KnowledgeBase, OpenQuery
+from relrl.kb import KnowledgeBase
+from relrl.query import OpenQuery
 from relrl.terms import format_term
 
 __all__ = ["Shell", "COMMANDS", "command", "check_timeout"]

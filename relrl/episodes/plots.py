@@ -22,6 +22,8 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
     except ImportError:
         return []
     files = []
+    # on devices, evaluations and naming ran on the scripted world: the titles say so
+    sim = " - SIMULATED" if summary.get("where", {}).get("simulated_evaluation") else ""
     if rewards:
         fig, ax = plt.subplots(figsize=(6, 3))
         r = np.asarray(rewards)
@@ -44,7 +46,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         ax.set_ylim(0, 1.05)
         ax.set_xlabel("learning time units")
         ax.set_ylabel("CGI (mean +- sd of runs)")
-        ax.set_title("Learning evolution (cf. the paper's Fig. 6)")
+        ax.set_title("Learning evolution (cf. the paper's Fig. 6)" + sim)
         fig.tight_layout()
         files.append(out / "cgi.png")
         fig.savefig(files[-1], dpi=100)
@@ -60,7 +62,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
                label="paper", capsize=3)
         ax.set_xticks(x, [k.replace("_", " ") for k in keys])
         ax.set_ylabel("rate (%)")
-        ax.set_title("Declarative pointing (Table 1)")
+        ax.set_title("Declarative pointing (Table 1)" + sim)
         ax.legend()
         fig.tight_layout()
         files.append(out / "table1.png")

@@ -208,6 +208,7 @@ class EpisodeWorld(Environment):
         self.focus = "centre"
         self.heard: list[str] = []
         self.last_frame: np.ndarray | None = None
+        self.last_percept: Any = None  # what perception found in last_frame (the monitor)
 
     @property
     def perceiver(self) -> Any:
@@ -276,6 +277,7 @@ class EpisodeWorld(Environment):
         frame = render(view)
         self.last_frame = frame
         percept = self.perceiver.analyse(frame, looking_at=focus)
+        self.last_percept = percept
         facts = [f for f in percept.facts if not (isinstance(f, tuple) and f[0] in
                                                   ("pan", "tilt"))]
         if not facts:

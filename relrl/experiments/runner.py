@@ -14,7 +14,8 @@ are ended (SIGTERM, then SIGKILL after half a second), the jobs finished so far 
 events of the unfinished ones are returned in a :class:`Outcome` marked ``interrupted``, and
 the caller writes them (marked partial). Workers ignore SIGINT (Ctrl-C in a terminal reaches
 the whole process group; the parent alone decides) and die with the parent (Linux
-``PR_SET_PDEATHSIG``), so no worker outlives the run.
+``PR_SET_PDEATHSIG``), so no worker outlives the run. Progress (:mod:`relrl.progress`: a bar
+with ETA on a terminal, log lines elsewhere) counts the jobs' ``point`` events.
 
 Failures. A job that raises a relrl error (a bad domain file, a runaway rule) stops the run;
 so does a worker that dies (a domain calling ``halt/0``, a crash in Prolog: :class:`WorkerLost`).
@@ -27,7 +28,6 @@ from __future__ import annotations
 
 import os
 import signal
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -78,33 +78,28 @@ class Outcome:
 
 
 class ProgressBar:
-    """A one-line progress bar on a terminal; silent otherwise."""
+    """The experiment's progress (:func:`relrl.progress.progress`): a tqdm bar with ETA on
+    a terminal, log lines otherwise; workers report to the parent, which owns it."""
 
-    def __init__(self, total: int, stream: Any = None) -> None:
+    def __init__(self, total: int) -> None:
+        from relrl.progress import progress
+
         self.total = total
-        self.done = 0
-        self.stream = stream = sys.stderr if stream is None else stream
-        self.active = bool(getattr(stream, "isatty", lambda: False)())
-        self._start = time.perf_counter()
+        self._progress = progress(total, "experiment", unit="point")
+
+    @property
+    def done(self) -> int:
+        """Units done so far."""
+        return self._progress.n
 
     def update(self, label: str, units: int = 1) -> None:
-        """``units`` more done."""
-        self.done += units
-        if self.active:
-            width = 30
-            filled = int(width * min(self.done, self.total) / max(1, self.total))
-            elapsed = time.perf_counter() - self._start
-            eta = elapsed * (self.total - self.done) / self.done if self.done else 0.0
-            self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] "
-                              f"{self.done}/{self.total} {elapsed:5.0f}s (~{eta:.0f}s left) "
-                              f"{label:<36.36}")
-            self.stream.flush()
+        """``units`` more done (``label`` says which)."""
+        self._progress.set_description(label)
+        self._progress.update(units)
 
     def close(self) -> None:
-        """End the bar's line."""
-        if self.active:
-            self.stream.write("\n")
-            self.stream.flush()
+        """End the bar."""
+        self._progress.close()
 
 
 def raise_kept(error: str, out: Any) -> None:

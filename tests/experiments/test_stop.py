@@ -50,7 +50,7 @@ def _wait_for_points(fd: int, points: int, timeout: float) -> str:
                 text += os.read(fd, 4096).decode(errors="replace")
             except OSError:
                 break
-            done = re.findall(r"\] (\d+)/\d+", text)
+            done = re.findall(r"(\d+)/\d+ \[", text)          # tqdm: "4/100001 [00:02<"
             if done and int(done[-1]) >= points:
                 return text
     raise AssertionError(f"no progress within {timeout} s: {text[-300:]!r}")
