@@ -86,6 +86,9 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
     p.add_argument("--eval-policy", choices=["behaviour", "greedy"], default="behaviour",
                    help="evaluate the robot's behaviour (exploration kept, the default) "
                         "or the greedy policy")
+    p.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
+                   help="seconds one control step may run before the run stops, naming the "
+                        "rule (default 60)")
     p.add_argument("--quick", action="store_true", help="a short run")
 
 
@@ -177,6 +180,9 @@ def _check_common(args: argparse.Namespace, config, learners_known) -> None:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     if args.address is not None and args.engine != "ray":
         raise ConfigError("--address applies to --engine ray only")
+    if not math.isfinite(args.timeout) or args.timeout <= 0:
+        raise ConfigError(f"--timeout must be a number of seconds > 0, not {args.timeout}")
+    config.timeout = args.timeout
 
 
 def build_config(args: argparse.Namespace):
@@ -259,10 +265,15 @@ def run(args: argparse.Namespace) -> int:
     ``kill -USR1 PID`` prints the stack of every thread to stderr (for a sweep that seems
     stuck); Ctrl-C or SIGTERM stops it keeping what finished."""
     import faulthandler
+    import io
     import signal
+    import sys
 
-    if hasattr(signal, "SIGUSR1"):
-        faulthandler.register(signal.SIGUSR1, all_threads=True)
+    if hasattr(signal, "SIGUSR1") and sys.__stderr__ is not None:
+        try:
+            faulthandler.register(signal.SIGUSR1, file=sys.__stderr__, all_threads=True)
+        except (ValueError, OSError, io.UnsupportedOperation):
+            pass  # no real stderr (embedded): no stack dumps, nothing else changes
     from relrl.experiments import main as sis_main
     from relrl.experiments.report import summary_table
     from relrl.outdir import OutDir

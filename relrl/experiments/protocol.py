@@ -36,14 +36,18 @@ class Session:
             that hold some places out).
         eval_steps: time units per evaluation run.
         eval_policy: ``behaviour`` (exploration kept, no learning) or ``greedy``.
-        hold: time units on the face that make eye contact (metrics).
+        eval_caregiver_params: the caregiver's overrides while evaluating (default: the
+            learning ones).
+        timeout: seconds one gateway call (one control step) may run before the run stops
+            with a QueryTimeout naming the rule.
     """
 
     def __init__(self, domain: str, learner: str, learner_params: Mapping[str, float],
                  seed: int, *, world: Any = None, caregiver: str = "paper",
                  caregiver_params: Mapping[str, Any] | None = None, eval_steps: int = 500,
                  eval_policy: str = "behaviour",
-                 eval_caregiver_params: Mapping[str, Any] | None = None) -> None:
+                 eval_caregiver_params: Mapping[str, Any] | None = None,
+                 timeout: float = 60.0) -> None:
         from relrl.kb import KnowledgeBase, gateway_calls
         from relrl.learners import make_learner
         from relrl.loop import Agent, Interaction
@@ -59,7 +63,7 @@ class Session:
         self.seed = seed
         self.eval_caregiver_params = dict(eval_caregiver_params if eval_caregiver_params
                                           is not None else caregiver_params or {})
-        self.kb = KnowledgeBase(domain)
+        self.kb = KnowledgeBase(domain, timeout=timeout)
         try:
             self.learner = make_learner(learner, **dict(learner_params))
             self.agent = Agent(self.kb, self.learner, seed=seed)

@@ -55,6 +55,9 @@ class ScalingConfig:
     threshold: float = 0.9
     patience: int = 2                #: stop after this many evaluations >= threshold (0: never)
     eval_policy: str = "behaviour"
+    #: seconds one control step may run before the run stops (a rule that never ends); the
+    #: robot's own default is 10 s, batch runs on a loaded machine need more room.
+    timeout: float = 60.0
     transfer: str = "places"         #: places | kinds | none
     transfer_sizes: list[int] = field(default_factory=lambda: [5, 9, 17, 33])
     holdout: float = 0.4             #: share of places (or kinds) held out for transfer
@@ -139,7 +142,7 @@ def run_scaling_job(config: ScalingConfig, learner: str, size: int, seed: int,
     with Session(_domain(world), learner, config.learner_params.get(learner, {}), seed,
                  world=world, caregiver=config.caregiver, caregiver_params=learn_params,
                  eval_caregiver_params=eval_params, eval_steps=config.eval_steps,
-                 eval_policy=config.eval_policy) as session:
+                 eval_policy=config.eval_policy, timeout=config.timeout) as session:
         curve: list[dict[str, Any]] = []
         reached, streak = None, 0
         points = config.budget // config.block

@@ -71,6 +71,9 @@ class SISConfig:
     #: "behaviour": evaluate the robot as it behaves (its exploration kept, no learning);
     #: "greedy": the learners' greedy policy (contingency's roulette stays a roulette).
     eval_policy: str = "behaviour"
+    #: seconds one control step may run before the run stops (a rule that never ends); the
+    #: robot's own default is 10 s, batch runs on a loaded machine need more room.
+    timeout: float = 60.0
     #: toy places used while learning (None: the caregiver's own placement).
     train_places: list[str] | None = None
     #: toy places of the evaluation's targets and distractors (None: all of them).
@@ -135,7 +138,7 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
     with Session(config.domain, learner_name, config.learner_params.get(learner_name, {}),
                  seed, caregiver=config.caregiver, caregiver_params=learn,
                  eval_caregiver_params=evaluation, eval_steps=config.eval_steps,
-                 eval_policy=config.eval_policy) as session:
+                 eval_policy=config.eval_policy, timeout=config.timeout) as session:
         curve = []
         for point in range(config.points + 1):
             if point > 0:

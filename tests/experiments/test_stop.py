@@ -78,7 +78,7 @@ def test_a_signal_stops_the_run_and_its_workers_within_2_s_keeping_points(sig, t
     os.close(slave)
     drained: list[bytes] = []
     try:
-        _wait_for_points(master, 4, timeout=120)      # a few points of each job part done
+        _wait_for_points(master, 4, timeout=300)      # a few points of each job part done
         # keep reading the terminal, or the bar fills it and the run blocks writing
         reader = threading.Thread(target=_drain, args=(master, drained), daemon=True)
         reader.start()
