@@ -50,8 +50,9 @@ def run(args: argparse.Namespace) -> int:
         episode.seed = args.seed
     if args.check:
         print(f"{args.episode}: ok - {episode.name}: {len(episode.phases)} phases, "
-              f"{episode.steps} time units, {len(episode.events)} events, learner "
-              f"{episode.learner} {episode.learner_params}, domain {episode.domain.name}")
+              f"{episode.steps} time units ({episode.time_unit}s), {len(episode.events)} events, "
+              f"learner {episode.learner} {episode.learner_params}, domain "
+              f"{episode.domain.name}")
         return 0
     if args.protocol and not args.head:
         raise ConfigError("--protocol needs --head PORT")
@@ -88,7 +89,7 @@ def run(args: argparse.Namespace) -> int:
                 print(f"relrl run: the policy was not saved: {summary['policy_error']}",
                       file=sys.stderr)
         if summary["stopped_early"]:
-            print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}"
+            print(f"stopped after time unit {summary['units']} of {summary['planned_steps']}"
                   f"{' by ' + summary['stopped_by'] if summary['stopped_by'] else ''}; "
                   "everything up to it is written", file=sys.stderr)
             return 128 + (stop.signum or 2)
@@ -112,21 +113,10 @@ def _run(episode, opts, stop) -> dict:
 
 
 def _report(s: dict) -> str:
+    from relrl.experiments.fruits import report_lines
+
     cgi = "n/a" if s["cgi"] is None else f"{s['cgi']:.3f}"
-    head = (f"{s['episode']}: {s['steps']} time units, CGI {cgi} ({s['correct_shifts']}/"
-            f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
-            f"reward {s['rewards']['total']:+.0f}")
-    lines = [head]
-    sim = " (simulated)" if s.get("where", {}).get("simulated_evaluation") else ""
-    if sim and (s.get("evaluation") or "table1" in s):
-        lines.append("  evaluations and naming below ran on the scripted world (simulated), "
-                     "not on the devices")
-    for p in s.get("evaluation", []):
-        lines.append(f"  evaluation{sim} after {p['learning_steps']:4d} time units: CGI "
-                     f"{p['cgi_mean']:.3f} +- {p['cgi_std']:.3f}")
-    if "table1" in s:
-        lines.append(f"  Table 1{sim} (mean +- sd %, measured | paper):")
-        for k, (m, sd) in s["table1"]["rates"].items():
-            pm, psd = s["table1"]["paper"][k]
-            lines.append(f"    {k:16s} {m:6.2f} +- {sd:5.2f} | {pm:6.2f} +- {psd:.2f}")
-    return "\n".join(lines)
+    head = (f"{s['episode']}: {s['units']} time units ({s['time_unit']}s, {s['steps']} control "
+            f"steps), CGI {cgi} ({s['correct_shifts']}/{s['shifts']} shifts), eye contacts "
+            f"{s['eye_contacts']}/{s['opportunities']}, reward {s['rewards']['total']:+.0f}")
+    return "\n".join([head] + report_lines(s))

@@ -211,7 +211,8 @@ class SessionTap:
         view = view_of(run.t, phase, record)
         view.head = head_view(self.head, info["record"].focus)
         view.metrics = metrics_view(run.metrics)
-        view.extra = {"caregiver": info.get("scene"), "focus": info["record"].focus,
+        view.extra = {"unit": info.get("unit", run.t),  # the time unit this step belongs to
+                      "caregiver": info.get("scene"), "focus": info["record"].focus,
                       "heard": info["words"], "naming": outcome, "said": said,
                       "overlay": overlay_of(percept, frame)}
         if self.frames is not None and frame is not None and self.frames.due():

@@ -150,7 +150,8 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.executions: list[dict[str, Any]] = []
         self.t = 0
-        self.done = 0  # learning time units finished (traced)
+        self.done = 0  # control steps of learning finished (traced)
+        self.units = 0  # learning time units finished
         self.in_view = None
         self.tap: Any = None
 
@@ -257,32 +258,42 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
 
         def evaluate() -> None:
             point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
-            point["learning_steps"] = run.t
+            point["units"], point["control_steps_learning"] = run.units, run.t
             point["on"] = where["evaluation"]
             _flag_cut_short(point, "cgi_runs", len(eval_seeds))
             run.curve.append(point)
             run.tap.event("evaluation", cgi_mean=point["cgi_mean"], cgi_std=point["cgi_std"],
                           on=where["evaluation"])
-            line = (f"evaluation{where['evaluation_label']} after {run.t} time units: CGI "
+            line = (f"evaluation{where['evaluation_label']} after {run.units} "
+                    f"{episode.time_unit}s: CGI "
                     f"{point['cgi_mean']:.3f} +- {point['cgi_std']:.3f}")
             if opts.live:
                 print(line, file=opts.stream, flush=True)
             log.info(line)
             # learning resumes where it stopped: the world keeps its time line (and phase)
 
-        for t in range(1, episode.steps + 1):
+        cycles = episode.time_unit == "interaction"
+        bound = fruits.unit_bound(episode) if cycles else 1
+        for unit in range(1, episode.steps + 1):
             if stop():
                 break
-            if ev and (t - 1) % ev["every"] == 0:
+            if ev and (unit - 1) % ev["every"] == 0:
                 evaluate()
-            phase = episode.phase_at(t)
+            phase = episode.phase_at(unit)
             phase_name = phase.name
-            _pull_words(run, env)
-            run.t = t
-            interaction.run(1, learning=phase.learning, keep=False, want=run.tap.want())
-            bar.update(1)
-            if opts.step_seconds:
-                time.sleep(opts.step_seconds)
+            for _ in range(bound):   # one time unit: a control step, or a whole cycle
+                if stop():
+                    break
+                _pull_words(run, env)
+                run.t += 1
+                interaction.run(1, learning=phase.learning, keep=False, want=run.tap.want())
+                if opts.step_seconds:
+                    time.sleep(opts.step_seconds)
+                if not cycles or env.units_done >= unit:
+                    break
+            if not stop():
+                run.units = unit
+                bar.update(1)
         bar.close()
         if ev and not stop() and episode.steps % ev["every"] == 0:
             evaluate()
@@ -310,7 +321,9 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         recorded = run.tap.finish()
         summary = _summary(run, stopped=stop(), why=_signal_name(stop))
         summary["where"] = {k: v for k, v in where.items() if not k.endswith("_label")}
-        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t}
+        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t,
+                  "evaluation_steps": sum(p["control_steps"] for p in run.curve),
+                  "naming_steps": sum(e["steps"] for e in run.executions)}
         if out is not None:
             written = True
             _write_outputs(run, out, summary, timing)
@@ -353,7 +366,11 @@ def _release(*things: Any, quiet: bool) -> None:
 
 def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
     from relrl.episodes.devices import DeviceWorld, HeadActuator
+    from relrl.errors import ConfigError
 
+    if opts.camera is not None and episode.time_unit != "step":
+        raise ConfigError(f"{episode.path}: time_unit = {episode.time_unit!r} counts the "
+                          "simulated caregiver's cycles; on a camera use time_unit = \"step\"")
     actuator = None
     if opts.head is not None:
         from head import open_head
@@ -391,8 +408,9 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
     summary: dict[str, Any] = {
         "episode": ep.name, "script": str(ep.path), "seed": ep.seed,
         "learner": {"name": ep.learner, "params": run.learner.params},
-        "steps": run.t, "planned_steps": ep.steps, "stopped_early": stopped,
-        "partial": stopped or run.t < ep.steps, "stopped_by": why,
+        "time_unit": ep.time_unit, "units": run.units, "steps": run.t,
+        "planned_steps": ep.steps, "stopped_early": stopped,
+        "partial": stopped or run.units < ep.steps, "stopped_by": why,
         "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
         "eye_contacts": e.established, "opportunities": e.opportunities,
         "mutual_gaze_events": m.mutual_gaze_events,
@@ -405,10 +423,7 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
-        complete = [x for x in run.executions if not x.get("interrupted")]
-        summary["table1"] = {"executions": run.executions,
-                             "rates": fruits.rates(complete) if complete else {},
-                             "paper": fruits.PAPER["table1"]}
+        summary["table1"] = fruits.table1(run.executions)
     return summary
 
 
@@ -436,7 +451,7 @@ def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
         exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore[attr-defined]
         return
     policy = f" and {summary['policy']}" if "policy" in summary else ""
-    exc.kept = (f"learned up to time unit {run.t} of {ep.steps}: summary.json"  # type: ignore
+    exc.kept = (f"learned up to time unit {run.units} of {ep.steps}: summary.json"  # type: ignore
                 f"{policy} written to {out} (partial)")
 
 
@@ -453,7 +468,8 @@ def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
             if not path.resolve().is_relative_to(out.resolve()):
                 raise OSError(f"{ep.policy_save} leads outside {out}")
             run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
-                                   f"seed {ep.seed}, {run.t} time units"
+                                   f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "
+                                   f"{run.t} control steps"
                                    + (" (partial)" if summary.get("partial") else ""))
             summary["policy"] = ep.policy_save
         except (RelrlError, OSError) as exc:  # the summary is written all the same
