@@ -6,6 +6,7 @@ source                     meaning
 ``0``, ``cam://0``         webcam by index (OpenCV ``VideoCapture``)
 ``video.mp4``              a video file (``file://video.mp4`` also works)
 ``frames/``                a folder of images, read in name order (``dir://frames``)
+``session/``               a session recorded by relrl (``recording://session``): its frames
 ``photo.png``              one image, read once (``image://photo.png``)
 ``synthetic://``           :func:`perception.render.render` of a :class:`SceneView`
 =========================  ==========================================================
@@ -230,6 +231,12 @@ def _webcam(rest: str) -> Camera:
     return _Capture(int(rest), f"webcam {rest}")
 
 
+def _recording(path: str) -> Camera:
+    from perception.recorded import RecordedCamera
+
+    return RecordedCamera(path)
+
+
 def _video(path: str) -> Camera:
     if not Path(path).is_file():
         raise CameraError(f"no such video file: {path!r}")
@@ -242,6 +249,7 @@ SOURCES: dict[str, Callable[[str], Camera]] = {
     "file": _video,
     "dir": _Folder,
     "image": _Image,
+    "recording": _recording,
     "synthetic": lambda rest: _synthetic("synthetic://" + rest),
 }
 
@@ -258,7 +266,8 @@ def open_camera(source: str | int) -> Camera:
     elif src.isdigit():
         scheme, rest = "cam", src
     elif Path(src).is_dir():
-        scheme, rest = "dir", src
+        scheme = "recording" if (Path(src) / "frames.jsonl").is_file() else "dir"
+        rest = src
     elif Path(src).suffix.lower() in _IMAGE_EXT:
         scheme, rest = "image", src
     else:

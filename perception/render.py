@@ -19,11 +19,13 @@ The detector is not told that a frame is synthetic; it sees pixels the cascade r
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from perception.appearance import Appearance, FruitLook, blur_kernel
 from perception.errors import PerceptionError
 from perception.vocab import COLOURS, OBJECT_PLACES, PLACES, POSES
 
@@ -50,6 +52,10 @@ class SceneView:
             name (a toy block of that colour, see :data:`perception.vocab.COLOURS`).
         lighting: brightness gain of the scene light (1.0 normal, 0.5 dim, 1.4 bright).
         seed: seeds the small random parts (object jitter, sensor noise, light tint).
+        appearance: how a camera in a real room sees the scene (light colour and white
+            balance, blur, noise, each fruit's shade, shape, size, place and occlusion; see
+            :mod:`perception.appearance`), or ``None`` for the plain drawing with a small
+            random tint and noise.
     """
 
     looking_at: str
@@ -57,6 +63,7 @@ class SceneView:
     objects: Mapping[str, str] = field(default_factory=dict)
     lighting: float = 1.0
     seed: int = 0
+    appearance: Appearance | None = None
 
     def __post_init__(self) -> None:
         if self.looking_at not in PLACES:
@@ -250,13 +257,128 @@ _POSE_DRAWERS: dict[str, Callable] = {
 
 
 def _background(h: int, w: int, looking_at: str) -> np.ndarray:
+    return _background_cached(h, w, looking_at.endswith("down") and looking_at != "centre")
+
+
+@functools.lru_cache(maxsize=16)
+def _background_cached(h: int, w: int, table: bool) -> np.ndarray:
     img = np.empty((h, w, 3), np.float32)
     ramp = np.linspace(1.05, 0.9, h, dtype=np.float32)[:, None, None]
     img[:] = np.array(_WALL, np.float32) * ramp
-    if looking_at.endswith("down") and looking_at != "centre":
+    if table:
         top = int(h * 0.3)
         img[top:] = np.array(_TABLE, np.float32) * ramp[top:]
-    return img
+    out = img.clip(0, 255).astype(np.uint8)
+    out.flags.writeable = False
+    return out
+
+
+def _draw_look(img: np.ndarray, kind: str, cx: int, cy: int, r: int, look: FruitLook) -> None:
+    """A fruit in one of its real shades and shapes, lit from the upper left, perhaps partly
+    behind the caregiver's hand (drawn in the fruit's bounding box only)."""
+    import cv2
+
+    h, w = img.shape[:2]
+    ext = int(r * max(look.aspect, 1.0) * (1.0 + look.lumps)) + 3
+    x0, x1, y0, y1 = max(0, cx - ext), min(w, cx + ext + 1), max(0, cy - ext), min(h, cy + ext + 1)
+    if x0 < x1 and y0 < y1:
+        rng = np.random.default_rng(look.texture)
+        yy, xx = np.mgrid[y0:y1, x0:x1].astype(np.float32)
+        dx, dy = (xx - cx) / r, (yy - cy) / r
+        a = np.radians(look.angle)
+        u = (dx * np.cos(a) + dy * np.sin(a)) / look.aspect
+        v = -dx * np.sin(a) + dy * np.cos(a)
+        rho = np.hypot(u, v)
+        edge = 1.0 + look.lumps * np.sin(look.lobes * np.arctan2(v, u) + rng.uniform(0, 6.3))
+        d = rho / edge
+        inside = d <= 1.0
+        if inside.any():
+            # the second colour: a smooth random field over the skin, cut to cover `patch`
+            mix = np.zeros_like(d)
+            if look.patch > 0.0:
+                f = sum(np.sin(rng.uniform(1.2, 3.5) * (u * np.cos(t) + v * np.sin(t))
+                               + rng.uniform(0, 6.3))
+                        for t in rng.uniform(0, np.pi, 3))
+                cut = float(np.quantile(f[inside], 1.0 - look.patch))
+                mix = np.clip((f - cut) / 0.3 + 0.5, 0.0, 1.0)
+            base = (np.array(look.colour, np.float32)[None, None] * (1.0 - mix[..., None])
+                    + np.array(look.patch_colour, np.float32)[None, None] * mix[..., None])
+            # a sphere lit from the upper left: Lambert shading and a specular highlight
+            nz = np.sqrt(np.clip(1.0 - d * d, 0.0, 1.0))
+            nx, ny = dx / max(look.aspect, 1.0), dy
+            lam = np.clip(-0.45 * nx - 0.5 * ny + 0.74 * nz, 0.0, 1.0)
+            spec = look.highlight * np.clip(-0.25 * nx - 0.28 * ny + 0.93 * nz, 0.0, 1.0) ** 40
+            pores = 1.0 + 0.04 * rng.standard_normal(d.shape).astype(np.float32)
+            px = base * ((0.35 + 0.75 * lam) * pores)[..., None] + 255.0 * spec[..., None]
+            region = img[y0:y1, x0:x1]
+            region[inside] = np.clip(px[inside], 0, 255).astype(np.uint8)
+    if kind == "apple":
+        top = cy - r
+        cv2.line(img, (cx, top + 2), (cx + r // 6, top - r // 4), (30, 60, 90), max(1, r // 10))
+        cv2.ellipse(img, (cx + r // 4, top - r // 8), (r // 4, r // 8), -20, 0, 360,
+                    (40, 140, 50), -1)
+    if look.hand > 0.0:
+        _hand(img, cx, cy, r, look)
+
+
+def _hand(img: np.ndarray, cx: int, cy: int, r: int, look: FruitLook) -> None:
+    """The caregiver's hand and arm, reaching ``look.hand`` of the fruit's diameter into it
+    from the side ``look.hand_angle``."""
+    import cv2
+
+    a = np.radians(look.hand_angle)
+    ux, uy = float(np.cos(a)), float(np.sin(a))
+    front = r * (1.0 - 2.0 * look.hand)            # the hand's leading edge, from the centre
+    palm = front + 0.7 * r
+    px, py = int(cx + ux * palm), int(cy + uy * palm)
+    skin = look.skin
+    dark = tuple(int(0.8 * c) for c in skin)
+    far = 4 * max(img.shape[:2])
+    cv2.line(img, (px, py), (int(px + ux * far), int(py + uy * far)), dark, max(2, int(1.1 * r)))
+    cv2.ellipse(img, (px, py), (int(0.7 * r), int(0.95 * r)), float(look.hand_angle), 0, 360,
+                skin, -1)
+    for k in (-0.5, 0.0, 0.5):                     # fingers curled round the fruit
+        fx = int(cx + ux * (front + 0.15 * r) - uy * k * r)
+        fy = int(cy + uy * (front + 0.15 * r) + ux * k * r)
+        cv2.ellipse(img, (fx, fy), (int(0.2 * r), int(0.13 * r)), float(look.hand_angle), 0,
+                    360, dark if k else skin, -1)
+
+
+#: standard normal samples that frames with an :class:`Appearance` draw their sensor noise
+#: from (a seeded slice per frame: the same seed, the same noise; far cheaper than drawing
+#: a fresh frame of normals).
+_NOISE: list[np.ndarray] = []
+
+
+def _noise(rng: np.random.Generator, shape: tuple[int, ...]) -> np.ndarray:
+    n = int(np.prod(shape))
+    if not _NOISE:
+        _NOISE.append(np.random.default_rng(20120417).standard_normal(1 << 21,
+                                                                      dtype=np.float32))
+    bank = _NOISE[0]
+    if n > bank.size // 2:
+        return rng.standard_normal(shape, dtype=np.float32)
+    start = int(rng.integers(0, bank.size - n))
+    return bank[start:start + n].reshape(shape)
+
+
+def _camera(img: np.ndarray, view: SceneView, rng: np.random.Generator) -> np.ndarray:
+    """The light, white balance, exposure, optics and sensor of ``view.appearance``."""
+    import cv2
+
+    app = view.appearance
+    assert app is not None
+    s = img.shape[0] / 240.0
+    gains = (app.light.gains() * float(view.lighting)).astype(np.float32)
+    out = img.astype(np.float32) * gains[None, None]
+    o = app.optics
+    if o.blur > 0.0:
+        out = cv2.GaussianBlur(out, (0, 0), o.blur * s)
+    if o.motion > 0.0:
+        out = cv2.filter2D(out, -1, blur_kernel(o.motion * s, o.motion_angle))
+    if o.noise > 0.0:
+        out += _noise(rng, out.shape) * np.float32(o.noise)
+    return np.clip(out, 0, 255).astype(np.uint8)
 
 
 def render(view: SceneView, size: tuple[int, int] = (320, 240)) -> np.ndarray:
@@ -275,7 +397,7 @@ def render(view: SceneView, size: tuple[int, int] = (320, 240)) -> np.ndarray:
     if w < 64 or h < 48:
         raise PerceptionError(f"frame size {size!r} is too small; use at least (64, 48)")
     rng = np.random.default_rng(view.seed)
-    img = _background(h, w, view.looking_at).clip(0, 255).astype(np.uint8)
+    img = _background(h, w, view.looking_at).copy()
     u = h / 240.0
     if view.looking_at == "centre":
         if view.face_pose is not None:
@@ -289,11 +411,17 @@ def render(view: SceneView, size: tuple[int, int] = (320, 240)) -> np.ndarray:
             _face(img, view.face_pose, cx, cy, r)
     else:
         kind = view.objects.get(view.looking_at)
-        if kind is not None:
+        look = view.appearance.looks.get(view.looking_at) if view.appearance else None
+        if kind is not None and look is not None and kind in OBJECT_KINDS:
+            cx, cy = w // 2 + int(look.dx * w), h // 2 + int(look.dy * h)
+            _draw_look(img, kind, cx, cy, max(4, int(38 * u * look.scale)), look)
+        elif kind is not None:
             draw = OBJECT_KINDS.get(kind) or OBJECT_KINDS[f"{kind}_block"]
             cx = w // 2 + int(rng.integers(-30, 31) * u)
             cy = h // 2 + int(rng.integers(-20, 21) * u)
             draw(img, cx, cy, int(38 * u), rng)
+    if view.appearance is not None:
+        return _camera(img, view, rng)
     tint = 1.0 + rng.normal(0.0, 0.04, 3)
     out = img.astype(np.float32) * float(view.lighting) * tint[None, None].astype(np.float32)
     out += rng.normal(0.0, 2.5, out.shape).astype(np.float32)

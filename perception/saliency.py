@@ -133,8 +133,8 @@ def saliency_map(frame: np.ndarray, params: SaliencyParams = SaliencyParams()) -
     """
     import cv2
 
-    if not _GABORS:
-        _GABORS.extend(_gabor_kernels())
+    if not _GABORS:  # one slice assignment: two threads arriving here make the same list
+        _GABORS[:] = _gabor_kernels()
     h, w = frame.shape[:2]
     ww = int(params.work_width)
     wh = max(8, round(h * ww / w))

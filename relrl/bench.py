@@ -4,6 +4,7 @@
 * steps per second of each learner driving the Social Interactive Simulator (a fixed,
   seeded synthetic environment), learning on, and the gateway calls per step;
 * the simulator's own step rate;
+* ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
 * the perception pipeline's frames per second (perception.bench), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
@@ -12,7 +13,7 @@ same run: the gateway call is timed right before and right after the learners, s
 holds under whatever load the machine has. The step rates are reported too (they move with
 the load; the ratio much less). tg (issue 10): at most 1.5 gateway calls per step and at
 least 3,000 steps/s. Perception: at least 60 fps on real photographs at 320x240 (full
-search).
+search), with one thread and with two (wall clock, and on two free cores).
 """
 
 from __future__ import annotations
@@ -73,6 +74,9 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     for figures in out["learners"].values():
         figures["step_in_gateway_calls"] = figures["us_per_step"] / out["gateway_call_us"]
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
+    from relrl.monitor.bench import bench_monitor
+
+    out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
     if perception:
         try:
             import perception as perception_pkg
@@ -86,8 +90,14 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
         "etg_step<=3_gateway_calls": etg["step_in_gateway_calls"] <= 3.0,
         "tg_calls_per_step<=1.5": out["learners"]["tg"]["gateway_calls_per_step"] <= 1.5,
         "tg_steps_per_second>=3000": out["learners"]["tg"]["steps_per_second"] >= 3000,
+        "monitor_steps_ratio>=0.9": out["monitor"]["ratio"] >= 0.9,
     }
     photos = out.get("perception", {}).get("fps_photos_320x240_cold")
     if photos is not None:  # issue 13: real photos, full search, one OpenCV thread
         out["targets"]["perception_photos_320x240_fps>=60"] = photos >= 60
+    for key, line in (("fps_photos_320x240_cold_2threads", "2threads_fps"),
+                      ("free_cores_fps_photos_320x240_cold_2threads", "2threads_free_cores_fps")):
+        fps = out.get("perception", {}).get(key)  # the same with two perception threads
+        if fps is not None:
+            out["targets"][f"perception_photos_320x240_{line}>=60"] = fps >= 60
     return out

@@ -36,13 +36,15 @@ def _make_swipl(tmp_path: Path, present: tuple[str, ...]) -> list[str]:
 def test_missing_packages_are_installed_without_recommends(tmp_path: Path) -> None:
     calls = _make_swipl(tmp_path, present=())
     assert calls == ["update -qq",
-                     "install -y -qq --no-install-recommends swi-prolog-nox espeak-ng"]
+                     "install -y -qq --no-install-recommends swi-prolog-nox espeak-ng graphviz "
+                     "chromium libportaudio2"]
 
 
 def test_only_what_is_missing(tmp_path: Path) -> None:
-    assert _make_swipl(tmp_path, present=("swipl",)) == [
-        "update -qq", "install -y -qq --no-install-recommends espeak-ng"]
+    assert _make_swipl(tmp_path, present=("swipl", "dot", "dpkg")) == [
+        "update -qq", "install -y -qq --no-install-recommends espeak-ng chromium"]
 
 
 def test_nothing_when_everything_is_there(tmp_path: Path) -> None:
-    assert _make_swipl(tmp_path, present=("swipl", "espeak-ng")) == []
+    # dot: graphviz; dpkg answers that libportaudio2 is installed (the stand-in says yes)
+    assert _make_swipl(tmp_path, present=("swipl", "espeak-ng", "dot", "chromium", "dpkg")) == []

@@ -31,6 +31,8 @@ SUBCOMMANDS: dict[str, str] = {
     "head": "relrl.cli.head",
     "demo": "relrl.cli.demo",
     "examples": "relrl.cli.examples",
+    "replay": "relrl.cli.replay",
+    "tree": "relrl.cli.tree",
 }
 
 
@@ -48,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="relrl", description="Relational reinforcement learning for social "
                      "robots: shared attention with knowledge in SWI-Prolog.")
     parser.add_argument("--version", action="version", version=f"relrl {__version__}")
+    _add_verbosity(parser, 0)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, modname in SUBCOMMANDS.items():
         try:
@@ -61,15 +64,31 @@ def build_parser() -> argparse.ArgumentParser:
                            epilog=f"example:\n  {example}" if example else None,
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
+        _add_verbosity(p, argparse.SUPPRESS)  # also after the subcommand
         p.set_defaults(_run=mod.run)
     return parser
 
 
+def _add_verbosity(parser: argparse.ArgumentParser, default: object) -> None:
+    """``-v``/``-q`` (where a subcommand has not taken the letters for itself)."""
+    taken = parser._option_string_actions
+    if "-v" not in taken and "--verbose" not in taken:
+        parser.add_argument("-v", "--verbose", action="count", default=default,
+                            help="more messages (-vv: debug)")
+    if "-q" not in taken and "--quiet" not in taken:
+        parser.add_argument("-q", "--quiet", action="count", default=default,
+                            help="only warnings and errors; no progress bars")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``relrl`` command line; returns the exit status."""
+    from relrl import log
+
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(argv)
+    verbose, quiet = getattr(args, "verbose", 0), getattr(args, "quiet", 0)
+    log.setup(min(int(verbose), 2) - min(int(quiet is True or quiet), 1))
     args.command_line = "relrl " + shlex.join(argv)  # for the record of an output folder
     if not getattr(args, "_run", None):
         parser.print_help()

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 import math
-import re
 import sys
 
+from relrl.cli.session_flags import add_session_arguments, session_options
 from relrl.outdir import add_out_options
 
 HELP = "run a scripted interaction episode (simulator by default, or camera and head)"
@@ -35,29 +35,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-plots", action="store_true", help="do not write PNG plots")
     parser.add_argument("--check", action="store_true",
                         help="only check the script and print what it would run")
-
-
-_WORD = re.compile(r"[a-z][a-z0-9_]*")
-
-
-def _reader(queue) -> None:
-    """Typed words into ``queue``; bytes that are not UTF-8 or not words are skipped, said."""
-    stream = getattr(sys.stdin, "buffer", sys.stdin)
-    for raw in stream:
-        line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else raw
-        for word in line.strip().lower().split():
-            if _WORD.fullmatch(word):
-                queue.put(word)
-            else:
-                print(f"relrl run: ignored {word!r}: type words of letters, digits and _",
-                      file=sys.stderr, flush=True)
+    add_session_arguments(parser)
 
 
 def run(args: argparse.Namespace) -> int:
     """Check the script, run it, print the summary; 128 + N when stopped by signal N."""
-    import queue
-    import threading
-
     from relrl.episodes import RunOptions, StopRequest, load_episode
     from relrl.errors import ConfigError
 
@@ -68,8 +50,9 @@ def run(args: argparse.Namespace) -> int:
         episode.seed = args.seed
     if args.check:
         print(f"{args.episode}: ok - {episode.name}: {len(episode.phases)} phases, "
-              f"{episode.steps} time units, {len(episode.events)} events, learner "
-              f"{episode.learner} {episode.learner_params}, domain {episode.domain.name}")
+              f"{episode.steps} time units ({episode.time_unit}s), {len(episode.events)} events, "
+              f"learner {episode.learner} {episode.learner_params}, domain "
+              f"{episode.domain.name}")
         return 0
     if args.protocol and not args.head:
         raise ConfigError("--protocol needs --head PORT")
@@ -81,39 +64,36 @@ def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(step) and 0 <= step <= 60):
         raise ConfigError(f"--step-seconds must be a number of seconds from 0 to 60, not "
                           f"{step}")
-    words = None
-    if args.live:
-        words = queue.Queue()
-        threading.Thread(target=_reader, args=(words,), daemon=True).start()
-        print("live session: type words (e.g. apple, attention) and Enter; Ctrl-C stops",
-              flush=True)
     opts = RunOptions(head=args.head, protocol=args.protocol, calibration=args.calibration,
-                      camera=args.camera, live=args.live, step_seconds=step, words=words,
+                      camera=args.camera, live=args.live, step_seconds=step,
                       plots=not args.no_plots)
     stop = StopRequest()
-    if args.out is None:
-        summary = _run(episode, opts, stop)
-    else:
-        from relrl.outdir import OutDir
-
-        with OutDir.claim(args.out, command=args.command_line,
-                          overwrite=args.overwrite) as out:
-            opts.out = out.path
+    with session_options(args, episode, opts) as session:  # monitor, recording, words
+        if args.out is None:
             summary = _run(episode, opts, stop)
-            if not summary["partial"]:
-                out.status = "complete"
-    print(_report(summary))
-    if args.out:
-        policy = f", {summary['policy']}" if "policy" in summary else ""
-        print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
-        if "policy_error" in summary:
-            print(f"relrl run: the policy was not saved: {summary['policy_error']}",
-                  file=sys.stderr)
-    if summary["stopped_early"]:
-        print(f"stopped after time unit {summary['steps']} of {summary['planned_steps']}"
-              f"{' by ' + summary['stopped_by'] if summary['stopped_by'] else ''}; "
-              "everything up to it is written", file=sys.stderr)
-        return 128 + (stop.signum or 2)
+        else:
+            from relrl.outdir import OutDir
+
+            with OutDir.claim(args.out, command=args.command_line,
+                              overwrite=args.overwrite) as out:
+                opts.out = out.path
+                session.log_to(out.path / "run.log")
+                summary = _run(episode, opts, stop)
+                if not summary["partial"]:
+                    out.status = "complete"
+        print(_report(summary))
+        if args.out:
+            policy = f", {summary['policy']}" if "policy" in summary else ""
+            print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
+            if "policy_error" in summary:
+                print(f"relrl run: the policy was not saved: {summary['policy_error']}",
+                      file=sys.stderr)
+        if summary["stopped_early"]:
+            print(f"stopped after time unit {summary['units']} of {summary['planned_steps']}"
+                  f"{' by ' + summary['stopped_by'] if summary['stopped_by'] else ''}; "
+                  "everything up to it is written", file=sys.stderr)
+            return 128 + (stop.signum or 2)
+        session.hold()
     return 0
 
 
@@ -133,17 +113,10 @@ def _run(episode, opts, stop) -> dict:
 
 
 def _report(s: dict) -> str:
+    from relrl.experiments.fruits import report_lines
+
     cgi = "n/a" if s["cgi"] is None else f"{s['cgi']:.3f}"
-    head = (f"{s['episode']}: {s['steps']} time units, CGI {cgi} ({s['correct_shifts']}/"
-            f"{s['shifts']} shifts), eye contacts {s['eye_contacts']}/{s['opportunities']}, "
-            f"reward {s['rewards']['total']:+.0f}")
-    lines = [head]
-    for p in s.get("evaluation", []):
-        lines.append(f"  evaluation after {p['learning_steps']:4d} time units: CGI "
-                     f"{p['cgi_mean']:.3f} +- {p['cgi_std']:.3f}")
-    if "table1" in s:
-        lines.append("  Table 1 (mean +- sd %, measured | paper):")
-        for k, (m, sd) in s["table1"]["rates"].items():
-            pm, psd = s["table1"]["paper"][k]
-            lines.append(f"    {k:16s} {m:6.2f} +- {sd:5.2f} | {pm:6.2f} +- {psd:.2f}")
-    return "\n".join(lines)
+    head = (f"{s['episode']}: {s['units']} time units ({s['time_unit']}s, {s['steps']} control "
+            f"steps), CGI {cgi} ({s['correct_shifts']}/{s['shifts']} shifts), eye contacts "
+            f"{s['eye_contacts']}/{s['opportunities']}, reward {s['rewards']['total']:+.0f}")
+    return "\n".join([head] + report_lines(s))

@@ -67,6 +67,8 @@ class DeviceWorld(Environment):
         self.gaze = "frontal"
         self.t = 0
         self.heard: list[str] = []
+        self.last_frame: Any = None    # the frame perceived last and what perception found
+        self.last_percept: Any = None  # in it (the monitor and the recording show them)
         self._say = {}
         for ev in episode.events:
             self._say.setdefault(ev.t, []).extend(ev.say)
@@ -100,6 +102,7 @@ class DeviceWorld(Environment):
         if self.head is not None:
             self.focus = self.head.looking_at() or self.focus
         percept = self.perceiver.analyse(frame, looking_at=self.focus)
+        self.last_frame, self.last_percept = frame, percept
         facts = [f for f in percept.facts if f[0] not in ("pan", "tilt")]
         if percept.face is not None:
             self.gaze = "frontal" if percept.face.pose == "frontal" else \

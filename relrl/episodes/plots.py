@@ -22,6 +22,8 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
     except ImportError:
         return []
     files = []
+    # on devices, evaluations and naming ran on the scripted world: the titles say so
+    sim = " - SIMULATED" if summary.get("where", {}).get("simulated_evaluation") else ""
     if rewards:
         fig, ax = plt.subplots(figsize=(6, 3))
         r = np.asarray(rewards)
@@ -39,17 +41,17 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
     if summary.get("evaluation"):
         pts = summary["evaluation"]
         fig, ax = plt.subplots(figsize=(6, 3.5))
-        ax.errorbar([p["learning_steps"] for p in pts], [p["cgi_mean"] for p in pts],
+        ax.errorbar([p["units"] for p in pts], [p["cgi_mean"] for p in pts],
                     yerr=[p["cgi_std"] for p in pts], marker="o", capsize=3)
         ax.set_ylim(0, 1.05)
-        ax.set_xlabel("learning time units")
+        ax.set_xlabel(f"learning time units ({summary.get('time_unit', 'step')}s)")
         ax.set_ylabel("CGI (mean +- sd of runs)")
-        ax.set_title("Learning evolution (cf. the paper's Fig. 6)")
+        ax.set_title("Learning evolution (cf. the paper's Fig. 6)" + sim)
         fig.tight_layout()
         files.append(out / "cgi.png")
         fig.savefig(files[-1], dpi=100)
         plt.close(fig)
-    if summary.get("table1"):
+    if summary.get("table1") and summary["table1"]["rates"] is not None:
         rates, paper = summary["table1"]["rates"], summary["table1"]["paper"]
         keys = list(paper)
         x = np.arange(len(keys))
@@ -60,7 +62,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
                label="paper", capsize=3)
         ax.set_xticks(x, [k.replace("_", " ") for k in keys])
         ax.set_ylabel("rate (%)")
-        ax.set_title("Declarative pointing (Table 1)")
+        ax.set_title("Declarative pointing (Table 1)" + sim)
         ax.legend()
         fig.tight_layout()
         files.append(out / "table1.png")

@@ -26,6 +26,7 @@ from relrl.errors import UserError
 __all__ = [
     "OBJECT_PLACES",
     "PLACES",
+    "TIME_UNITS",
     "Episode",
     "EpisodeError",
     "Event",
@@ -38,6 +39,11 @@ _KINDS = ("apple", "lemon", "orange", "lime", "red", "orange", "yellow", "green"
           "purple")
 _CAREGIVERS = ("protocol", "script")
 _PERCEPTION = ("render", "symbolic")
+#: what a time unit is: a control step, or an interaction cycle of the protocol caregiver
+#: (eye contact and, with objects, one presentation; docs/episodes.md).
+TIME_UNITS = ("step", "interaction")
+_VARIATION = ("none", "camera")
+_EVAL_POLICIES = ("behaviour", "greedy")
 
 
 class EpisodeError(UserError):
@@ -107,7 +113,9 @@ class Episode:
     learner_params: dict[str, float] = field(default_factory=dict)
     policy_load: Path | None = None
     policy_save: str | None = "policy.pl"
+    time_unit: str = "step"
     perception: str = "render"
+    variation: str = "none"
     lighting: tuple[float, float] = (0.9, 1.1)
     fruits: tuple[str, ...] = ("apple", "lime", "orange")
     names: dict[str, str] = field(default_factory=dict)
@@ -115,7 +123,7 @@ class Episode:
     caregiver: dict[str, Any] = field(default_factory=dict)
     phases: list[Phase] = field(default_factory=list)
     events: list[Event] = field(default_factory=list)
-    evaluation: dict[str, int] | None = None
+    evaluation: dict[str, Any] | None = None
     naming: dict[str, int] | None = None
     speech: dict[str, Any] = field(default_factory=dict)
 
@@ -320,7 +328,8 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
 def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
     w = ("episode",)
     base = ep.path.parent
-    c.keys(head, ("name", "domain", "seed", "learner", "policy_load", "policy_save"), w)
+    c.keys(head, ("name", "domain", "seed", "learner", "policy_load", "policy_save",
+                  "time_unit"), w)
     ep.name = c.get(head, "name", str, ep.path.stem, w)
     domain = c.get(head, "domain", str, None, w)
     if domain is None:
@@ -346,6 +355,9 @@ def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
             c.fail(w + ("policy_load",), f"policy file {load!r} not found")
     save = c.get(head, "policy_save", str, "policy.pl", w)
     ep.policy_save = c.policy_file(save, w + ("policy_save",)) if save else None
+    unit = c.get(head, "time_unit", str, "step", w)
+    if c.choice(unit, TIME_UNITS, "time unit", w + ("time_unit",)):
+        ep.time_unit = unit
 
 
 def _learner_table(c: _Checker, params: dict[str, Any], ep: Episode) -> None:
@@ -372,10 +384,13 @@ def _learner_table(c: _Checker, params: dict[str, Any], ep: Episode) -> None:
 
 def _world_table(c: _Checker, world: dict[str, Any], ep: Episode) -> None:
     w = ("world",)
-    c.keys(world, ("perception", "lighting", "fruits", "names", "places"), w)
+    c.keys(world, ("perception", "variation", "lighting", "fruits", "names", "places"), w)
     mode = c.get(world, "perception", str, "render", w)
     if c.choice(mode, _PERCEPTION, "perception mode", w + ("perception",)):
         ep.perception = mode
+    variation = c.get(world, "variation", str, "none", w)
+    if c.choice(variation, _VARIATION, "appearance variation", w + ("variation",)):
+        ep.variation = variation
     light = c.get(world, "lighting", (float, int, list), [0.9, 1.1], w)
     light = [light, light] if not isinstance(light, list) else light
     if len(light) != 2 or not all(isinstance(x, (int, float)) and 0.05 <= x <= 3.0
@@ -476,10 +491,14 @@ def _optional_tables(c: _Checker, data: dict[str, Any], ep: Episode) -> None:
     if "evaluation" in data:
         ev = c.table(data, "evaluation")
         w = ("evaluation",)
-        c.keys(ev, ("every", "runs", "steps"), w)
+        c.keys(ev, ("every", "runs", "steps", "policy"), w)
         ep.evaluation = {"every": c.positive(ev, "every", 10, w),
                          "runs": c.positive(ev, "runs", 5, w, maximum=MAX_RUNS),
-                         "steps": c.positive(ev, "steps", 100, w)}
+                         "steps": c.positive(ev, "steps", 100, w),
+                         "policy": "behaviour"}
+        policy = c.get(ev, "policy", str, "behaviour", w)
+        if c.choice(policy, _EVAL_POLICIES, "evaluation policy", w + ("policy",)):
+            ep.evaluation["policy"] = policy
     if "naming" in data:
         nm = c.table(data, "naming")
         w = ("naming",)
@@ -488,6 +507,16 @@ def _optional_tables(c: _Checker, data: dict[str, Any], ep: Episode) -> None:
                      "presentations": c.positive(nm, "presentations", 40, w),
                      "confident_after": c.positive(nm, "confident_after", 3, w),
                      "max_steps": c.positive(nm, "max_steps", 1000, w)}
+    if ep.time_unit == "interaction":
+        # interaction cycles are counted by the protocol caregiver
+        for i, ph in enumerate(ep.phases):
+            if ph.caregiver != "protocol":
+                c.fail(("phase", i, "caregiver"), 'time_unit = "interaction" counts the '
+                       "protocol caregiver's cycles; this phase has caregiver = "
+                       f"{ph.caregiver!r}")
+        if ep.events:
+            c.fail(("event", 0), '[[event]] times are control steps; they cannot be used '
+                   'with time_unit = "interaction"')
     sp = c.table(data, "speech")
     w = ("speech",)
     c.keys(sp, ("say", "voice"), w)

@@ -14,7 +14,7 @@ policy so far are written, marked ``"partial": true``, before the error goes on
 
 from __future__ import annotations
 
-import json
+import logging
 import math
 import signal
 import sys
@@ -27,7 +27,10 @@ from typing import Any, TextIO
 
 import numpy as np
 
+from relrl.episodes.provenance import provenance, session_manifest
+from relrl.episodes.recording import SessionTap, write_manifest
 from relrl.episodes.script import Episode
+from relrl.progress import progress
 from relrl.terms import format_term
 
 __all__ = ["STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial", "run_episode"]
@@ -36,6 +39,8 @@ __all__ = ["STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial", "run_epi
 #: signals that stop a run after the current time unit (SIGHUP: the terminal was closed).
 STOP_SIGNALS = tuple(getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP")
                      if hasattr(signal, name))
+
+log = logging.getLogger(__name__)
 
 
 class StopRequest:
@@ -88,8 +93,13 @@ class RunOptions:
         step_seconds: pause per time unit (a live session on the simulator is slowed down so
             a person can follow and type).
         stream: where the live view goes.
-        words: a source of typed/recognised words (``get_nowait()``), or ``None``.
+        words: a source of typed/recognised words: a :class:`relrl.listen.WordSource`
+            (``poll()`` once per time unit) or a queue (``get_nowait()``), or ``None``.
         plots: write PNG plots (needs matplotlib).
+        monitor: the live monitor's :class:`relrl.monitor.Hub`, or ``None``.
+        record: record frames, trees and events into ``out`` (:mod:`.recording`).
+        record_rate: recorded frames per second at most (0: every time unit).
+        record_quality: JPEG quality of recorded frames.
     """
 
     out: Path | None = None
@@ -102,27 +112,14 @@ class RunOptions:
     stream: TextIO = field(default_factory=lambda: sys.stdout)
     words: Any = None
     plots: bool = True
+    monitor: Any = None
+    record: bool = False
+    record_rate: float = 10.0
+    record_quality: int = 85
 
 
 def _json_num(x: float) -> float | None:
     return None if isinstance(x, float) and math.isnan(x) else x
-
-
-class _Trace:
-    """trace.jsonl, one flushed line per time unit."""
-
-    def __init__(self, path: Path | None) -> None:
-        self.fh = open(path, "w", encoding="utf-8") if path is not None else None  # noqa: SIM115
-
-    def write(self, row: dict[str, Any]) -> None:
-        if self.fh is not None:
-            self.fh.write(json.dumps(row, sort_keys=True) + "\n")
-            self.fh.flush()
-
-    def close(self) -> None:
-        if self.fh is not None:
-            self.fh.close()
-            self.fh = None
 
 
 class _Run:
@@ -153,8 +150,10 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.executions: list[dict[str, Any]] = []
         self.t = 0
-        self.done = 0  # learning time units finished (traced)
+        self.done = 0  # control steps of learning finished (traced)
+        self.units = 0  # learning time units finished
         self.in_view = None
+        self.tap: Any = None
 
     def close(self) -> None:
         self.kb.close()
@@ -176,12 +175,8 @@ def _live_line(t: int, phase: str, record: Any, outcome: str | None, said: str |
     return text
 
 
-#: What a traced step asks the engine for, in the step's one gateway call.
-TRACE_WANTS = ("memory_size", "explain")
-
-
-def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
-    """Trace, naming and live output of one time unit."""
+def _on_step(run: _Run, record: Any, phase: str) -> None:
+    """Naming, metrics, the trace and the monitor (:class:`SessionTap`), live output."""
     run.done += 1
     info = record.info
     said = None
@@ -196,36 +191,29 @@ def _on_step(run: _Run, trace: _Trace, record: Any, phase: str) -> None:
     stats["steps"] += 1
     stats["reward"] += float(record.out.reward)
     stats["attention"] += int(info["record"].attention)
-    out = record.out
-    trace.write({
-        "t": run.t, "phase": phase,
-        "percepts": [format_term(p) for p in record.percepts],
-        "memory": out.memory_size,
-        "state": out.code, "necessity": out.necessity,
-        "activation": {k: round(v, 6) for k, v in out.outputs.items()},
-        "reward": out.reward,
-        "response": format_term(out.action) if out.action is not None else None,
-        "allowed": [format_term(a) for a in out.allowed],
-        "explanation": out.explanation,
-        "caregiver": info.get("scene"), "focus": info["record"].focus,
-        "heard": info["words"], "naming": outcome, "said": said,
-    })
+    run.tap.step(record, phase, outcome=outcome, said=said)
     if run.opts.live:
         print(_live_line(run.t, phase, record, outcome, said), file=run.opts.stream,
               flush=True)
 
 
 def _pull_words(run: _Run, env: Any) -> None:
-    import queue
-
+    """Words heard in this time unit (typed, recognised from the microphone or a file)."""
     source = run.opts.words
     if source is None:
         return
-    while True:
-        try:
-            word = source.get_nowait()
-        except queue.Empty:
-            return
+    if hasattr(source, "poll"):  # a relrl.listen.WordSource
+        words = source.poll()
+    else:  # a queue of words (get_nowait)
+        import queue
+
+        words = []
+        while True:
+            try:
+                words.append(source.get_nowait())
+            except queue.Empty:
+                break
+    for word in words:
         if word:
             env.hear(word)
 
@@ -247,63 +235,100 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     run = _Run(episode, opts)
-    trace = _Trace(out / "trace.jsonl" if out is not None else None)
+    where = provenance(opts)
     env = actuator = None
+    bar = None
     written = failed = False
     try:
         env, actuator = _world(episode, opts)
+        run.tap = SessionTap(run, out, env, getattr(actuator, "head", None), hub=opts.monitor,
+                             record=opts.record, record_rate=opts.record_rate,
+                             record_quality=opts.record_quality)
         phase_name = episode.phase_at(1).name
         interaction = Interaction(env, run.agent, actuator=actuator,
-                                  on_step=lambda r: _on_step(run, trace, r, phase_name))
+                                  on_step=lambda r: _on_step(run, r, phase_name))
         info = interaction.reset(seed=episode.seed)
+        run.tap.start()
         run.in_view = info.get("features")
         ev = episode.evaluation
         eval_seeds = [int(s) for s in np.random.SeedSequence([episode.seed, 2])
                       .generate_state(ev["runs"])] if ev else []
+        bar = progress(episode.steps, f"{episode.name}", unit="unit",
+                       enabled=not opts.live)
 
         def evaluate() -> None:
             point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
-            point["learning_steps"] = run.t
+            point["units"], point["control_steps_learning"] = run.units, run.t
+            point["on"] = where["evaluation"]
             _flag_cut_short(point, "cgi_runs", len(eval_seeds))
             run.curve.append(point)
+            run.tap.event("evaluation", cgi_mean=point["cgi_mean"], cgi_std=point["cgi_std"],
+                          on=where["evaluation"])
+            line = (f"evaluation{where['evaluation_label']} after {run.units} "
+                    f"{episode.time_unit}s: CGI "
+                    f"{point['cgi_mean']:.3f} +- {point['cgi_std']:.3f}")
             if opts.live:
-                print(f"evaluation after {run.t} time units: CGI {point['cgi_mean']:.3f} +- "
-                      f"{point['cgi_std']:.3f}", file=opts.stream, flush=True)
+                print(line, file=opts.stream, flush=True)
+            log.info(line)
             # learning resumes where it stopped: the world keeps its time line (and phase)
 
-        for t in range(1, episode.steps + 1):
+        cycles = episode.time_unit == "interaction"
+        bound = fruits.unit_bound(episode) if cycles else 1
+        for unit in range(1, episode.steps + 1):
             if stop():
                 break
-            if ev and (t - 1) % ev["every"] == 0:
+            if ev and (unit - 1) % ev["every"] == 0:
                 evaluate()
-            phase = episode.phase_at(t)
+            phase = episode.phase_at(unit)
             phase_name = phase.name
-            _pull_words(run, env)
-            run.t = t
-            interaction.run(1, learning=phase.learning, keep=False,
-                            want=TRACE_WANTS if out is not None else ())
-            if opts.step_seconds:
-                time.sleep(opts.step_seconds)
+            for _ in range(bound):   # one time unit: a control step, or a whole cycle
+                if stop():
+                    break
+                _pull_words(run, env)
+                run.t += 1
+                interaction.run(1, learning=phase.learning, keep=False, want=run.tap.want())
+                if opts.step_seconds:
+                    time.sleep(opts.step_seconds)
+                if not cycles or env.units_done >= unit:
+                    break
+            if not stop():
+                run.units = unit
+                bar.update(1)
+        bar.close()
         if ev and not stop() and episode.steps % ev["every"] == 0:
             evaluate()
         if episode.naming and not stop():
+            bar = progress(episode.naming["executions"], "naming executions",
+                           unit="execution", enabled=not opts.live)
             for k in range(episode.naming["executions"]):
                 if stop():
                     break
                 res = fruits.naming_execution(run.agent, episode, episode.seed * 1000 + k,
                                               stop=stop)
+                res["on"] = where["naming"]
                 if stop():
                     res["interrupted"] = True  # kept, flagged, left out of the rates
                 run.executions.append(res)
+                run.tap.event("naming", execution=k + 1, counts=res["counts"],
+                              on=where["naming"])
+                line = (f"naming execution {k + 1}{where['naming_label']}: {res['counts']} "
+                        f"({res['presentations']} presentations)")
                 if opts.live:
-                    print(f"naming execution {k + 1}: {res['counts']} "
-                          f"({res['presentations']} presentations)", file=opts.stream,
-                          flush=True)
+                    print(line, file=opts.stream, flush=True)
+                log.info(line)
+                bar.update(1)
+            bar.close()
+        recorded = run.tap.finish()
         summary = _summary(run, stopped=stop(), why=_signal_name(stop))
-        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t}
+        summary["where"] = {k: v for k, v in where.items() if not k.endswith("_label")}
+        timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t,
+                  "evaluation_steps": sum(p["control_steps"] for p in run.curve),
+                  "naming_steps": sum(e["steps"] for e in run.executions)}
         if out is not None:
             written = True
             _write_outputs(run, out, summary, timing)
+            if opts.record:
+                write_manifest(out, session_manifest(run, opts, summary, timing, recorded))
         return summary
     except BaseException as exc:  # a lost device, a fault, a second Ctrl-C
         failed = True
@@ -311,8 +336,11 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             keep_partial(run, out, t0, exc)
         raise
     finally:
-        trace.close()
+        if bar is not None:
+            bar.close()
         try:
+            if getattr(run, "tap", None) is not None:
+                run.tap.close()
             _release(actuator, env, quiet=failed)
         finally:
             run.close()
@@ -338,7 +366,11 @@ def _release(*things: Any, quiet: bool) -> None:
 
 def _world(episode: Episode, opts: RunOptions) -> tuple[Any, Any]:
     from relrl.episodes.devices import DeviceWorld, HeadActuator
+    from relrl.errors import ConfigError
 
+    if opts.camera is not None and episode.time_unit != "step":
+        raise ConfigError(f"{episode.path}: time_unit = {episode.time_unit!r} counts the "
+                          "simulated caregiver's cycles; on a camera use time_unit = \"step\"")
     actuator = None
     if opts.head is not None:
         from head import open_head
@@ -376,8 +408,9 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
     summary: dict[str, Any] = {
         "episode": ep.name, "script": str(ep.path), "seed": ep.seed,
         "learner": {"name": ep.learner, "params": run.learner.params},
-        "steps": run.t, "planned_steps": ep.steps, "stopped_early": stopped,
-        "partial": stopped or run.t < ep.steps, "stopped_by": why,
+        "time_unit": ep.time_unit, "units": run.units, "steps": run.t,
+        "planned_steps": ep.steps, "stopped_early": stopped,
+        "partial": stopped or run.units < ep.steps, "stopped_by": why,
         "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
         "eye_contacts": e.established, "opportunities": e.opportunities,
         "mutual_gaze_events": m.mutual_gaze_events,
@@ -390,10 +423,7 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
-        complete = [x for x in run.executions if not x.get("interrupted")]
-        summary["table1"] = {"executions": run.executions,
-                             "rates": fruits.rates(complete) if complete else {},
-                             "paper": fruits.PAPER["table1"]}
+        summary["table1"] = fruits.table1(run.executions)
     return summary
 
 
@@ -421,7 +451,7 @@ def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
         exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore[attr-defined]
         return
     policy = f" and {summary['policy']}" if "policy" in summary else ""
-    exc.kept = (f"learned up to time unit {run.t} of {ep.steps}: summary.json"  # type: ignore
+    exc.kept = (f"learned up to time unit {run.units} of {ep.steps}: summary.json"  # type: ignore
                 f"{policy} written to {out} (partial)")
 
 
@@ -438,7 +468,8 @@ def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
             if not path.resolve().is_relative_to(out.resolve()):
                 raise OSError(f"{ep.policy_save} leads outside {out}")
             run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
-                                   f"seed {ep.seed}, {run.t} time units"
+                                   f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "
+                                   f"{run.t} control steps"
                                    + (" (partial)" if summary.get("partial") else ""))
             summary["policy"] = ep.policy_save
         except (RelrlError, OSError) as exc:  # the summary is written all the same

@@ -69,32 +69,43 @@ class ProtocolCaregiver:
       ``contact_hold`` time units); gives attention in the time unit of eye contact and after
       it, and, with ``gaze_attention`` (default), in every time unit the robot looks at its
       face (Triesch et al.'s reward for looking at the caregiver, as in Experiment 1); a new
-      opportunity starts after ``contact_timeout`` units without contact.
+      opportunity starts after ``contact_timeout`` units without contact. Without objects
+      the eye contact is held ``joint`` more units (or until the robot looks away) and then a
+      new opportunity starts, so that every interaction cycle ends.
     * ``present`` (only when the phase has objects): with ``latency`` 0 (default), in the time
       unit of eye contact a fruit appears at a place and the caregiver turns to it (random in
       learning, a fixed cycle in evaluation); otherwise ``latency`` units later.
     * ``attend``: when the robot looks at the fruit the caregiver looks at, the caregiver gives
       attention and says the fruit's name (``hear(Word)``); after ``timeout`` units without it
-      the fruit is removed.
+      the fruit is removed. With ``first_shift`` (the paper's evaluation) only the robot's
+      first turn away from the face is checked: a turn elsewhere ends the presentation.
     * ``joint``: both look at the fruit for up to ``joint`` units; naming it (``name_object``)
       earns attention; then the fruit is removed and the caregiver looks at the robot again.
+
+    An interaction cycle (one ``opportunity``) runs from the caregiver turning to the robot to
+    the next time she does: eye contact, then (with objects) the presentation.
 
     Args:
         episode: the script (caregiver parameters, fruits, places, names).
         sequence: place the fruits in a pre-established cycle (evaluation) instead of at random.
+        first_shift: check only the robot's first turn of each presentation (evaluation).
     """
 
-    def __init__(self, episode: Episode, *, sequence: bool = False) -> None:
+    def __init__(self, episode: Episode, *, sequence: bool = False,
+                 first_shift: bool = False) -> None:
         self.p = dict(episode.caregiver)
         self.fruits = episode.fruits
         self.places = episode.places
         self.word_for = episode.word_for
         self.sequence = sequence
+        self.first_shift = first_shift
         self.rng = np.random.default_rng(0)
         self.scene = Scene()
         self._streak = 0
         self._timer = 0
         self._kind: str | None = None
+        self._held = False
+        self._missed = False
 
     def reset(self, rng: np.random.Generator) -> Scene:
         """Start over: looking at the robot, nothing on the table."""
@@ -102,6 +113,7 @@ class ProtocolCaregiver:
         self.scene = Scene()
         self._streak = self._timer = 0
         self._kind = None
+        self._held = self._missed = False
         return self.scene
 
     def _next_fruit(self) -> tuple[str, str]:
@@ -122,8 +134,12 @@ class ProtocolCaregiver:
     def _end_trial(self) -> None:
         s = self.scene
         s.objects, s.look, s.mode, s.target = {}, "centre", "engage", None
-        s.opportunity += 1
+        self._next_cycle()
+
+    def _next_cycle(self) -> None:
+        self.scene.opportunity += 1
         self._streak = self._timer = 0
+        self._held = self._missed = False
 
     def advance(self, focus: str, named: bool, objects: bool) -> Scene:
         """One time unit, seeing where the robot now looks and whether it named the object."""
@@ -134,13 +150,19 @@ class ProtocolCaregiver:
             self._streak = self._streak + 1 if focus == "centre" else 0
             self._timer += 1
             s.attention = focus == "centre" and p["gaze_attention"]
-            if self._streak >= p["contact_hold"]:
+            if self._held and focus != "centre":
+                self._next_cycle()          # no objects: the robot looked away after contact
+            elif self._streak >= p["contact_hold"]:
                 s.attention = True
                 s.contact = self._streak == p["contact_hold"]
                 if objects and p["latency"] == 0:
                     self._present()
                 elif objects:
                     s.mode, self._timer = "present", 0
+                else:
+                    self._held = True
+                    if self._streak >= p["contact_hold"] + p["joint"]:
+                        self._next_cycle()  # eye contact held: the cycle is over
             elif self._timer >= p["contact_timeout"]:
                 s.opportunity += 1
                 self._timer = 0
@@ -154,13 +176,15 @@ class ProtocolCaregiver:
                 s.attention = True
                 s.words = [self.word_for(self._kind or "")]
                 s.mode, self._timer = "joint", 0
+            elif self.first_shift and focus != "centre":
+                s.mode, self._timer, self._missed = "joint", 0, True
             elif self._timer >= p["timeout"]:
                 self._end_trial()
         elif s.mode == "joint":
             self._timer += 1
-            if named and focus == s.target:
+            if named and focus == s.target and not self._missed:
                 s.attention = True
-            if named or focus != s.target or self._timer >= p["joint"]:
+            if self._missed or named or focus != s.target or self._timer >= p["joint"]:
                 self._end_trial()
         return s
 
@@ -182,22 +206,35 @@ class ProtocolCaregiver:
 class EpisodeWorld(Environment):
     """An episode's world as an :class:`~relrl.interfaces.Environment`.
 
+    Time is counted in the script's time unit (:attr:`units_done`): control steps
+    (``time_unit = "step"``) or interaction cycles of the protocol caregiver
+    (``"interaction"``: one eye-contact opportunity and, with objects, its presentation).
+
+    With ``variation = "camera"`` in render mode every frame is drawn as a webcam in a lit room
+    would see it (:mod:`perception.appearance`): the room's light is the same for every world
+    of the run (drawn from the episode's seed: the paper did not change the light), white
+    balance and the fruit (shade, shape, size, place in view, the caregiver's hand) change
+    with each presentation, exposure, blur and noise with each frame.
+
     Args:
         episode: the script.
         protocol_only: the protocol caregiver with objects all the time and no script events
             (evaluation runs and naming executions), whatever the phases say.
         sequence: place fruits in a pre-established cycle (evaluation) instead of at random.
+        first_shift: check only the robot's first turn of each presentation (evaluation).
         perceiver: a :class:`perception.Perceiver` to share (render mode).
-        max_steps: truncate after this many time units (``None``: never).
+        max_units: truncate after this many time units (``None``: never).
     """
 
     def __init__(self, episode: Episode, *, protocol_only: bool = False, sequence: bool = False,
-                 perceiver: Any = None, max_steps: int | None = None) -> None:
+                 first_shift: bool = False, perceiver: Any = None,
+                 max_units: int | None = None) -> None:
         self.episode = episode
         self.protocol_only = protocol_only
-        self.caregiver = ProtocolCaregiver(episode, sequence=sequence)
-        self.max_steps = max_steps
+        self.caregiver = ProtocolCaregiver(episode, sequence=sequence, first_shift=first_shift)
+        self.max_units = max_units
         self.render_mode = episode.perception == "render"
+        self.cycles = episode.time_unit == "interaction"
         self._perceiver = perceiver
         self._events: dict[int, list[Event]] = {}
         if not protocol_only:
@@ -208,6 +245,24 @@ class EpisodeWorld(Environment):
         self.focus = "centre"
         self.heard: list[str] = []
         self.last_frame: np.ndarray | None = None
+        self.last_percept: Any = None  # what perception found in last_frame (the monitor)
+        self.variation = None
+        if self.render_mode and episode.variation == "camera":
+            from perception.appearance import Variation
+
+            self.variation = Variation(exposure=episode.lighting)
+            # the room: one light for every world of this run
+            self.room = self.variation.session_light(np.random.default_rng([episode.seed, 7]))
+        self._look_rng = np.random.default_rng(0)
+        self._looks: dict[str, tuple[int, str, Any]] = {}
+        self._light: Any = None
+        self._moved = False
+        self._unit = 1
+
+    @property
+    def units_done(self) -> int:
+        """Time units completed: control steps, or interaction cycles."""
+        return self.caregiver.scene.opportunity if self.cycles else self.t
 
     @property
     def perceiver(self) -> Any:
@@ -232,6 +287,9 @@ class EpisodeWorld(Environment):
         self.caregiver.reset(self.rng)
         focus = (options or {}).get("focus")
         self.focus = focus if focus in PLACES else PLACES[int(self.rng.integers(len(PLACES)))]
+        # appearance draws from a stream of its own: the same caregiver with or without it
+        self._look_rng = np.random.default_rng([int(self.rng.integers(2**31)), 11])
+        self._looks, self._light, self._moved, self._unit = {}, None, False, 1
         if self.render_mode:
             self.perceiver.reset()
         return None, self._observe(named=False)
@@ -239,10 +297,13 @@ class EpisodeWorld(Environment):
     def step(self, action: Term) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Apply the response, advance the caregiver and the script one time unit, perceive."""
         named = action == "name_object"
+        before = self.focus
         if isinstance(action, tuple) and action[0] == "look" and action[1] in PLACES:
             self.focus = action[1]
+        self._moved = self.focus != before
         self.t += 1
-        phase = self.episode.phase_at(self.t)
+        self._unit = self.units_done + 1 if self.cycles else self.t
+        phase = self.episode.phase_at(self._unit)
         objects = True if self.protocol_only else phase.objects
         if self.protocol_only or phase.caregiver == "protocol":
             self.caregiver.advance(self.focus, named, objects)
@@ -252,9 +313,25 @@ class EpisodeWorld(Environment):
         for ev in self._events.get(self.t, ()):
             self.caregiver.apply(ev)
         info = self._observe(named)
-        truncated = self.max_steps is not None and self.t >= self.max_steps
+        truncated = self.max_units is not None and self.units_done >= self.max_units
         reward = 1.0 if self.caregiver.scene.attention else 0.0
         return None, reward, False, truncated, info
+
+    def _appearance(self, scene: Scene) -> Any:
+        """This frame's appearance: a new light and new fruit looks with each presentation."""
+        from perception.appearance import Appearance
+
+        var, rng = self.variation, self._look_rng
+        if self._light is None or self._light[0] != scene.opportunity:
+            self._light = (scene.opportunity, var.light(rng, self.room))
+        for place, kind in scene.objects.items():
+            held = self._looks.get(place)
+            if held is None or held[:2] != (scene.trial, kind):
+                self._looks[place] = (scene.trial, kind, var.fruit(rng, kind)
+                                      if kind in var.shades else None)
+        looks = {p: look for p, (_, _, look) in self._looks.items()
+                 if p in scene.objects and look is not None}
+        return Appearance(var.exposed(rng, self._light[1]), var.optics(rng, self._moved), looks)
 
     def _view_facts(self, scene: Scene) -> tuple[list[Term], np.ndarray | None]:
         focus = self.focus
@@ -271,11 +348,16 @@ class EpisodeWorld(Environment):
         from perception.render import SceneView, render
 
         low, high = self.episode.lighting
-        view = SceneView(focus, GAZE_POSE[scene.look], dict(scene.objects),
-                         float(self.rng.uniform(low, high)), int(self.rng.integers(2**31)))
+        if self.variation is not None:
+            app, gain = self._appearance(scene), 1.0
+        else:
+            app, gain = None, float(self.rng.uniform(low, high))
+        view = SceneView(focus, GAZE_POSE[scene.look], dict(scene.objects), gain,
+                         int(self.rng.integers(2**31)), app)
         frame = render(view)
         self.last_frame = frame
         percept = self.perceiver.analyse(frame, looking_at=focus)
+        self.last_percept = percept
         facts = [f for f in percept.facts if not (isinstance(f, tuple) and f[0] in
                                                   ("pan", "tilt"))]
         if not facts:
@@ -301,7 +383,7 @@ class EpisodeWorld(Environment):
                 "scene": {"look": scene.look, "objects": dict(scene.objects),
                           "mode": scene.mode, "target": scene.target,
                           "kind": scene.objects.get(scene.target or "", None)},
-                "phase": self.episode.phase_at(max(self.t, 1)).name}
+                "unit": self._unit, "phase": self.episode.phase_at(self._unit).name}
 
     def close(self) -> None:
         """Nothing to release."""

@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "write_outputs", "summary_table", "write_json_atomic"]
+__all__ = ["aggregate", "pyplot_or_note", "skip_plots", "summary_table", "write_json_atomic",
+           "write_outputs"]
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -25,18 +26,23 @@ def write_json_atomic(path: Path, data: Any) -> None:
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
-    """Per learner: the CGI curve pooled over seeds, eye contacts, memory, states met."""
+    """Per learner: the CGI curves (relrl's and literal) pooled over seeds, eye contacts,
+    memory, states met. Jobs stopped part-way contribute the points they finished."""
     out: dict[str, Any] = {}
     for name in learners:
         mine = sorted((j for j in jobs if j["learner"] == name), key=lambda j: j["seed"])
         if not mine:
             continue
-        points = len(mine[0]["curve"])
+        points = max(len(j["curve"]) for j in mine)
         curve = []
         for p in range(points):
-            runs = [v for j in mine for v in j["curve"][p]["cgi_runs"]]
-            curve.append({"point": p, "learning_steps": mine[0]["curve"][p]["learning_steps"],
+            have = [j["curve"][p] for j in mine if len(j["curve"]) > p]
+            runs = [v for c in have for v in c["cgi_runs"]]
+            literal = [v for c in have for v in c["cgi_literal_runs"]]
+            curve.append({"point": p, "learning_steps": have[0]["learning_steps"],
                           "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
+                          "cgi_literal_mean": float(np.mean(literal)),
+                          "cgi_literal_std": float(np.std(literal)),
                           "n_runs": len(runs)})
         n_opp = min(len(j["eye_contacts"]["per_opportunity"]) for j in mine)
         flags = np.array([j["eye_contacts"]["per_opportunity"][:n_opp] for j in mine],
@@ -44,13 +50,17 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
         cumulative = np.cumsum(flags, axis=1).mean(axis=0) if n_opp else np.zeros(0)
         established = [j["eye_contacts"]["established"] for j in mine]
         memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
-        first = mine[0]["curve"][1] if points > 1 else None
-        memory_first = ({k: float(np.mean([j["curve"][1]["memory"][k] for j in mine]))
-                         for k in first["memory"]} if first and "memory" in first else None)
+        evaluation = [j["states_met"]["evaluation"] for j in mine
+                      if j["states_met"]["evaluation"] is not None]
+        firsts = [j["curve"][1]["memory"] for j in mine if len(j["curve"]) > 1]
+        memory_first = ({k: float(np.mean([m[k] for m in firsts])) for k in firsts[0]}
+                        if firsts else None)
         out[name] = {
             "curve": curve,
             "cgi_after_first_run": curve[1]["cgi_mean"] if points > 1 else None,
             "cgi_final": curve[-1]["cgi_mean"],
+            "cgi_literal_after_first_run": curve[1]["cgi_literal_mean"] if points > 1 else None,
+            "cgi_literal_final": curve[-1]["cgi_literal_mean"],
             "eye_contacts": {"mean": float(np.mean(established)),
                              "std": float(np.std(established)),
                              "opportunities": n_opp,
@@ -58,8 +68,8 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
             "memory": memory,
             "memory_after_first_run": memory_first,
             "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
-            "states_met_evaluation": float(np.mean([j["states_met"]["evaluation"]
-                                                    for j in mine])),
+            "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
+            "partial": any(j.get("partial", False) for j in mine),
         }
         if "cgi_places" in mine[0]["curve"][0]:
             out[name]["cgi_places"] = _places_curve(mine, points)
@@ -73,7 +83,8 @@ def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any
     for group in jobs[0]["curve"][0]["cgi_places"]:
         values = []
         for p in range(points):
-            runs = [r for j in jobs for r in j["curve"][p]["cgi_places"][group]["runs"]]
+            runs = [r for j in jobs if len(j["curve"]) > p
+                    for r in j["curve"][p]["cgi_places"][group]["runs"]]
             shifts = sum(r[1] for r in runs)
             values.append(sum(r[0] for r in runs) / shifts if shifts else None)
         out[group] = values
@@ -81,25 +92,24 @@ def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any
 
 
 def summary_table(summary: dict[str, Any]) -> str:
-    """The results as a fixed-width text table (with held-out places: the final CGI on the
-    trained and on the held-out places too)."""
+    """The results as a fixed-width text table."""
+    nan = float("nan")
     places = any("cgi_places" in s for s in summary.values())
-    head = (f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'eye contacts':>13} "
-            f"{'memory':>8} {'states':>7}")
-    if places:
-        head += f" {'trained':>8} {'held out':>8}"
-    lines = [head]
+    head = (f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'literal':>8} "
+            f"{'eye contacts':>13} {'memory':>8} {'states':>7}")
+    lines = [head + (f" {'trained':>8} {'held out':>8}" if places else "")]
     for name, s in summary.items():
         ec = s["eye_contacts"]
         first = s["cgi_after_first_run"]
-        line = (f"{name:<12} {first if first is not None else float('nan'):>9.3f} "
-                f"{s['cgi_final']:>9.3f} {ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
+        line = (f"{name:<12} {first if first is not None else nan:>9.3f} "
+                f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
+                f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
                 f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
         if places:
             for group in ("trained", "held_out"):
                 v = s.get("cgi_places", {}).get(group, [None])[-1]
                 line += f" {v:>8.3f}" if v is not None else f" {'-':>8}"
-        lines.append(line)
+        lines.append(line + ("  (partial)" if s.get("partial") else ""))
     return "\n".join(lines)
 
 
@@ -116,11 +126,13 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
     fig5 = out_dir / "fig5_cgi.csv"
     with open(fig5, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "n_runs"])
+        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std",
+                    "cgi_literal_mean", "cgi_literal_std", "n_runs"])
         for name, s in summary.items():
             for c in s["curve"]:
                 w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
-                            f"{c['cgi_std']:.6f}", c["n_runs"]])
+                            f"{c['cgi_std']:.6f}", f"{c['cgi_literal_mean']:.6f}",
+                            f"{c['cgi_literal_std']:.6f}", c["n_runs"]])
     fig4 = out_dir / "fig4_eye_contacts.csv"
     with open(fig4, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -148,13 +160,22 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
                                             else f"{groups[g][p]:.6f}"
                                             for g in ("trained", "held_out")])
         written.append(places)
-    written += plot(out_dir, summary)
+    written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
 
 
-def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
-    """Fig. 4 and Fig. 5 as PNG files (and, with held-out places, the CGI on trained and
-    held-out places); nothing (and a note) without matplotlib."""
+def skip_plots(out_dir: Path) -> list[Path]:
+    """A note in place of the figures of an interrupted run (drawing them would delay the
+    stop by seconds; the numbers are in results.json and the CSVs)."""
+    note = out_dir / "PLOTS.txt"
+    note.write_text("The run was interrupted, so no figures were drawn (to stop at once); "
+                    "every finished point is in results.json and the CSV files.\n")
+    return [note]
+
+
+def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
+    """``(matplotlib.pyplot, [])`` drawing off-screen, or ``(None, [note])`` with a note in
+    ``out_dir`` saying how to get plots when matplotlib is not installed."""
     try:
         import matplotlib
 
@@ -165,7 +186,17 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
                         "are in the CSV files.\nInstall the extra to get plots:  "
                         "pip install 'relrl[plots]'\n")
-        return [note]
+        return None, [note]
+    return plt, []
+
+
+def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
+    """Fig. 4 and Fig. 5 as PNG files (and, with held-out places, the CGI on trained and
+    held-out places); nothing (and a note) without matplotlib."""
+    plt, note = pyplot_or_note(out_dir)
+    if plt is None:
+        return note
+
     def finish(fig, ax, name: str, xlabel: str, ylabel: str, title: str) -> Path:
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -182,9 +213,11 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, s in summary.items():
         steps = [c["point"] for c in s["curve"]]
-        ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
-                    yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3, capsize=3,
-                    label=name)
+        bars = ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
+                           yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3,
+                           capsize=3, label=name)
+        ax.plot(steps, [c["cgi_literal_mean"] for c in s["curve"]], ls="--", lw=1,
+                color=bars[0].get_color(), label=f"{name} (Eq. 5 literally)")
     ax.set_ylim(-0.05, 1.05)
     files.append(finish(fig, ax, "fig5_cgi.png",
                         "run (evaluation point; 500 learning time units each)",

@@ -50,8 +50,9 @@ def test_experiment2_has_the_papers_settings() -> None:
     assert ep.learner_params == {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05}
     assert [p.steps for p in ep.phases] == [30, 70]
     assert ep.phases[0].objects is False
-    assert ep.evaluation == {"every": 10, "runs": 5, "steps": 100}
-    assert ep.naming["executions"] == 5
+    assert ep.time_unit == "interaction" and ep.variation == "camera"
+    assert ep.evaluation == {"every": 25, "runs": 5, "steps": 100, "policy": "behaviour"}
+    assert ep.naming["executions"] == 5 and ep.naming["presentations"] == 150
 
 
 def test_parse_good_script() -> None:

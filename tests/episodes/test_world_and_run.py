@@ -189,7 +189,7 @@ runs = 1
 steps = 5
 """), tmp_path / "e.toml")
     s = run_episode(ep, RunOptions(out=tmp_path, plots=False))
-    assert [p["learning_steps"] for p in s["evaluation"]] == [0, 5, 10, 15, 20, 25]
+    assert [p["units"] for p in s["evaluation"]] == [0, 5, 10, 15, 20, 25]
     rows = [json.loads(x) for x in (tmp_path / "trace.jsonl").read_text().splitlines()]
     assert not any(r["caregiver"]["objects"] for r in rows if r["phase"] == "no objects")
     assert any(r["caregiver"]["objects"] for r in rows if r["t"] > 10)

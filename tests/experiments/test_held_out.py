@@ -1,5 +1,5 @@
-"""``relrl experiment sis --train-places/--eval-places``: places held out while learning,
-the CGI on trained and held-out places apart; tg learns in the simulator."""
+"""``relrl experiment sis --train-places/--eval-places`` with tg among the learners (the
+place split itself: test_sis_experiment.py); tg learns in the simulator."""
 
 from __future__ import annotations
 
@@ -10,37 +10,9 @@ from pathlib import Path
 import pytest
 
 from relrl.cli import main
-from relrl.experiments.sis import SISConfig, _caregivers, _PlaceShifts, run_job
-from relrl.sim.metrics import StepRecord
+from relrl.experiments.sis import SISConfig, run_job
 
 SMALL = ["--points", "1", "--eval-runs", "2", "--eval-steps", "150", "--block", "300"]
-
-
-def record(t: int, focus: str, gaze: str) -> StepRecord:
-    return StepRecord(t, focus, gaze, "attend", 0, 0, (), None, False, False)
-
-
-def test_shifts_counted_by_the_place_the_caregiver_looked_at() -> None:
-    shifts = _PlaceShifts({"trained": {"left", "down"}, "held_out": {"right"}})
-    trace = [record(0, "centre", "left"), record(1, "left", "left"),      # followed: left
-             record(2, "centre", "right"), record(3, "down", "right"),    # wrong: right
-             record(4, "centre", "right"), record(5, "centre", "right"),  # no shift yet
-             record(6, "right", "frontal"),                               # followed: right
-             record(7, "centre", "frontal"), record(8, "left", "frontal")]  # not a shift
-    for r in trace:
-        shifts.add(r)
-    assert shifts.counts == {"trained": [1, 1], "held_out": [1, 2]}
-
-
-def test_learning_caregiver_places_toys_only_at_the_trained_places() -> None:
-    config = SISConfig(train_places=["left", "left_down", "down"])
-    learning, evaluation, groups = _caregivers(config)
-    assert {p for p, w in learning.params.placement.items() if w > 0} == \
-        {"left", "left_down", "down"}
-    assert set(evaluation.params.target_sequence) == \
-        {"left", "left_down", "down", "right_down", "right"}
-    assert groups == {"trained": {"left", "left_down", "down"},
-                      "held_out": {"right_down", "right"}}
 
 
 def test_held_out_places_reported_apart(tmp_path: Path, capsys) -> None:
@@ -60,18 +32,6 @@ def test_held_out_places_reported_apart(tmp_path: Path, capsys) -> None:
     assert rows[0] == ["learner", "point", "cgi_trained", "cgi_held_out"]
     assert len(rows) == 1 + 2 * 2
     assert (out / "cgi_places.png").stat().st_size > 1000
-
-
-@pytest.mark.parametrize("args,message", [
-    (["--train-places", "left,lft"], "--train-places: unknown toy place 'lft'"),
-    (["--eval-places", "centre"], "--eval-places: unknown toy place 'centre'"),
-    (["--train-places", ","], "--train-places needs at least one place"),
-])
-def test_bad_places_one_line_exit_2(args: list[str], message: str, tmp_path: Path,
-                                    capsys) -> None:
-    assert main(["experiment", "sis", *args, "--out", str(tmp_path / "x")]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and message in err[0]
 
 
 def test_tg_learns_gaze_following_in_the_simulator() -> None:

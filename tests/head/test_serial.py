@@ -93,8 +93,10 @@ def test_a_silent_controller_is_a_clear_timeout(fast_cal, name):
         with pytest.raises(HeadTimeout, match=f"{name} controller on .* did not answer"):
             SerialHead(pty.port, name, fast_cal, timeout=0.1)  # it asks for positions at once
         fake.mute = False
-        head = SerialHead(pty.port, name, fast_cal, timeout=0.1)
+        # answering: a generous time-out, so a busy machine cannot make the fake look silent
+        head = SerialHead(pty.port, name, fast_cal, timeout=5.0)
         fake.mute = True  # the controller goes quiet while in use
+        head.link.timeout = head.link.serial.timeout = 0.1
         with pytest.raises(HeadTimeout, match="check power, cable, baud rate"):
             head.is_moving()
         head.close(centre=False)

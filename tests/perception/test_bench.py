@@ -1,12 +1,51 @@
-"""perception.bench: the photo case and its stage breakdown."""
+"""perception.bench: the photo case, its stage breakdown and the two-thread figures."""
+
+import time
 
 import perception
+from perception.bench import FreeCoresPool
 
 
 def test_photo_figures_wall_cpu_and_stages():
     out = perception.bench(frames=8)
     for size in ("320x240", "640x480"):
-        assert out[f"fps_photos_{size}_cold"] > 0 and out[f"cpu_fps_photos_{size}_cold"] > 0
+        for key in ("fps_photos_{}_cold", "cpu_fps_photos_{}_cold", "fps_photos_{}_cold_2threads",
+                    "cpu_fps_photos_{}_cold_2threads", "free_cores_fps_photos_{}_cold_2threads"):
+            assert out[key.format(size)] > 0, key
     stages = out["ms_photos_320x240_cold"]
     assert set(stages) == {"faces", "saliency", "colour"} and min(stages.values()) > 0
     assert out["faces_found"] >= 90 and out["false_detections"] == 0
+    assert out["pose_frames"] == 192 and out["poses_right"] >= 185
+
+
+def _burn(seconds: float) -> float:
+    start = time.thread_time()
+    while time.thread_time() - start < seconds:
+        pass
+    return seconds
+
+
+def test_free_cores_clock_replays_a_fifo_pool_from_cpu_times():
+    two, one = FreeCoresPool(2), FreeCoresPool(1)
+    try:
+        for pool, expected in ((two, 0.1), (one, 0.2)):
+            pool.restart()
+            tasks = [pool.submit(_burn, 0.05) for _ in range(4)]
+            assert [t.result() for t in tasks] == [0.05] * 4
+            assert expected <= pool.elapsed() < expected + 0.04
+        # a task cancelled before it starts costs nothing; the caller's own CPU time counts
+        two.restart()
+        first = [two.submit(_burn, 0.05) for _ in range(2)]
+        late = [two.submit(_burn, 0.05) for _ in range(10)]
+        first[0].result()
+        first[1].result()
+        ran = [t for t in late if not t.cancel()]
+        for t in ran:
+            t.result()
+        _burn(0.02)
+        assert len(ran) < len(late)
+        expected = 0.05 + 0.05 * -(-len(ran) // 2) + 0.02
+        assert expected <= two.elapsed() < expected + 0.04
+    finally:
+        two.shutdown()
+        one.shutdown()

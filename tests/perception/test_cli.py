@@ -29,7 +29,18 @@ def test_errors_are_one_line_exit_2(tmp_path, capsys):
     for argv in (["perceive", str(tmp_path / "missing.png")], ["perceive", str(bad)],
                  ["perceive", "--camera", "cam://nope"], ["perceive"],
                  ["perceive", "--camera", "cam://97"],
-                 ["perceive", "--camera", "ftp://x"]):
+                 ["perceive", "--camera", "ftp://x"],
+                 ["perceive", "--camera", "synthetic://", "--threads", "0"]):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "Traceback" not in err, err
+
+
+def test_perceive_with_two_threads_prints_the_same(tmp_path, capsys):
+    img = tmp_path / "profile.png"
+    cv2.imwrite(str(img), render(SceneView("centre", "left_2", seed=2)))
+    outs = []
+    for threads in ("1", "2"):
+        assert main(["perceive", str(img), "--threads", threads]) == 0
+        outs.append(capsys.readouterr().out)
+    assert outs[0] == outs[1] and "pose(face, left_2)." in outs[0]

@@ -73,3 +73,39 @@ def test_tracker_forgets_a_lost_face():
     assert tracker.detect(render(SceneView("centre", "frontal"))) is not None
     assert tracker.detect(render(SceneView("left", None))) is None
     assert tracker.last is None
+
+
+def _lfw_frames(step: int) -> list[np.ndarray]:
+    from skimage import data
+
+    crops = (data.lfw_subset() * 255).round().astype(np.uint8)[::step]
+    return [cv2.copyMakeBorder(cv2.resize(c, (64, 64)), 16, 16, 16, 16, cv2.BORDER_REPLICATE)
+            for c in crops]
+
+
+def test_pooled_full_search_finds_the_same_faces(astronaut_bgr):
+    from concurrent.futures import ThreadPoolExecutor
+
+    from perception.bench import _photos
+
+    frames = [render(SceneView("centre", pose, lighting=light, seed=5), size)
+              for pose in POSES for light in (0.6, 1.25) for size in ((320, 240), (640, 480))]
+    frames += [*_photos((320, 240)), *_photos((640, 480)), astronaut_bgr, *_lfw_frames(5)]
+    serial = FaceTracker()
+    with ThreadPoolExecutor(2) as pool:
+        pooled = FaceTracker(pool=pool)
+        for frame in frames:
+            serial.reset()
+            pooled.reset()
+            assert pooled.detect(frame) == serial.detect(frame)
+    # a found face cancels the later cascades' tasks, and the next search still works
+    assert pooled.full_searches == serial.full_searches == len(frames)
+
+
+def test_bands_cover_the_sizes_once():
+    from perception.faces import _bands
+
+    assert _bands(20, 120) == [(20, 20), (21, 23), (24, 30), (31, 46), (47, 120)]
+    assert _bands(25, 40) == [(25, 30), (31, 40)]
+    assert _bands(20, 20) == [(20, 20)]
+    assert _bands(20, 16) == []  # a frame too small for any face

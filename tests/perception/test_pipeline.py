@@ -89,3 +89,27 @@ def test_bench_is_callable_from_the_package():
     import perception.bench as module
 
     assert callable(module) and module.bench is not None
+
+
+def test_two_threads_give_the_same_facts():
+    from perception.bench import _photos
+
+    frames = [render(SceneView("centre", pose, seed=6)) for pose in ("frontal", "left_2",
+                                                                      "right_2")]
+    frames += [render(SceneView("left_down", None, {"left_down": "lemon"})), *_photos((320, 240))]
+    one = Perceiver()
+    with Perceiver(threads=2) as two:
+        for cold in (False, True):
+            for frame in frames:
+                if cold:
+                    one.reset()
+                    two.reset()
+                assert two.perceive(frame) == one.perceive(frame)
+    assert two.pool is None
+    two.close()  # safe twice
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, "2", True])
+def test_bad_thread_counts_are_user_errors(bad):
+    with pytest.raises(PerceptionError, match="threads"):
+        Perceiver(threads=bad)

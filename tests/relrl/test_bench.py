@@ -36,3 +36,16 @@ def test_perception_photo_target_line(monkeypatch) -> None:
         assert figures["targets"]["perception_photos_320x240_fps>=60"] is met
     monkeypatch.setattr(perception_bench, "bench", lambda faces=True: {"fps_320x240": 1.0})
     assert "perception_photos_320x240_fps>=60" not in bench_all(steps=100)["targets"]
+
+
+def test_perception_two_thread_target_lines(monkeypatch) -> None:
+    import perception.bench as perception_bench
+    from relrl.bench import bench_all
+
+    figures = {"fps_photos_320x240_cold": 30.0, "fps_photos_320x240_cold_2threads": 59.0,
+               "free_cores_fps_photos_320x240_cold_2threads": 61.0}
+    monkeypatch.setattr(perception_bench, "bench", lambda faces=True: figures)
+    targets = bench_all(steps=100)["targets"]
+    assert targets["perception_photos_320x240_fps>=60"] is False
+    assert targets["perception_photos_320x240_2threads_fps>=60"] is False
+    assert targets["perception_photos_320x240_2threads_free_cores_fps>=60"] is True

@@ -1,0 +1,143 @@
+"""The session flags of ``relrl run``: monitor, recording, microphone, audio file, log file.
+
+Kept apart from :mod:`relrl.cli.run` so the run command stays a thin front: this module
+declares the flags, checks them, starts what they ask for (the web monitor, the word
+sources, the log file) and stops it again.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Any
+
+from relrl.errors import ConfigError
+
+__all__ = ["add_session_arguments", "session_options"]
+
+
+def add_session_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare ``--monitor``, ``--record``, ``--mic``, ``--audio`` and their options."""
+    g = parser.add_argument_group("watch, record, listen")
+    g.add_argument("--monitor", nargs="?", const="", default=None, metavar="HOST:PORT",
+                   help="serve a live web page of the session (default 127.0.0.1 and a free "
+                        "port, printed at start; off localhost a token is required)")
+    g.add_argument("--monitor-rate", type=float, default=10.0, metavar="HZ",
+                   help="views and frames sent to the browser per second, at most (10)")
+    g.add_argument("--monitor-hold", action="store_true",
+                   help="keep the page up after the session ends, until Ctrl-C")
+    g.add_argument("--record", action="store_true",
+                   help="record frames, the tree and events beside the trace in --out: a "
+                        "self-contained folder for `relrl replay`")
+    g.add_argument("--record-rate", type=float, default=10.0, metavar="HZ",
+                   help="recorded frames per second, at most (10; 0: every time unit, so "
+                        "`--camera DIR` can perceive them again)")
+    g.add_argument("--record-quality", type=int, default=85, metavar="Q",
+                   help="JPEG quality of recorded frames, 1..100 (85)")
+    g.add_argument("--mic", nargs="?", const="default", default=None, metavar="DEVICE",
+                   help="hear the caregiver through a microphone (default input device, or "
+                        "an index or name from `python -m sounddevice`)")
+    g.add_argument("--audio", default=None, metavar="FILE.wav",
+                   help="hear a recorded WAV file, --audio-seconds per time unit")
+    g.add_argument("--audio-seconds", type=float, default=0.5, metavar="S",
+                   help="seconds of --audio heard per time unit (0.5)")
+
+
+class _Closing:
+    def __init__(self, fn: Any) -> None:
+        self.close = fn
+
+
+@dataclass
+class Session:
+    """What the flags started; :meth:`hold` keeps the monitor up after the run."""
+
+    opts: Any
+    server: Any = None
+    closers: list[Any] = field(default_factory=list)
+    hold_after: bool = False
+
+    def log_to(self, path: Any) -> None:
+        """Also log to ``path`` (the session's ``run.log``) until the session ends."""
+        import logging
+
+        from relrl import log
+
+        handler = log.add_file(path)
+        self.closers.append(_Closing(lambda: log.remove_file(handler)))
+        logging.getLogger("relrl.run").debug("session started: %s", " ".join(sys.argv))
+
+    def hold(self) -> None:
+        """With ``--monitor-hold``: serve until Ctrl-C."""
+        if self.server is None or not self.hold_after:
+            return
+        print(f"the monitor stays up at {self.server.url} ; Ctrl-C ends it", flush=True)
+        try:
+            while True:
+                time.sleep(0.5)
+        except KeyboardInterrupt:
+            pass
+
+
+def _vocabulary(episode: Any) -> list[str]:
+    return sorted({episode.word_for(k) for k in episode.fruits} | {"attention"})
+
+
+def _words(args: argparse.Namespace, episode: Any, closers: list[Any]) -> Any:
+    from relrl.listen import AudioFileWords, MicWords, TypedWords, Words
+
+    sources = []
+    if args.live:
+        sources.append(TypedWords())
+        print("live session: type words (e.g. apple, attention) and Enter; Ctrl-C stops",
+              flush=True)
+    if args.audio is not None:
+        sources.append(AudioFileWords(args.audio, _vocabulary(episode), args.audio_seconds))
+    if args.mic is not None:
+        sources.append(MicWords(_vocabulary(episode),
+                                None if args.mic == "default" else args.mic))
+    closers.extend(sources)
+    if not sources:
+        return None
+    return sources[0] if len(sources) == 1 else Words(sources)
+
+
+def _check(args: argparse.Namespace) -> None:
+    if not args.monitor_rate > 0:
+        raise ConfigError(f"--monitor-rate must be positive, not {args.monitor_rate}")
+    if args.record and not args.out:
+        raise ConfigError("--record needs --out DIR (the recording goes there)")
+    if args.record_rate < 0:
+        raise ConfigError(f"--record-rate must be >= 0, not {args.record_rate}")
+    if not 1 <= args.record_quality <= 100:
+        raise ConfigError(f"--record-quality must be in 1..100, not {args.record_quality}")
+    if args.monitor_hold and args.monitor is None:
+        raise ConfigError("--monitor-hold needs --monitor")
+
+
+@contextmanager
+def session_options(args: argparse.Namespace, episode: Any, opts: Any):
+    """Start what the flags ask for around a run; yields a :class:`Session` whose ``opts``
+    carry the monitor, the recording settings and the word sources."""
+    _check(args)
+    session = Session(opts, hold_after=args.monitor_hold)
+    try:
+        opts.record = args.record
+        opts.record_rate = args.record_rate
+        opts.record_quality = args.record_quality
+        opts.words = _words(args, episode, session.closers)
+        if args.monitor is not None:
+            from relrl.monitor import Hub, start_live
+
+            opts.monitor = Hub(args.monitor_rate)
+            session.server = start_live(opts.monitor, args.monitor or None)
+            session.closers.append(session.server)
+            note = " (token required: not bound to localhost)" if session.server.token else ""
+            print(f"monitor: {session.server.url}{note}", flush=True)
+        yield session
+    finally:
+        for thing in reversed(session.closers):
+            thing.close()

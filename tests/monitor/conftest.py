@@ -1,0 +1,123 @@
+"""Fixtures of the monitor's tests: a headless Chromium (Debian's, driven by Playwright; no
+browser is ever downloaded), short episodes, and running ``relrl run`` in a subprocess."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+FRUITS = ROOT / "examples" / "domains" / "fruits.pl"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                  "--no-first-run", "--disable-background-networking",
+                  "--disable-component-update", "--disable-sync"]
+
+
+def episode(tmp_path: Path, steps: int = 200, perception: str = "render",
+            extra: str = "") -> Path:
+    """A short Experiment-2-like script (protocol caregiver with fruits)."""
+    path = tmp_path / "short.toml"
+    path.write_text(f"""[episode]
+name = "short"
+domain = "{FRUITS}"
+seed = 5
+learner = "etg"
+policy_save = "policy.pl"
+[world]
+perception = "{perception}"
+fruits = ["apple", "lime", "orange"]
+names = {{ lime = "lemon" }}
+[caregiver]
+contact_hold = 1
+[[phase]]
+name = "no objects"
+steps = 10
+objects = false
+[[phase]]
+name = "fruits"
+steps = {steps - 10}
+{extra}""")
+    return path
+
+
+@pytest.fixture(scope="session")
+def chromium() -> Iterator[object]:
+    """A headless Chromium (``/usr/bin/chromium``) under Playwright."""
+    from playwright.sync_api import sync_playwright
+
+    assert Path(CHROMIUM).exists(), "make test installs Debian's chromium"
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+        yield browser
+        browser.close()
+
+
+@pytest.fixture
+def page(chromium, tmp_path: Path) -> Iterator[object]:
+    """A fresh page (its own context) of 1400 x 1000 pixels; console errors collected."""
+    context = chromium.new_context(viewport={"width": 1400, "height": 1000})
+    pg = context.new_page()
+    pg.errors = []  # type: ignore[attr-defined]
+    pg.on("pageerror", lambda exc: pg.errors.append(str(exc)))  # type: ignore[attr-defined]
+    yield pg
+    context.close()
+
+
+class RelrlProcess:
+    """``relrl ARGS`` in a subprocess; :meth:`url` waits for the monitor's address."""
+
+    def __init__(self, *args: str) -> None:
+        self.proc = subprocess.Popen([sys.executable, "-m", "relrl", *args],
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True, cwd=ROOT)
+        self.lines: list[str] = []
+
+    def wait_for(self, pattern: str, timeout: float = 60.0) -> re.Match[str]:
+        """Read output lines until one matches ``pattern``."""
+        deadline = time.monotonic() + timeout
+        assert self.proc.stdout is not None
+        while time.monotonic() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                break
+            self.lines.append(line)
+            m = re.search(pattern, line)
+            if m:
+                return m
+        raise AssertionError(f"never printed {pattern!r}: " + "".join(self.lines))
+
+    def url(self, timeout: float = 60.0) -> str:
+        """The monitor's address, once printed."""
+        return self.wait_for(r"(http://\S+)", timeout).group(1)
+
+    def finish(self, timeout: float = 120.0) -> tuple[int, str]:
+        out, _ = self.proc.communicate(timeout=timeout)
+        return self.proc.returncode, "".join(self.lines) + out
+
+    def kill(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.communicate()
+
+
+@pytest.fixture
+def relrl_process() -> Iterator[type[RelrlProcess]]:
+    """Start ``relrl`` subprocesses; every one still running at the end is killed."""
+    started: list[RelrlProcess] = []
+
+    def start(*args: str) -> RelrlProcess:
+        p = RelrlProcess(*args)
+        started.append(p)
+        return p
+
+    yield start  # type: ignore[misc]
+    for p in started:
+        p.kill()
