@@ -32,7 +32,7 @@ swipl:
 $(STAMP): pyproject.toml Makefile
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev,speech,monitor]'
+	$(BIN)/pip install -q -e '.[dev,speech,monitor,ray]'
 	@touch $(STAMP)
 
 demo: setup

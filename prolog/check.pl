@@ -1,6 +1,7 @@
 :- module(relrl_check,
           [ check_domain/2,       % +KB, -Problems
             rule_listing/2,       % +KB, -Rules
+            bias_listing/2,       % +KB, -Listing
             body_goal/2,          % +Body, -Goal
             data_goal/2,          % +Declaration, -Goal
             clause_location/3     % +ClauseRef, -File, -Line
@@ -10,6 +11,7 @@
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
 :- use_module(declarations).
+:- use_module(tg_bias).
 
 /** <module> Validating a domain
 
@@ -20,7 +22,11 @@ check_domain/2 lists what is wrong with the domain loaded into a knowledge base:
   - a response used in a behaviour or constraint rule that is not declared;
   - a stimulus, fact, response or necessity declared twice;
   - a necessity unit parameter that is missing, unknown or not a number;
-  - a property, input or behaviour rule about something that is not declared.
+  - a property, input or behaviour rule about something that is not declared;
+  - a bad relational view or language bias (relation/1, rmode/1, rconst/2; see
+    tg_bias.pl): a relation that is not defined, an rmode of an undeclared relation or with
+    a bad argument, a #Type without constants, a +Type no rmode can bind, an action mode
+    that matches no response.
 
 Each problem is problem(File, Line, Message) with Message a string. Syntax errors and
 singleton variables are reported by the loader (see the Python gateway).
@@ -46,6 +52,7 @@ problem(KB, P) :- duplicate_declaration(KB, P).
 problem(KB, P) :- bad_unit(KB, P).
 problem(KB, P) :- undeclared_reference(KB, P).
 problem(KB, P) :- empty_declaration(KB, P).
+problem(KB, P) :- bias_problem(KB, P).
 
 %!  clause_location(+Ref, -File, -Line) is det.
 %
@@ -98,6 +105,7 @@ data_goal(unit_input(_, G, _), G).
 data_goal(satisfier(_, G, _), G).
 data_goal(behaviour(G, _, _, _), G).
 data_goal(etg_test(G), G).
+data_goal(relation(G), G).
 
 %!  body_goal(+Body, -Goal) is nondet.
 %
@@ -238,3 +246,22 @@ rule_listing(KB, Rules) :-
                 split_string(S0, "", "\n", [S])
             ),
             Rules).
+
+%!  bias_listing(+KB, -Listing) is det.
+%
+%   Listing is bias(Relations, Refinements): the relation/1 templates of KB written as
+%   text, and the candidate tests the tg learner's refinement operator gives for an empty
+%   tree (strings), or bias([], []) for a domain without a language bias.
+
+bias_listing(KB, bias(Relations, Refinements)) :-
+    findall(S, ( declared(KB, relation(T)),
+                 copy_term(T, T1),
+                 term_variables(T1, Vs),
+                 maplist(=('$VAR'('_')), Vs),
+                 format(string(S), "~W", [T1, [quoted(true), numbervars(true),
+                                              spacing(next_argument)]]) ),
+            Relations),
+    (   declared(KB, rmode(_))
+    ->  root_refinements(KB, Refinements)
+    ;   Refinements = []
+    ).

@@ -150,6 +150,7 @@ python_api(relrl_responses:allowed_responses/2).
 python_api(relrl_declarations:necessity_inputs/3).
 python_api(relrl_check:check_domain/2).
 python_api(relrl_check:rule_listing/2).
+python_api(relrl_check:bias_listing/2).
 python_api(relrl_percepts:world_problems/3).
 python_api(relrl_percepts:unread_percepts/3).
 python_api(relrl_gateway:gw_new_kb/1).

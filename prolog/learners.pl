@@ -9,3 +9,4 @@ here is all it takes to make a learner available by name.
 :- use_module(etg).
 :- use_module(contingency).
 :- use_module(external).
+:- use_module(tg).

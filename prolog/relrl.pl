@@ -16,7 +16,8 @@
             feature_code/2,       % ?Term, ?X
             list_state_codes/0,
             allowed/1,            % ?Response
-            allowed_responses/1   % -Responses
+            allowed_responses/1,  % -Responses
+            op(200, fy, #)        % #Type: a constant of Type in a language bias (rmode/1)
           ]).
 :- use_module(library(arithmetic)).   % the same arithmetic checks for every load
 :- use_module(memory).

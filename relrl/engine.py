@@ -75,6 +75,7 @@ GOALS: dict[str, str] = {
     "necessity_inputs": "relrl_declarations:necessity_inputs",
     "check_domain": "relrl_check:check_domain",
     "rule_listing": "relrl_check:rule_listing",
+    "bias_listing": "relrl_check:bias_listing",
     # percepts against a world's vocabulary (prolog/percepts.pl)
     "world_problems": "relrl_percepts:world_problems",
     "unread_percepts": "relrl_percepts:unread_percepts",

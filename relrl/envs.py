@@ -18,6 +18,7 @@ __all__ = ["ENVS", "register_envs"]
 #: environment id -> ``module:class`` (imported only when the environment is made).
 ENVS: dict[str, str] = {
     "relrl/SharedAttention-v0": "relrl.sim.sis:SharedAttentionEnv",
+    "relrl/SharedAttention-v1": "relrl.sim.sis:SharedAttentionEnvV1",
 }
 
 

@@ -54,13 +54,13 @@ def _agent(shell: Shell) -> Agent:
     return shell.policy
 
 
-@command("learner", ":learner NAME", "start a fresh learner (etg, contingency, qlearning)")
+@command("learner", ":learner NAME", "start a fresh learner (etg, tg, contingency, qlearning)")
 def _learner(shell: Shell, text: str) -> None:
     attach_learner(shell, text.strip() or "etg")
     shell.print(f"learner {text.strip() or 'etg'} ready")
 
 
-@command("tree", ":tree", "draw the ETG tree")
+@command("tree", ":tree", "draw the learner's tree (etg, tg)")
 def _tree(shell: Shell, _: str) -> None:
     text = _agent(shell).learner.tree()
     shell.print(text.rstrip() if text else "(this learner has no tree)")
@@ -71,7 +71,9 @@ def _explain(shell: Shell, _: str) -> None:
     exp = _agent(shell).learner.explain(now=True)
     shell.print(f"state {exp.get('state')}  necessity {exp.get('necessity')}")
     for step in exp.get("path", []):
-        shell.print(f"  {step['test']} -> {'yes' if step['holds'] else 'no'}")
+        bound = ", ".join(f"{k} = {v}" for k, v in step.get("bindings", {}).items())
+        shell.print(f"  {step['test']} -> {'yes' if step['holds'] else 'no'}"
+                    + (f"  ({bound})" if bound else ""))
     if "leaf" in exp:
         shell.print(f"  leaf {exp['leaf']}" if exp["leaf"] is not None else "  (null branch)")
     ranked = exp.get("ranked", [])

@@ -88,4 +88,18 @@ def describe(kb: KnowledgeBase) -> str:
     rules = kb.call("relrl_check:rule_listing", kb.module, Var())[0]  # type: ignore[index]
     lines.append("rules:")
     lines += [f"  {r}" for r in rules] or ["  (none)"]
+    lines += _bias_lines(kb)
     return "\n".join(lines)
+
+
+def _bias_lines(kb: KnowledgeBase) -> list[str]:
+    """The relational view and what the tg learner's language bias generates at the root."""
+    _, relations, refinements = kb.call("relrl_check:bias_listing", kb.module,
+                                        Var())[0]  # type: ignore[index]
+    if not relations and not refinements:
+        return []
+    lines = ["relations (the relational view, learner tg):"]
+    lines += [f"  {r}" for r in relations] or ["  (none)"]
+    lines.append(f"refinements of an empty tree (tg's candidate tests, {len(refinements)}):")
+    lines += [f"  {r}" for r in refinements] or ["  (none: the domain declares no rmode/1)"]
+    return lines

@@ -59,6 +59,74 @@ looking_fruit(object) :-
     ),
     !.
 
+% ---- The relational view (learner tg) ----------------------------------------------------
+
+% What the robot perceives now, as relations over agents, places, objects, colours and
+% words. Their ground solutions are the relational state the tg learner learns from (the
+% state code above is unchanged for the other learners).
+relation(sees(_Thing)).
+relation(gaze(_Who, _Place)).
+relation(head_at(_Place)).
+relation(object_at(_Object, _Place)).
+relation(colour(_Object, _Colour)).
+relation(heard(_Word)).
+
+sees(Thing)              :- memory(see(Thing), 0).
+gaze(Who, Place)         :- memory(pose(Who, Pose), 0), pose_place(Pose, Place).
+head_at(Place)           :- memory(at(Place), 0).
+object_at(Object, Place) :- memory(at(Object, Place), 0).
+colour(Object, Colour)   :- memory(colour(Object, Colour), 0).
+heard(Word)              :- memory(hear(Word), 0).
+
+% Where a head pose points (perception's pose classes): a frontal face looks at the robot
+% (centre), a strong turn to the left of the image at left, a slight one at left_down.
+pose_place(frontal, centre).
+pose_place(left_2, left).
+pose_place(left_1, left_down).
+pose_place(down, down).
+pose_place(right_1, right_down).
+pose_place(right_2, right).
+
+% ---- The language bias (learner tg) ------------------------------------------------------
+
+% Single literals with modes: +T a variable of type T bound earlier on the path (or by the
+% action), -T a new variable, #T each constant of type T. See docs/tg.md.
+rmode(sees(#thing)).
+rmode(gaze(#agent, -place)).
+rmode(gaze(#agent, +place)).
+rmode(gaze(#agent, #place)).
+rmode(head_at(+place)).
+rmode(head_at(#place)).
+rmode(object_at(-object, -place)).
+rmode(object_at(-object, +place)).
+rmode(colour(+object, #colour)).
+rmode(heard(#word)).
+rmode(action(look(-place))).
+rmode(action(look(+place))).
+rmode(action(look(#place))).
+rmode(action(name_object)).
+rmode(necessity(#necessity)).
+
+rconst(thing, face).
+rconst(thing, object).
+rconst(thing, environment).
+rconst(agent, face).
+rconst(place, centre).
+rconst(place, left).
+rconst(place, left_down).
+rconst(place, down).
+rconst(place, right_down).
+rconst(place, right).
+rconst(colour, red).
+rconst(colour, orange).
+rconst(colour, yellow).
+rconst(colour, green).
+rconst(word, attention).
+rconst(word, apple).
+rconst(word, orange).
+rconst(word, lemon).
+rconst(word, lime).
+
 % ---- Responses ---------------------------------------------------------------------------
 
 % Look at the caregiver or search one of the five regions; name the object in view.

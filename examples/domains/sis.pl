@@ -65,6 +65,67 @@ green_toy(toy) :- see(toy), percept(colour(toy, green)).
 % A percept stays in working memory for this many further steps.
 memory_span(1).
 
+% ---- The relational view (learner tg) ----------------------------------------------------
+
+% What the robot perceives now, as relations over agents, places, toys, colours and words.
+% The ground solutions of these templates are the relational state the tg learner learns
+% from (the state code above is unchanged for the other learners).
+relation(sees(_Thing)).
+relation(gaze(_Who, _Place)).
+relation(head_at(_Place)).
+relation(toy_at(_Toy, _Place)).
+relation(colour(_Toy, _Colour)).
+relation(heard(_Word)).
+
+sees(Thing)           :- memory(see(Thing), 0).
+gaze(Who, Place)      :- memory(pose(Who, Pose), 0), pose_place(Pose, Place).
+toy_at(Toy, Place)    :- memory(at(Toy, Place), 0).
+colour(Toy, Colour)   :- memory(colour(Toy, Colour), 0).
+heard(Word)           :- memory(hear(Word), 0).
+% head_at(Place) is defined above.
+
+% Where a face's pose points: a frontal face looks at the robot, whose place is centre.
+pose_place(frontal, centre).
+pose_place(left, left).
+pose_place(left_down, left_down).
+pose_place(down, down).
+pose_place(right_down, right_down).
+pose_place(right, right).
+
+% ---- The language bias (learner tg) ------------------------------------------------------
+
+% Single literals with modes: +T a variable of type T bound earlier on the path (or by the
+% action), -T a new variable, #T each constant of type T. Conjunctions come from the
+% refinement operator; see docs/tg.md.
+rmode(sees(#thing)).
+rmode(gaze(#agent, -place)).
+rmode(gaze(#agent, +place)).
+rmode(gaze(#agent, #place)).
+rmode(head_at(+place)).
+rmode(head_at(#place)).
+rmode(toy_at(-toy, -place)).
+rmode(toy_at(-toy, +place)).
+rmode(colour(+toy, #colour)).
+rmode(heard(#word)).
+rmode(action(look(-place))).
+rmode(action(look(+place))).
+rmode(action(look(#place))).
+rmode(necessity(#necessity)).
+
+rconst(thing, face).
+rconst(thing, toy).
+rconst(thing, environment).
+rconst(agent, face).
+rconst(place, centre).
+rconst(place, left).
+rconst(place, left_down).
+rconst(place, down).
+rconst(place, right_down).
+rconst(place, right).
+rconst(colour, red).
+rconst(colour, green).
+rconst(word, attention).
+
 % ---- Responses ---------------------------------------------------------------------------
 
 response(look(centre)).

@@ -1,16 +1,24 @@
-"""``relrl experiment sis``: reproduce the paper's Experiment 1 with one command."""
+"""``relrl experiment sis|scaling``: Experiment 1, and the scaling benchmark, with one command."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 from pathlib import Path
 
 from relrl.outdir import add_out_options
 
-HELP = "reproduce the paper's experiments (sis: Experiment 1, three learners in the simulator)"
-EXAMPLE = "relrl experiment sis --quick --out runs/exp1-quick"
+HELP = ("run the experiments (sis: the paper's Experiment 1, with relrl's relational learner tg "
+        "beside the paper's three; scaling: every learner in worlds that grow, with zero-shot "
+        "transfer)")
+EXAMPLE = ("relrl experiment sis --quick --out runs/exp1-quick\n"
+           "  relrl experiment scaling --quick --out runs/scaling-quick")
+
+#: ``--quick`` settings of the scaling benchmark (under 5 minutes on 2 cores).
+QUICK_SCALING = {"seeds": "0", "budget": 20_000, "block": 2_000, "eval_runs": 4,
+                 "eval_steps": 300, "transfer_sizes": "5,9"}
 
 
 def _param(text: str) -> tuple[str, str, float]:
@@ -35,98 +43,275 @@ def _caregiver_param(text: str) -> tuple[str, object]:
         return key, value
 
 
+def _places(option: str, text: str | None) -> list[str] | None:
+    """The toy places of ``--train-places`` / ``--eval-places`` (None when not given)."""
+    from relrl.errors import ConfigError
+    from relrl.sim.errors import did_you_mean
+    from relrl.sim.places import TOY_PLACES
+
+    if text is None:
+        return None
+    places = [p.strip() for p in text.split(",") if p.strip()]
+    if not places:
+        raise ConfigError(f"{option} needs at least one place ({', '.join(TOY_PLACES)})")
+    for p in places:
+        if p not in TOY_PLACES:
+            raise ConfigError(f"{option}: unknown toy place {p!r}{did_you_mean(p, TOY_PLACES)} "
+                              f"(places: {', '.join(TOY_PLACES)})")
+    return list(dict.fromkeys(places))
+
+
+def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds: str) -> None:
+    p.add_argument("--learners", default=default_learners,
+                   help=f"comma-separated learners (default: {default_learners})")
+    p.add_argument("--seeds", default=None, help=f"comma-separated seeds (default "
+                                                 f"{default_seeds})")
+    p.add_argument("--eval-runs", type=int, default=None, help="evaluation runs per point")
+    p.add_argument("--eval-steps", type=int, default=None, help="time units per run")
+    p.add_argument("--block", type=int, default=None,
+                   help="learning time units between evaluations")
+    p.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
+                   help="worker processes, one Prolog engine each (default: up to 2)")
+    p.add_argument("--engine", choices=["local", "ray"], default="local",
+                   help="where the jobs run: local worker processes (default) or a Ray "
+                        "cluster (pip install 'relrl[ray]')")
+    p.add_argument("--address", default=None,
+                   help="with --engine ray: the cluster to join (ray://HEAD:10001, "
+                        "HOST:6379 or auto); default: a local Ray instance with --workers "
+                        "CPUs")
+    p.add_argument("--caregiver", default="paper", help="caregiver model (default paper)")
+    p.add_argument("--caregiver-param", type=_caregiver_param, action="append", default=[],
+                   metavar="NAME=VALUE", help="override a caregiver parameter (repeatable)")
+    p.add_argument("--param", type=_param, action="append", default=[],
+                   metavar="LEARNER.NAME=X", help="learner parameter (repeatable)")
+    p.add_argument("--eval-policy", choices=["behaviour", "greedy"], default="behaviour",
+                   help="evaluate the robot's behaviour (exploration kept, the default) "
+                        "or the greedy policy")
+    p.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
+                   help="seconds one control step may run before the run stops, naming the "
+                        "rule (default 60)")
+    p.add_argument("--quick", action="store_true", help="a short run")
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Declare the options of ``relrl experiment``."""
-    parser.add_argument("name", choices=["sis"], help="which experiment")
-    parser.add_argument("--learners", default="contingency,qlearning,etg",
-                        help="comma-separated learners (default: all three)")
-    parser.add_argument("--points", type=int, default=None,
-                        help="evaluation points after the first (default 20; --quick: 4)")
-    parser.add_argument("--eval-runs", type=int, default=None,
-                        help="evaluation runs per point (default 20; --quick: 5)")
-    parser.add_argument("--eval-steps", type=int, default=500, help="time units per run")
-    parser.add_argument("--block", type=int, default=500,
-                        help="learning time units between evaluations (default 500)")
-    parser.add_argument("--seeds", default="0", help="comma-separated seeds (default 0)")
-    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
-                        help="worker processes, one Prolog engine each (default: up to 2)")
-    parser.add_argument("--caregiver", default="paper", help="caregiver model (default paper)")
-    parser.add_argument("--caregiver-param", type=_caregiver_param, action="append", default=[],
-                        metavar="NAME=VALUE", help="override a caregiver parameter (repeatable)")
-    parser.add_argument("--param", type=_param, action="append", default=[],
-                        metavar="LEARNER.NAME=X", help="learner parameter (repeatable)")
-    parser.add_argument("--eval-policy", choices=["behaviour", "greedy"], default="behaviour",
-                        help="evaluate the robot's behaviour (exploration kept, the default) "
-                             "or the greedy policy")
-    parser.add_argument("--domain", default=None, help="domain file (default sis.pl)")
-    add_out_options(parser, default="runs/exp1",
-                    what="output folder: results.json, CSVs, figures")
-    parser.add_argument("--quick", action="store_true", help="a short run (under a minute)")
+    """Declare the subcommands and options of ``relrl experiment``."""
+    from relrl.learners import LEARNERS
+
+    sub = parser.add_subparsers(dest="name", metavar="EXPERIMENT", required=True,
+                                parser_class=type(parser))
+    sis = sub.add_parser("sis", help="the paper's Experiment 1 (the learners in the SIS)",
+                         description="The paper's Experiment 1: learning curves (CGI), eye "
+                                     "contacts and memory of each learner in the simulator.")
+    _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
+    sis.add_argument("--points", type=int, default=None,
+                     help="evaluation points after the first (default 20; --quick: 4)")
+    sis.add_argument("--train-places", default=None, metavar="P,P,...",
+                     help="toy places while learning, e.g. left,left_down,down (default: "
+                          "all); the others are held out")
+    sis.add_argument("--eval-places", default=None, metavar="P,P,...",
+                     help="toy places of the evaluation (default: all); with held-out "
+                          "places the CGI is reported for trained and held-out apart")
+    sis.add_argument("--domain", default=None, help="domain file (default sis.pl)")
+    add_out_options(sis, default="runs/exp1", what="output folder: results.json, CSVs, figures")
+    sc = sub.add_parser("scaling", help="every learner in worlds that grow; transfer",
+                        description="Time to CGI >= 0.9, final CGI, memory and steps/s of "
+                                    "every learner as the world grows (P toy places), and "
+                                    "zero-shot transfer to places never trained on.")
+    _common(sc, default_learners=",".join(LEARNERS), default_seeds="0,1,2")
+    sc.add_argument("--sizes", default="5,9,17,33", help="world sizes P (default 5,9,17,33)")
+    sc.add_argument("--world", default="", metavar="NAME=VALUE,...",
+                    help="the worlds' other fields: colours, kinds, toys, scene, field "
+                         "(e.g. colours=3,scene=true)")
+    sc.add_argument("--budget", type=int, default=None,
+                    help="learning time units at most (default 60000; --quick 20000)")
+    sc.add_argument("--threshold", type=float, default=0.9, help="the CGI to reach (0.9)")
+    sc.add_argument("--patience", type=int, default=2, help="stop after this many "
+                    "evaluations at or above the threshold (0: learn the whole budget)")
+    sc.add_argument("--transfer", choices=["places", "kinds", "none"], default="places",
+                    help="hold out places (default), toy kinds, or no transfer jobs")
+    sc.add_argument("--transfer-sizes", default=None,
+                    help="sizes with transfer jobs (default: all; --quick: 5,9)")
+    sc.add_argument("--holdout", type=float, default=0.4,
+                    help="share of places (or kinds) held out (default 0.4)")
+    add_out_options(sc, default="runs/scaling",
+                    what="output folder: results.json, CSVs, figures, domains")
+
+
+def _ints(text: str, what: str) -> list[int]:
+    from relrl.errors import ConfigError
+
+    try:
+        values = [int(s) for s in text.split(",")]
+    except ValueError:
+        raise ConfigError(f"{what} must be comma-separated integers, not {text!r}") from None
+    if not values:
+        raise ConfigError(f"{what} is empty")
+    return values
+
+
+def _check_common(args: argparse.Namespace, config, learners_known) -> None:
+    """Validate and copy the options both experiments share into ``config``."""
+    from relrl.errors import ConfigError
+    from relrl.learners import make_learner
+
+    learners = [x.strip() for x in args.learners.split(",") if x.strip()]
+    for name in learners:
+        if name not in learners_known:
+            raise ConfigError(f"unknown learner {name!r} in --learners "
+                              f"(known: {', '.join(sorted(learners_known))})")
+    if not learners:
+        raise ConfigError("--learners is empty")
+    config.learners = learners
+    for what, value in [("--eval-runs", config.eval_runs), ("--eval-steps", config.eval_steps),
+                        ("--block", config.block)]:
+        if value < 1:
+            raise ConfigError(f"{what} must be at least 1, not {value}")
+    if len(set(config.seeds)) != len(config.seeds) or any(s < 0 for s in config.seeds):
+        raise ConfigError(f"--seeds must be distinct whole numbers >= 0, not {args.seeds!r}")
+    config.eval_policy = args.eval_policy
+    config.caregiver = args.caregiver
+    config.caregiver_params.update(dict(args.caregiver_param))
+    for learner, name, value in args.param:
+        if learner not in learners:
+            raise ConfigError(f"--param {learner}.{name}: {learner} is not among --learners")
+        config.learner_params.setdefault(learner, {})[name] = value
+    for learner in learners:
+        make_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    if args.workers < 1:
+        raise ConfigError(f"--workers must be at least 1, not {args.workers}")
+    if args.address is not None and args.engine != "ray":
+        raise ConfigError("--address applies to --engine ray only")
+    if not math.isfinite(args.timeout) or args.timeout <= 0:
+        raise ConfigError(f"--timeout must be a number of seconds > 0, not {args.timeout}")
+    config.timeout = args.timeout
 
 
 def build_config(args: argparse.Namespace):
-    """The SISConfig the options describe."""
+    """The SISConfig the options of ``relrl experiment sis`` describe."""
     from relrl.errors import ConfigError
     from relrl.experiments.sis import SISConfig
     from relrl.learners import LEARNERS
     from relrl.sim.caregiver import make_caregiver
 
-    learners = [x.strip() for x in args.learners.split(",") if x.strip()]
-    for name in learners:
-        if name not in LEARNERS:
-            raise ConfigError(f"unknown learner {name!r} in --learners "
-                              f"(known: {', '.join(sorted(LEARNERS))})")
-    try:
-        seeds = [int(s) for s in args.seeds.split(",")]
-    except ValueError:
-        raise ConfigError(f"--seeds must be comma-separated integers, not {args.seeds!r}") \
-            from None
-    for seed in seeds:
-        if seed < 0:
-            raise ConfigError(f"--seeds: {seed} is negative; seeds are integers >= 0")
-    config = SISConfig(learners=learners, seeds=seeds)
+    config = SISConfig(seeds=_ints(args.seeds or "0", "--seeds"))
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
-    config.eval_steps = args.eval_steps
-    config.block = args.block
-    for what, value in [("--points", config.points), ("--eval-runs", config.eval_runs),
-                        ("--eval-steps", config.eval_steps), ("--block", config.block)]:
-        if value < 1:
-            raise ConfigError(f"{what} must be at least 1, not {value}")
-    config.eval_policy = args.eval_policy
-    config.caregiver = args.caregiver
-    config.caregiver_params.update(dict(args.caregiver_param))
+    config.eval_steps = args.eval_steps if args.eval_steps is not None else 500
+    config.block = args.block if args.block is not None else 500
+    if config.points < 1:
+        raise ConfigError(f"--points must be at least 1, not {config.points}")
+    _check_common(args, config, LEARNERS)
     make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker
-    for learner, name, value in args.param:
-        if learner not in learners:
-            raise ConfigError(f"--param {learner}.{name}: {learner} is not among --learners")
-        config.learner_params.setdefault(learner, {})[name] = value
-    from relrl.learners import make_learner
-
-    for learner in learners:
-        make_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    config.train_places = _places("--train-places", args.train_places)
+    config.eval_places = _places("--eval-places", args.eval_places)
     if args.domain:
-        if not Path(args.domain).exists():
+        if not Path(args.domain).is_file():
             raise ConfigError(f"--domain {args.domain}: no such file")
         config.domain = str(Path(args.domain).resolve())
-    if args.workers < 1:
-        raise ConfigError(f"--workers must be at least 1, not {args.workers}")
+    return config
+
+
+def build_scaling_config(args: argparse.Namespace):
+    """The ScalingConfig the options of ``relrl experiment scaling`` describe."""
+    from relrl.errors import ConfigError
+    from relrl.experiments.scaling import ScalingConfig
+    from relrl.learners import LEARNERS
+    from relrl.sim.world import World
+
+    quick = QUICK_SCALING if args.quick else {}
+    config = ScalingConfig(seeds=_ints(args.seeds or quick.get("seeds", "0,1,2"), "--seeds"))
+    config.sizes = _ints(args.sizes, "--sizes")
+    for name in ("budget", "block", "eval_runs", "eval_steps"):
+        value = getattr(args, name)
+        if value is None:
+            value = quick.get(name, getattr(config, name))
+        setattr(config, name, value)
+    _check_common(args, config, LEARNERS)
+    if config.budget < config.block:
+        raise ConfigError(f"--budget ({config.budget}) must be at least --block "
+                          f"({config.block})")
+    if math.isnan(args.threshold) or not 0 < args.threshold <= 1:
+        raise ConfigError(f"--threshold must be in (0, 1], not {args.threshold}")
+    config.threshold = args.threshold
+    if args.patience < 0:
+        raise ConfigError(f"--patience must be 0 or more, not {args.patience}")
+    config.patience = args.patience
+    world = World.parse(args.world)
+    if "places" in {k.split("=")[0].strip() for k in args.world.split(",")}:
+        raise ConfigError("--world sets the other fields; give the places with --sizes")
+    config.world = {k: v for k, v in world.to_dict().items() if k != "places"}
+    if args.transfer == "places" and "placement" in config.caregiver_params:
+        raise ConfigError("--transfer places sets the placement weights itself; drop "
+                          "--caregiver-param placement or use --transfer none")
+    for size in config.sizes:
+        try:
+            config.world_of(size).caregiver_params(config.caregiver_params, config.caregiver)
+        except ConfigError as exc:
+            raise ConfigError(f"--sizes {size}: {exc}") from None
+    config.transfer = args.transfer
+    transfer_sizes = args.transfer_sizes or quick.get("transfer_sizes")
+    config.transfer_sizes = (_ints(transfer_sizes, "--transfer-sizes") if transfer_sizes
+                             else list(config.sizes))
+    if math.isnan(args.holdout) or not 0 < args.holdout < 1:
+        raise ConfigError(f"--holdout must be between 0 and 1, not {args.holdout}")
+    config.holdout = args.holdout
+    if config.transfer == "kinds" and world.kinds < 2:
+        raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
     return config
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the experiment, write the outputs, print the summary."""
-    from relrl.experiments.main import run_sis
+    """Check everything, claim the output folder, run the experiment, print the summary.
+
+    ``kill -USR1 PID`` prints the stack of every thread to stderr (for a sweep that seems
+    stuck); Ctrl-C or SIGTERM stops it keeping what finished."""
+    import faulthandler
+    import io
+    import signal
+    import sys
+
+    if hasattr(signal, "SIGUSR1") and sys.__stderr__ is not None:
+        try:
+            faulthandler.register(signal.SIGUSR1, file=sys.__stderr__, all_threads=True)
+        except (ValueError, OSError, io.UnsupportedOperation):
+            pass  # no real stderr (embedded): no stack dumps, nothing else changes
+    from relrl.experiments import main as sis_main
     from relrl.experiments.report import summary_table
     from relrl.outdir import OutDir
 
+    if args.name == "scaling":
+        return _run_scaling(args)
     config = build_config(args)
     with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
                       default="runs/exp1") as out:
-        results, files = run_sis(config, out.path, workers=args.workers)
-        out.status = "complete"
+        results, files = sis_main.run_sis(config, out.path, workers=args.workers,
+                                          engine=args.engine, address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
     print(summary_table(results["summary"]))
-    print(f"\nwrote {len(files)} files to {out.path}/:")
+    return _finish(results, files, out.path)
+
+
+def _run_scaling(args: argparse.Namespace) -> int:
+    from relrl.experiments.scaling_report import run_scaling, scaling_table
+    from relrl.outdir import OutDir
+
+    config = build_scaling_config(args)
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      default="runs/scaling") as out:
+        results, files = run_scaling(config, out.path, workers=args.workers,
+                                     engine=args.engine, address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
+    timing = json.loads((out.path / "timing.json").read_text())
+    print(scaling_table(results, timing))
+    return _finish(results, files, out.path)
+
+
+def _finish(results: dict, files: list, out: Path) -> int:
+    print(f"\nwrote {len(files)} files to {out}/:")
     for f in files:
         print(f"  {f}")
+    if results.get("partial"):
+        print(f"stopped by {results.get('interrupted_by', 'a signal')}: the results are "
+              "partial (every finished evaluation point is kept)")
+        return 130 if results.get("interrupted_by") == "SIGINT" else 143
     return 0

@@ -13,7 +13,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "write_outputs", "summary_table", "write_json_atomic"]
+__all__ = ["aggregate", "pyplot_or_note", "skip_plots", "summary_table", "write_json_atomic",
+           "write_outputs"]
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -25,50 +26,90 @@ def write_json_atomic(path: Path, data: Any) -> None:
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
-    """Per learner: the CGI curve pooled over seeds, eye contacts, memory, states met."""
+    """Per learner: the CGI curves (relrl's and literal) pooled over seeds, eye contacts,
+    memory, states met. Jobs stopped part-way contribute the points they finished."""
     out: dict[str, Any] = {}
     for name in learners:
         mine = sorted((j for j in jobs if j["learner"] == name), key=lambda j: j["seed"])
         if not mine:
             continue
-        points = len(mine[0]["curve"])
+        points = max(len(j["curve"]) for j in mine)
         curve = []
         for p in range(points):
-            runs = [v for j in mine for v in j["curve"][p]["cgi_runs"]]
-            curve.append({"point": p, "learning_steps": mine[0]["curve"][p]["learning_steps"],
+            have = [j["curve"][p] for j in mine if len(j["curve"]) > p]
+            runs = [v for c in have for v in c["cgi_runs"]]
+            literal = [v for c in have for v in c["cgi_literal_runs"]]
+            curve.append({"point": p, "learning_steps": have[0]["learning_steps"],
                           "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
+                          "cgi_literal_mean": float(np.mean(literal)),
+                          "cgi_literal_std": float(np.std(literal)),
                           "n_runs": len(runs)})
-        flags = np.array([j["eye_contacts"]["per_opportunity"] for j in mine], dtype=float)
-        n_opp = min(len(f) for f in flags) if len(flags) else 0
-        cumulative = np.cumsum(flags[:, :n_opp], axis=1).mean(axis=0) if n_opp else np.zeros(0)
+        n_opp = min(len(j["eye_contacts"]["per_opportunity"]) for j in mine)
+        flags = np.array([j["eye_contacts"]["per_opportunity"][:n_opp] for j in mine],
+                         dtype=float).reshape(len(mine), n_opp)
+        cumulative = np.cumsum(flags, axis=1).mean(axis=0) if n_opp else np.zeros(0)
         established = [j["eye_contacts"]["established"] for j in mine]
         memory = {k: float(np.mean([j["memory"][k] for j in mine])) for k in mine[0]["memory"]}
+        evaluation = [j["states_met"]["evaluation"] for j in mine
+                      if j["states_met"]["evaluation"] is not None]
+        firsts = [j["curve"][1]["memory"] for j in mine if len(j["curve"]) > 1]
+        memory_first = ({k: float(np.mean([m[k] for m in firsts])) for k in firsts[0]}
+                        if firsts else None)
         out[name] = {
             "curve": curve,
             "cgi_after_first_run": curve[1]["cgi_mean"] if points > 1 else None,
             "cgi_final": curve[-1]["cgi_mean"],
+            "cgi_literal_after_first_run": curve[1]["cgi_literal_mean"] if points > 1 else None,
+            "cgi_literal_final": curve[-1]["cgi_literal_mean"],
             "eye_contacts": {"mean": float(np.mean(established)),
                              "std": float(np.std(established)),
                              "opportunities": n_opp,
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
+            "memory_after_first_run": memory_first,
             "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
-            "states_met_evaluation": float(np.mean([j["states_met"]["evaluation"]
-                                                    for j in mine])),
+            "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
+            "partial": any(j.get("partial", False) for j in mine),
         }
+        if "cgi_places" in mine[0]["curve"][0]:
+            out[name]["cgi_places"] = _places_curve(mine, points)
+    return out
+
+
+def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any]]:
+    """Per place group (trained, held_out), the CGI at each point pooled over seeds and runs
+    (correct shifts over shifts; None when no shift was made)."""
+    out: dict[str, list[Any]] = {}
+    for group in jobs[0]["curve"][0]["cgi_places"]:
+        values = []
+        for p in range(points):
+            runs = [r for j in jobs if len(j["curve"]) > p
+                    for r in j["curve"][p]["cgi_places"][group]["runs"]]
+            shifts = sum(r[1] for r in runs)
+            values.append(sum(r[0] for r in runs) / shifts if shifts else None)
+        out[group] = values
     return out
 
 
 def summary_table(summary: dict[str, Any]) -> str:
     """The results as a fixed-width text table."""
-    lines = [f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'eye contacts':>13} "
-             f"{'memory':>8} {'states':>7}"]
+    nan = float("nan")
+    places = any("cgi_places" in s for s in summary.values())
+    head = (f"{'learner':<12} {'CGI run 1':>9} {'CGI final':>9} {'literal':>8} "
+            f"{'eye contacts':>13} {'memory':>8} {'states':>7}")
+    lines = [head + (f" {'trained':>8} {'held out':>8}" if places else "")]
     for name, s in summary.items():
         ec = s["eye_contacts"]
         first = s["cgi_after_first_run"]
-        lines.append(f"{name:<12} {first if first is not None else float('nan'):>9.3f} "
-                     f"{s['cgi_final']:>9.3f} {ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
-                     f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+        line = (f"{name:<12} {first if first is not None else nan:>9.3f} "
+                f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
+                f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
+                f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+        if places:
+            for group in ("trained", "held_out"):
+                v = s.get("cgi_places", {}).get(group, [None])[-1]
+                line += f" {v:>8.3f}" if v is not None else f" {'-':>8}"
+        lines.append(line + ("  (partial)" if s.get("partial") else ""))
     return "\n".join(lines)
 
 
@@ -85,11 +126,13 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
     fig5 = out_dir / "fig5_cgi.csv"
     with open(fig5, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "n_runs"])
+        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std",
+                    "cgi_literal_mean", "cgi_literal_std", "n_runs"])
         for name, s in summary.items():
             for c in s["curve"]:
                 w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
-                            f"{c['cgi_std']:.6f}", c["n_runs"]])
+                            f"{c['cgi_std']:.6f}", f"{c['cgi_literal_mean']:.6f}",
+                            f"{c['cgi_literal_std']:.6f}", c["n_runs"]])
     fig4 = out_dir / "fig4_eye_contacts.csv"
     with open(fig4, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -105,12 +148,34 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
             detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
             w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
     written += [fig5, fig4, memory]
-    written += plot(out_dir, summary)
+    if any("cgi_places" in s for s in summary.values()):
+        places = out_dir / "cgi_places.csv"
+        with open(places, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["learner", "point", "cgi_trained", "cgi_held_out"])
+            for name, s in summary.items():
+                groups = s.get("cgi_places", {})
+                for p in range(len(s["curve"])):
+                    w.writerow([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
+                                            else f"{groups[g][p]:.6f}"
+                                            for g in ("trained", "held_out")])
+        written.append(places)
+    written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
 
 
-def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
-    """Fig. 4 and Fig. 5 as PNG files; nothing (and a note) without matplotlib."""
+def skip_plots(out_dir: Path) -> list[Path]:
+    """A note in place of the figures of an interrupted run (drawing them would delay the
+    stop by seconds; the numbers are in results.json and the CSVs)."""
+    note = out_dir / "PLOTS.txt"
+    note.write_text("The run was interrupted, so no figures were drawn (to stop at once); "
+                    "every finished point is in results.json and the CSV files.\n")
+    return [note]
+
+
+def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
+    """``(matplotlib.pyplot, [])`` drawing off-screen, or ``(None, [note])`` with a note in
+    ``out_dir`` saying how to get plots when matplotlib is not installed."""
     try:
         import matplotlib
 
@@ -121,7 +186,17 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
                         "are in the CSV files.\nInstall the extra to get plots:  "
                         "pip install 'relrl[plots]'\n")
-        return [note]
+        return None, [note]
+    return plt, []
+
+
+def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
+    """Fig. 4 and Fig. 5 as PNG files (and, with held-out places, the CGI on trained and
+    held-out places); nothing (and a note) without matplotlib."""
+    plt, note = pyplot_or_note(out_dir)
+    if plt is None:
+        return note
+
     def finish(fig, ax, name: str, xlabel: str, ylabel: str, title: str) -> Path:
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
@@ -138,9 +213,11 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, s in summary.items():
         steps = [c["point"] for c in s["curve"]]
-        ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
-                    yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3, capsize=3,
-                    label=name)
+        bars = ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
+                           yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3,
+                           capsize=3, label=name)
+        ax.plot(steps, [c["cgi_literal_mean"] for c in s["curve"]], ls="--", lw=1,
+                color=bars[0].get_color(), label=f"{name} (Eq. 5 literally)")
     ax.set_ylim(-0.05, 1.05)
     files.append(finish(fig, ax, "fig5_cgi.png",
                         "run (evaluation point; 500 learning time units each)",
@@ -155,4 +232,18 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     files.append(finish(fig, ax, "fig4_eye_contacts.png", "eye-contact opportunity",
                         "eye contacts established (cumulative)",
                         "Fig. 4 — capacity of attention (first opportunities)"))
+    if any("cgi_places" in s for s in summary.values()):
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for i, (name, s) in enumerate(summary.items()):
+            groups = s.get("cgi_places", {})
+            for group, style in (("trained", "-"), ("held_out", "--")):
+                values = groups.get(group, [])
+                points = [p for p, v in enumerate(values) if v is not None]
+                ax.plot(points, [values[p] for p in points], style, marker="o", ms=3,
+                        color=f"C{i}", label=f"{name}, {group.replace('_', '-')} places")
+        ax.set_ylim(-0.05, 1.05)
+        files.append(finish(fig, ax, "cgi_places.png",
+                            "run (evaluation point; 500 learning time units each)",
+                            "CGI (pooled shifts)",
+                            "Gaze following on trained and held-out places"))
     return files

@@ -1,5 +1,6 @@
 """Experiment 1 of da Silva & Romero (2012, section 5.1): contingency, Q-learning and ETG in
-the Social Interactive Simulator.
+the Social Interactive Simulator, relrl's relational learner tg beside them (and every other
+registered learner).
 
 Protocol: a learner interacts with the caregiver; every ``block`` (500) learning time units
 learning stops for an evaluation of ``eval_runs`` (20) runs of ``eval_steps`` (500) time
@@ -9,14 +10,18 @@ standard deviation per evaluation point. Fig. 4 counts the eye contacts the robo
 in the first 125 opportunities of the interaction. The learner's memory is reported in the
 paper's positions.
 
+Held-out places (``train_places``/``eval_places``): while learning, toys appear (and the
+caregiver looks) only at the training places (the caregiver's placement weights); evaluation
+puts targets (by a balanced sequence) and distractors at the evaluation places, and the CGI is
+also reported for the trained and the held-out places apart (``cgi_places`` at each point:
+pooled correct shifts over shifts).
+
 One *job* is one learner with one seed; jobs are independent and run in worker processes
 (each holds one Prolog engine).
 """
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -25,7 +30,7 @@ import numpy as np
 
 from relrl.resources import example
 
-__all__ = ["SISConfig", "run_job", "merge_parts", "DEFAULT_DOMAIN", "PAPER"]
+__all__ = ["SISConfig", "run_job", "job_from_curve", "DEFAULT_DOMAIN", "PAPER"]
 
 #: the SIS domain shipped with relrl (package data).
 DEFAULT_DOMAIN = example("domains/sis.pl")
@@ -40,11 +45,18 @@ PAPER: dict[str, Any] = {
 }
 
 
+def _all_learners() -> list[str]:
+    from relrl.learners import LEARNERS
+
+    return list(LEARNERS)
+
+
 @dataclass
 class SISConfig:
     """Everything that determines an Experiment 1 run (written into results.json)."""
 
-    learners: list[str] = field(default_factory=lambda: ["contingency", "qlearning", "etg"])
+    #: the registered learners (the paper's three, and relrl's own when registered).
+    learners: list[str] = field(default_factory=_all_learners)
     seeds: list[int] = field(default_factory=lambda: [0])
     points: int = 20                 #: evaluation points after the first (point 0: no learning)
     block: int = 500                 #: learning time units between evaluations
@@ -52,165 +64,159 @@ class SISConfig:
     eval_steps: int = 500
     opportunities: int = 125         #: Fig. 4: eye contacts in the first N opportunities
     caregiver: str = "paper"
-    #: The caregiver attends to the robot in every time unit of mutual gaze (Triesch et al.'s
-    #: reward for looking at the face); see docs/experiments.md for why and for the ablation.
-    caregiver_params: dict[str, Any] = field(
-        default_factory=lambda: {"attention_during_gaze": True})
+    #: overrides of the caregiver's parameters; the defaults are the simulator's (the same
+    #: task and reward as ``relrl/SharedAttention-v0``).
+    caregiver_params: dict[str, Any] = field(default_factory=dict)
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     domain: str = str(DEFAULT_DOMAIN)
     #: "behaviour": evaluate the robot as it behaves (its exploration kept, no learning);
     #: "greedy": the learners' greedy policy (contingency's roulette stays a roulette).
     eval_policy: str = "behaviour"
+    #: seconds one control step may run before the run stops (a rule that never ends); the
+    #: robot's own default is 10 s, batch runs on a loaded machine need more room.
+    timeout: float = 60.0
+    #: toy places used while learning (None: the caregiver's own placement).
+    train_places: list[str] | None = None
+    #: toy places of the evaluation's targets and distractors (None: all of them).
+    eval_places: list[str] | None = None
 
     def jobs(self) -> list[tuple[str, int]]:
         """Every (learner, seed) pair, learners first."""
         return [(learner, seed) for learner in self.learners for seed in self.seeds]
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready form."""
-        return asdict(self)
+        """JSON-ready form, with the caregiver's full parameters resolved."""
+        from relrl.sim.caregiver import make_caregiver
 
+        out = asdict(self)
+        out["caregiver_resolved"] = make_caregiver(self.caregiver,
+                                                   self.caregiver_params).params.to_dict()
+        return out
 
-def _nan_to_zero(x: float) -> float:
-    return 0.0 if math.isnan(x) else x
+    def place_split(self) -> tuple[dict[str, Any], dict[str, Any], tuple[str, ...] | None,
+                                   dict[str, set[str]]]:
+        """Learning and evaluation caregiver overrides, the evaluation's target places and
+        the place groups reported apart (empty without held-out places)."""
+        from relrl.sim.places import TOY_PLACES
+
+        learn, evaluation = dict(self.caregiver_params), dict(self.caregiver_params)
+        if self.train_places:
+            learn["placement"] = {p: 1.0 for p in self.train_places}
+        if not (self.train_places or self.eval_places):
+            return learn, evaluation, None, {}
+        places = tuple(self.eval_places or TOY_PLACES)
+        evaluation["placement"] = {p: 1.0 for p in places}
+        trained = set(self.train_places or TOY_PLACES)
+        return learn, evaluation, places, {"trained": set(places) & trained,
+                                           "held_out": set(places) - trained}
 
 
 def run_job(config: SISConfig, learner_name: str, seed: int,
-            progress: Callable[[str, int, int], None] | None = None,
-            runs: tuple[int, int] | None = None) -> dict[str, Any]:
+            runs: tuple[int, int] | None = None, *,
+            report: Callable[[dict[str, Any]], None] | None = None) -> dict[str, Any]:
     """Run one learner with one seed through the whole protocol.
 
-    Each evaluation run draws from random streams seeded for that run alone, and the
-    learner's own streams are saved before an evaluation and restored after it: learning
-    never depends on how much evaluating was done, and evaluation run *k* gives the same
-    numbers whichever process computes it. ``runs=(start, stop)`` computes only those
-    evaluation runs (the runner splits a job's evaluation over worker processes; each
+    Evaluations never change the learner (:class:`~relrl.experiments.protocol.Session`):
+    learning never depends on how much evaluating was done, and evaluation run *k* gives
+    the same numbers whichever process computes it. ``runs=(start, stop)`` computes only
+    those evaluation runs (the runner splits a job's evaluation over worker processes; each
     part repeats the short learning phase).
 
-    Returns a JSON-ready dict: the CGI of every evaluation run at every point, the eye
-    contacts of the first opportunities, the learner's memory, the states met.
-    Wall-clock figures go under ``"timing"`` (kept out of results.json so that the same
-    seed gives the same file).
+    ``report`` receives one ``{"kind": "point", ...}`` event per evaluation point, holding
+    that point's curve entry (a run stopped part-way keeps the points it finished).
+
+    Returns a JSON-ready dict: the CGI (relrl's and literal) of every evaluation run at every
+    point, the eye contacts of the first opportunities, the learner's memory, the states
+    met. Wall-clock figures go under ``"timing"`` (kept out of results.json so that the
+    same seed gives the same file).
     """
+    from relrl.experiments.protocol import Session, point_summary
+    from relrl.sim.caregiver import evaluation_sequence
+
     start, stop = runs if runs is not None else (0, config.eval_runs)
-    from relrl.kb import KnowledgeBase, gateway_calls
-    from relrl.learners import make_learner
-    from relrl.loop import Agent, Interaction
-    from relrl.sim.caregiver import make_caregiver
-    from relrl.sim.metrics import GazeMetrics
-    from relrl.sim.sis import SharedAttentionEnv
-
-    t_start = time.perf_counter()
-    calls0 = gateway_calls()
-    kb = KnowledgeBase(config.domain)
-    try:
-        learner = make_learner(learner_name, **config.learner_params.get(learner_name, {}))
-        agent = Agent(kb, learner, seed=seed)
-        caregiver = make_caregiver(config.caregiver, config.caregiver_params)
-        train_env = SharedAttentionEnv(caregiver, max_steps=None, record_trace=False)
-        eval_caregiver = make_caregiver(config.caregiver,
-                                        caregiver.params.for_evaluation().to_dict())
-        eval_env = SharedAttentionEnv(eval_caregiver, max_steps=config.eval_steps,
-                                      record_trace=False)
-        learning_metrics = GazeMetrics()
-        learning = Interaction(train_env, agent,
-                               on_step=lambda r: learning_metrics.add(r.info["record"]))
-        learning.reset(seed=seed)
-        eval_seeds = np.random.SeedSequence([seed, 1]).generate_state(config.eval_runs)
-        learning_states: set[int] = set()
-        eval_states: set[int] = set()
-        steps = 0
-
-        def evaluate() -> list[float]:
-            nonlocal steps
-            values = []
-            saved = agent.save_random()
-            before = set(agent.states)
-            agent.states.clear()
-            for run_seed in eval_seeds[start:stop]:
-                agent.reseed(int(run_seed))
-                metrics = GazeMetrics()
-                ev = Interaction(eval_env, agent,
-                                 on_step=lambda r, m=metrics: m.add(r.info["record"]))
-                ev.reset(seed=int(run_seed))
-                ev.run(config.eval_steps, learning=False,
-                       explore=config.eval_policy == "behaviour", keep=False)
-                steps += config.eval_steps
-                values.append(_nan_to_zero(metrics.cgi().value))
-            agent.end_episode()
-            agent.restore_random(saved)
-            eval_states.update(agent.states)
-            agent.states = before
-            return values
-
+    learn, evaluation, places, groups = config.place_split()
+    sequence = evaluation_sequence(places) if places else None
+    with Session(config.domain, learner_name, config.learner_params.get(learner_name, {}),
+                 seed, caregiver=config.caregiver, caregiver_params=learn,
+                 eval_caregiver_params=evaluation, eval_steps=config.eval_steps,
+                 eval_policy=config.eval_policy, timeout=config.timeout) as session:
         curve = []
         for point in range(config.points + 1):
             if point > 0:
-                learning.run(config.block, learning=True, keep=False)
-                learning_states |= agent.states
-                steps += config.block
-            values = evaluate()
-            curve.append({"point": point, "learning_steps": point * config.block,
-                          "cgi_mean": float(np.mean(values)), "cgi_std": float(np.std(values)),
-                          "cgi_runs": values})
-            if progress is not None:
-                progress(learner_name, seed, point)
-        contacts = learning_metrics.eye_contacts(config.opportunities)
-        result = {
-            "learner": learner_name,
-            "seed": seed,
-            "params": learner.params,
-            "curve": curve,
-            "eye_contacts": {"established": contacts.established,
-                             "opportunities": contacts.opportunities,
-                             "per_opportunity": [bool(f) for f in contacts.per_opportunity]},
-            "mutual_gaze_events": learning_metrics.mutual_gaze_events,
-            "learning_cgi": _nan_to_zero(learning_metrics.cgi().value),
-            "memory": learner.size(),
-            "states_met": {"learning": len(learning_states),
-                           "all": len(learning_states | eval_states)},
-            "runs": [start, stop],
-            "eval_states": sorted(eval_states),
-        }
-        elapsed = time.perf_counter() - t_start
-        calls = gateway_calls() - calls0
-        result["timing"] = {"seconds": elapsed, "steps": steps,
-                            "steps_per_second": steps / elapsed if elapsed else 0.0,
-                            "gateway_calls_per_step": calls / steps if steps else 0.0}
-        return result
-    finally:
-        kb.close()
+                session.learn(config.block)
+            ev = session.evaluate(config.eval_runs, which=(start, stop), sequence=sequence,
+                                  by_place=bool(groups))
+            entry = {"point": point, "learning_steps": point * config.block,
+                     "runs": [start, stop], **point_summary(ev),
+                     "memory": session.memory(),
+                     "eye_contacts": session.eye_contacts(config.opportunities),
+                     "learning": session.learning_summary(),
+                     "states_met": len(session.learning_states)}
+            if groups:
+                entry["place_runs"] = {
+                    g: [[sum(r["by_place"].get(p, [0, 0])[i] for p in ps) for i in (0, 1)]
+                        for r in ev.runs] for g, ps in sorted(groups.items())}
+            curve.append(entry)
+            if report is not None:
+                report({"kind": "point", "learner": learner_name, "seed": seed,
+                        "point": point, "entry": entry})
+        return {"learner": learner_name, "seed": seed,
+                "params": session.learner.params, "curve": curve, "runs": [start, stop],
+                "eval_states": sorted(session.eval_states), "timing": session.timing()}
 
 
-def merge_parts(parts: list[dict[str, Any]]) -> dict[str, Any]:
-    """Join the parts of one (learner, seed) job computed by different processes.
+def _pooled(runs: list[list[int]]) -> dict[str, Any]:
+    """The runs' ``[correct, shifts]`` and their pooled CGI (None: no shift at all)."""
+    correct, shifts = sum(r[0] for r in runs), sum(r[1] for r in runs)
+    return {"cgi": correct / shifts if shifts else None, "runs": runs}
 
-    The learning phase is the same in every part (it never depends on the evaluation);
-    the evaluation runs are concatenated in order.
+
+def job_from_curve(learner: str, seed: int, parts: list[list[dict[str, Any]]],
+                   params: dict[str, float] | None = None,
+                   eval_states: set[int] | None = None) -> dict[str, Any] | None:
+    """One (learner, seed) job from the curves its parts computed (possibly unfinished).
+
+    The learning phase is the same in every part (it never depends on the evaluation), so
+    the learning figures come from any part that reached a point, and the evaluation runs
+    are concatenated in order. A run stopped part-way keeps every evaluation run that
+    finished: a point some part did not reach is kept with the runs it has and marked
+    ``"incomplete": true``. ``None`` when no part finished a point.
     """
-    parts = sorted(parts, key=lambda p: p["runs"][0])
-    first = parts[0]
-    for p in parts[1:]:
-        for key in ("eye_contacts", "memory", "mutual_gaze_events", "learning_cgi"):
-            if p[key] != first[key]:
-                raise RuntimeError(f"parts of {first['learner']} seed {first['seed']} disagree "
-                                   f"on {key}: the learning phase is not repeatable")
-    job = {k: v for k, v in first.items() if k not in ("runs", "eval_states", "timing")}
-    job["curve"] = []
-    for i, point in enumerate(first["curve"]):
-        runs = [v for p in parts for v in p["curve"][i]["cgi_runs"]]
-        job["curve"].append({"point": point["point"], "learning_steps": point["learning_steps"],
-                             "cgi_mean": float(np.mean(runs)), "cgi_std": float(np.std(runs)),
-                             "cgi_runs": runs})
-    learning_states = first["states_met"]["learning"]
-    eval_states = set().union(*(p["eval_states"] for p in parts))
-    job["states_met"] = {"learning": learning_states, "evaluation": len(eval_states)}
-    job["timing"] = {
-        "seconds": sum(p["timing"]["seconds"] for p in parts),
-        "steps": sum(p["timing"]["steps"] for p in parts),
-        "parts": len(parts),
-    }
-    job["timing"]["steps_per_second"] = job["timing"]["steps"] / job["timing"]["seconds"]
-    job["timing"]["gateway_calls_per_step"] = float(np.mean(
-        [p["timing"]["gateway_calls_per_step"] for p in parts]))
+    expected = len(parts)
+    parts = sorted((c for c in parts if c), key=lambda c: c[0]["runs"][0])
+    if not parts:
+        return None
+    common = min(len(c) for c in parts)
+    longest = max(parts, key=len)
+    for c in parts:
+        for key in ("memory", "eye_contacts", "learning"):
+            if common and c[common - 1][key] != parts[0][common - 1][key]:
+                raise RuntimeError(f"parts of {learner} seed {seed} disagree on {key}: the "
+                                   "learning phase is not repeatable")
+    curve = []
+    for i in range(len(longest)):
+        have = [c[i] for c in parts if len(c) > i]
+        runs = {k: [v for entry in have for v in entry[k]]
+                for k in ("cgi_runs", "cgi_literal_runs", "eye_contacts_runs")}
+        curve.append({"point": have[0]["point"], "learning_steps": have[0]["learning_steps"],
+                      "cgi_mean": float(np.mean(runs["cgi_runs"])),
+                      "cgi_std": float(np.std(runs["cgi_runs"])),
+                      "cgi_literal_mean": float(np.mean(runs["cgi_literal_runs"])),
+                      "cgi_literal_std": float(np.std(runs["cgi_literal_runs"])),
+                      "memory": have[0]["memory"], **runs})
+        if len(have) < expected:
+            curve[-1]["incomplete"] = True
+        if "place_runs" in have[0]:
+            curve[-1]["cgi_places"] = {
+                g: _pooled([r for entry in have for r in entry["place_runs"][g]])
+                for g in have[0]["place_runs"]}
+    last = longest[-1]
+    job = {"learner": learner, "seed": seed, "curve": curve,
+           "eye_contacts": last["eye_contacts"],
+           "mutual_gaze_events": last["learning"]["mutual_gaze_events"],
+           "learning": last["learning"], "memory": last["memory"],
+           "states_met": {"learning": last["states_met"],
+                          "evaluation": len(eval_states) if eval_states is not None else None}}
+    if params is not None:
+        job["params"] = params
     return job

@@ -10,17 +10,20 @@ cycle of three phases:
 ``engage``
     The caregiver looks at the robot (its face is ``frontal`` to the robot) and waits for eye
     contact: the robot's focus on the caregiver's face for ``contact_hold`` (3) consecutive
-    time units. Each entry into this phase is one *eye-contact opportunity*. When eye contact
-    is established the caregiver gives attention (if ``attention_on_contact``). If it is not
-    established within ``contact_timeout`` time units the opportunity is missed and a new one
-    starts (the caregiver keeps looking at the robot; toys only come after eye contact).
+    time units. Each entry into this phase is one *eye-contact opportunity*. The caregiver
+    gives attention **at most once per opportunity**: when eye contact is established
+    (``attention_on_contact``, the default), or already in the first time unit the robot
+    looks at its face (``attention_during_gaze``). If eye contact is not established within
+    ``contact_timeout`` time units the opportunity is missed and a new one starts (the
+    caregiver keeps looking at the robot; toys only come after eye contact).
 ``present``
     The time unit after eye contact the toys appear (``n_toys`` of them, at empty places drawn
-    with ``placement`` weights; the first is the target). The caregiver keeps looking at the
+    with ``placement`` weights; the first is the target, the others distractors; each gets a
+    colour from ``toy_colours`` and a kind from ``toy_kinds``). The caregiver keeps looking at the
     robot for ``latency`` time units (0: it turns in the same time unit).
 ``attend``
     The caregiver looks at the target (with probability ``reliability``; otherwise at one of
-    the other four toy places, uniformly) and waits ``timeout`` time units after turning. In
+    the other toy places, uniformly) and waits ``timeout`` time units after turning. In
     the time unit the robot's focus is on the target, the caregiver gives attention; both look
     at the toy in that time unit. In the next time unit the toys are gone and the caregiver
     looks at the robot again (a new ``engage``). On timeout, or with ``single_look`` after the
@@ -36,13 +39,13 @@ import abc
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from relrl.sim.errors import CaregiverConfigError, UnknownCaregiver, did_you_mean
-from relrl.sim.places import CENTRE, PLACES, TOY_PLACES, place_index
+from relrl.sim.places import CENTRE, MAX_PLACES, TOY_PLACES
 
 __all__ = [
     "ATTEND",
@@ -53,7 +56,9 @@ __all__ = [
     "CaregiverParams",
     "ProtocolCaregiver",
     "caregiver_names",
+    "evaluation_sequence",
     "make_caregiver",
+    "preset_params",
     "register_caregiver",
 ]
 
@@ -61,17 +66,36 @@ __all__ = [
 ENGAGE, PRESENT, ATTEND = "engage", "present", "attend"
 
 #: a fixed, balanced sequence of target places for evaluation runs: each toy place four
-#: times, never twice in a row (the paper's "pre-established sequence"; its own is unknown).
+#: times, never twice in a row, also across the wrap from the end to the start (the paper's
+#: "pre-established sequence"; its own is unknown).
 EVALUATION_SEQUENCE: tuple[str, ...] = (
     "left", "down", "right_down", "left_down", "right",
     "down", "left_down", "right", "left", "right_down",
     "right", "left", "left_down", "down", "right_down",
-    "left_down", "right_down", "down", "right", "left",
+    "left_down", "right_down", "down", "left", "right",
 )
 
 
-def _uniform() -> dict[str, float]:
-    return {p: 1.0 for p in TOY_PLACES}
+def evaluation_sequence(places: tuple[str, ...] = TOY_PLACES, rounds: int = 4
+                        ) -> tuple[str, ...]:
+    """A fixed, balanced sequence of evaluation targets over ``places``.
+
+    Each place appears ``rounds`` times, never twice in a row (nor across the wrap from the
+    end to the start). The paper's five places give :data:`EVALUATION_SEQUENCE`; other worlds
+    get rounds shuffled by a generator seeded with the number of places, so the sequence is
+    the same on every machine.
+    """
+    places = tuple(places)
+    if places == TOY_PLACES and rounds == 4:
+        return EVALUATION_SEQUENCE
+    if len(places) == 1:
+        return places * rounds
+    rng = np.random.default_rng(len(places))
+    while True:  # draw rounds until no place follows itself (cyclically); a few tries
+        out = [places[i] for _ in range(rounds) for i in rng.permutation(len(places))]
+        if all(out[k] != out[k - 1] for k in range(len(out))):
+            break
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -79,16 +103,22 @@ class CaregiverParams:
     """What a researcher varies about the caregiver. Every time is in time units (steps).
 
     Attributes:
-        n_toys: toys put out per trial (1 to 5); the first is the target, the others are
-            distractors.
+        n_toys: toys put out per trial (1 to the number of places); the first is the target,
+            the others are distractors (the caregiver never means them).
         placement: weight of each toy place for placing a toy (missing places weigh 0); the
             target is drawn with these weights, then each distractor among the places still
-            empty (uniformly among them if those all weigh 0).
+            empty (uniformly among them if those all weigh 0). ``None``: every place alike.
         toy_colours: colours given to the toys of a trial in a random order (cycled if there
             are more toys than colours); the robot perceives ``colour(toy, C)``. Empty: toys
             have no colour and no colour percept.
+        toy_kinds: kinds of toy (``ball``, ``car``, ...) dealt to a trial's toys like the
+            colours; the robot perceives ``kind(toy, K)``. Empty (the paper's world): toys
+            have no kind and no kind percept.
+        places: the toy places of the world, from the robot's left to its right (see
+            :func:`relrl.sim.places.layout`); ``centre`` is always the caregiver's face.
         reliability: probability that the caregiver looks at the target; otherwise it looks
-            at one of the other four toy places, uniformly (0.2 makes its gaze uninformative).
+            at one of the other toy places, uniformly (with five places 0.2 makes its gaze
+            uninformative).
         latency: time units the caregiver keeps looking at the robot after placing the toys
             before it turns to the target (0: places and turns in the same time unit).
         timeout: time units the caregiver waits, after turning, for the robot to look at the
@@ -97,10 +127,13 @@ class CaregiverParams:
             that make eye contact (the paper: 3).
         contact_timeout: time units an eye-contact opportunity lasts before it is missed and
             a new one starts; ``None`` waits for ever.
-        attention_on_contact: give attention in the time unit eye contact is established.
-        attention_during_gaze: also give attention in every time unit of mutual gaze while
-            waiting for eye contact (the robot on the caregiver's face, the caregiver looking
-            at the robot), as Triesch et al.'s caregiver rewards looking at its face.
+        attention_on_contact: give attention in the time unit eye contact is established
+            (unless it was given already in this opportunity).
+        attention_during_gaze: give attention already in the first time unit of mutual gaze
+            of each opportunity (the robot on the caregiver's face, the caregiver looking at
+            the robot), as Triesch et al.'s caregiver rewards looking at its face. Either way
+            the caregiver attends at most once per opportunity: looking away and back cannot
+            farm attention.
         single_look: end a trial (no attention) at the robot's first look, after the turn, at
             anything but the face or the target — one try per trial, as the paper's
             evaluation reads.
@@ -110,8 +143,10 @@ class CaregiverParams:
     """
 
     n_toys: int = 2
-    placement: Mapping[str, float] = field(default_factory=_uniform)
+    placement: Mapping[str, float] | None = None
     toy_colours: tuple[str, ...] = ("red", "green")
+    toy_kinds: tuple[str, ...] = ()
+    places: tuple[str, ...] = TOY_PLACES
     reliability: float = 1.0
     latency: int = 0
     timeout: int = 5
@@ -127,24 +162,40 @@ class CaregiverParams:
             value = getattr(self, name)
             return CaregiverConfigError(f"caregiver parameter {name}={value!r}: {why}")
 
-        if not isinstance(self.n_toys, int) or not 1 <= self.n_toys <= len(TOY_PLACES):
-            raise bad("n_toys", f"use a whole number from 1 to {len(TOY_PLACES)}")
+        places = tuple(self.places) if isinstance(self.places, list | tuple) else None
+        if (not places or len(places) > MAX_PLACES or "centre" in places
+                or len(set(places)) != len(places)
+                or not all(isinstance(x, str) and x for x in places)):
+            raise bad("places", f"use 1 to {MAX_PLACES} distinct place names other than "
+                                "'centre', e.g. relrl.sim.places.place_names(9)")
+        object.__setattr__(self, "places", places)
+        if (not isinstance(self.n_toys, int) or isinstance(self.n_toys, bool)
+                or not 1 <= self.n_toys <= len(places)):
+            raise bad("n_toys", f"use a whole number from 1 to {len(places)}")
+        if self.placement is None:
+            object.__setattr__(self, "placement", {p: 1.0 for p in places})
         if not isinstance(self.placement, Mapping):
             raise bad("placement", "use a mapping place -> weight, e.g. {'left': 2.0}")
         weights = {}
         for place, weight in self.placement.items():
-            if place not in TOY_PLACES:
-                raise bad("placement", f"unknown place {place!r}{did_you_mean(place, TOY_PLACES)}"
-                          f" (places: {', '.join(TOY_PLACES)})")
+            if place not in places:
+                shown = ", ".join(places) if len(places) <= 9 else \
+                    f"{places[0]} ... {places[-1]}"
+                raise bad("placement", f"unknown place {place!r}{did_you_mean(place, places)}"
+                          f" (places: {shown})")
             if not isinstance(weight, int | float) or weight < 0 or math.isnan(weight):
                 raise bad("placement", f"the weight of {place!r} must be a number >= 0")
             weights[place] = float(weight)
         if sum(w > 0 for w in weights.values()) < 1:
             raise bad("placement", "give at least one place a positive weight")
-        object.__setattr__(self, "placement", {p: weights.get(p, 0.0) for p in TOY_PLACES})
-        object.__setattr__(self, "toy_colours", tuple(self.toy_colours))
-        if not all(isinstance(c, str) and c for c in self.toy_colours):
-            raise bad("toy_colours", "use non-empty colour names, e.g. ('red', 'green')")
+        object.__setattr__(self, "placement", {p: weights.get(p, 0.0) for p in places})
+        for name, example in (("toy_colours", "('red', 'green')"),
+                              ("toy_kinds", "('ball', 'car')")):
+            value = getattr(self, name)
+            if isinstance(value, str) or not isinstance(value, list | tuple) or not all(
+                    isinstance(c, str) and c for c in value):
+                raise bad(name, f"use a sequence of non-empty names, e.g. {example}")
+            object.__setattr__(self, name, tuple(value))
         if not isinstance(self.reliability, int | float) or not 0.0 <= self.reliability <= 1.0:
             raise bad("reliability", "use a probability from 0 to 1")
         for name, low in (("latency", 0), ("timeout", 1), ("contact_hold", 1)):
@@ -161,9 +212,9 @@ class CaregiverParams:
             if not seq:
                 raise bad("target_sequence", "use None or a non-empty sequence of places")
             for place in seq:
-                if place not in TOY_PLACES:
+                if place not in places:
                     raise bad("target_sequence", f"unknown place {place!r}"
-                              f"{did_you_mean(str(place), TOY_PLACES)}")
+                              f"{did_you_mean(str(place), places)}")
             object.__setattr__(self, "target_sequence", seq)
 
     def replace(self, **overrides: Any) -> CaregiverParams:
@@ -176,9 +227,11 @@ class CaregiverParams:
                     f"(parameters: {', '.join(sorted(names))})")
         return dataclasses.replace(self, **overrides)
 
-    def for_evaluation(self, sequence: tuple[str, ...] = EVALUATION_SEQUENCE
-                       ) -> CaregiverParams:
-        """Return a copy in evaluation mode: targets from ``sequence``."""
+    def for_evaluation(self, sequence: tuple[str, ...] | None = None) -> CaregiverParams:
+        """Return a copy in evaluation mode: targets from ``sequence`` (default: the
+        balanced :func:`evaluation_sequence` of this caregiver's places)."""
+        if sequence is None:
+            sequence = evaluation_sequence(self.places)
         return self.replace(target_sequence=tuple(sequence))
 
     def to_dict(self) -> dict[str, Any]:
@@ -186,6 +239,8 @@ class CaregiverParams:
         out = dataclasses.asdict(self)
         out["placement"] = dict(self.placement)
         out["toy_colours"] = list(self.toy_colours)
+        out["toy_kinds"] = list(self.toy_kinds)
+        out["places"] = list(self.places)
         if self.target_sequence is not None:
             out["target_sequence"] = list(self.target_sequence)
         return out
@@ -196,30 +251,40 @@ class Caregiver(abc.ABC):
 
     Attributes:
         params: the parameters it was built with.
+        places: every place of its world, ``centre`` first (``("centre",) + params.places``).
         phase: the current phase name (``engage``, ``present``, ``attend`` for the protocol).
-        gaze: index in :data:`~relrl.sim.places.PLACES` of where it looks; ``CENTRE`` (0)
-            means at the robot (the robot then sees a ``frontal`` face).
+        gaze: index in :attr:`places` of where it looks; ``CENTRE`` (0) means at the robot
+            (the robot then sees a ``frontal`` face).
         toy_at: for each place index, the colour of the toy there (``""`` for a toy without
             colour), or ``None`` when the place is empty.
+        kind_at: for each place index, the kind of the toy there (``""`` without kinds).
         toys: the toys out now as ``(place, colour)`` pairs, target first.
+        kinds: the kinds of :attr:`toys`, in the same order (empty without kinds).
         target: place index of the target toy, or -1 when there is none.
         opportunity: index of the current eye-contact opportunity (from 0).
         trial: index of the current (or last) toy trial (-1 before the first).
         contact: eye contact was established in this time unit.
         attention: attention is given in this time unit.
+        sequence_offset: evaluation mode: trial *k* of an episode takes the target at
+            ``target_sequence[(k + sequence_offset) % len]`` (set before ``reset``).
     """
 
     def __init__(self, params: CaregiverParams) -> None:
         self.params = params
+        self.places: tuple[str, ...] = ("centre",) + params.places
+        self._index = {name: i for i, name in enumerate(self.places)}
         self.phase = ENGAGE
         self.gaze = CENTRE
-        self.toy_at: list[str | None] = [None] * len(PLACES)
+        self.toy_at: list[str | None] = [None] * len(self.places)
+        self.kind_at: list[str] = [""] * len(self.places)
         self.toys: tuple[tuple[str, str], ...] = ()
+        self.kinds: tuple[str, ...] = ()
         self.target = -1
         self.opportunity = 0
         self.trial = -1
         self.contact = False
         self.attention = False
+        self.sequence_offset = 0
 
     @abc.abstractmethod
     def reset(self, rng: np.random.Generator, focus: int) -> None:
@@ -239,6 +304,7 @@ class ProtocolCaregiver(Caregiver):
         self._next: Callable[[], None] | None = None
         self._age = 0
         self._streak = 0
+        self._attended = False
         self.opportunity = -1
         self.trial = -1
         self._enter_engage()
@@ -259,14 +325,18 @@ class ProtocolCaregiver(Caregiver):
     def _enter_engage(self) -> None:
         if self.toys:
             for place, _ in self.toys:
-                self.toy_at[place_index(place)] = None
+                i = self._index[place]
+                self.toy_at[i] = None
+                self.kind_at[i] = ""
             self.toys = ()
+            self.kinds = ()
         self.target = -1
         self.gaze = CENTRE
         self.phase = ENGAGE
         self.opportunity += 1
         self._streak = 0
         self._age = 0
+        self._attended = False
 
     def _enter_present(self) -> None:
         self._place_toys()
@@ -285,7 +355,7 @@ class ProtocolCaregiver(Caregiver):
         if u < p.reliability:
             self.gaze = self.target
         else:
-            others = [i for i in range(1, len(PLACES)) if i != self.target]
+            others = [i for i in range(1, len(self.places)) if i != self.target]
             self.gaze = others[min(int(v * len(others)), len(others) - 1)]
 
     def _judge(self, focus: int) -> None:
@@ -295,11 +365,12 @@ class ProtocolCaregiver(Caregiver):
         phase = self.phase
         if phase == ENGAGE:
             self._streak = self._streak + 1 if focus == CENTRE else 0
-            if p.attention_during_gaze and focus == CENTRE:
-                self.attention = True
+            if p.attention_during_gaze and focus == CENTRE and not self._attended:
+                self.attention = self._attended = True
             if self._streak >= p.contact_hold:
                 self.contact = True
-                self.attention = p.attention_on_contact
+                if p.attention_on_contact and not self._attended:
+                    self.attention = self._attended = True
                 self._next = self._enter_present
             elif p.contact_timeout is not None and self._age + 1 >= p.contact_timeout:
                 self._next = self._enter_engage  # missed: a new opportunity starts
@@ -317,7 +388,8 @@ class ProtocolCaregiver(Caregiver):
 
     def _draw(self, free: list[int]) -> int:
         """Draw a place index from ``free`` with the placement weights."""
-        weights = [self.params.placement[PLACES[i]] for i in free]
+        placement, places = self.params.placement, self.places
+        weights = [placement[places[i]] for i in free]
         total = sum(weights)
         if total <= 0:
             weights, total = [1.0] * len(free), float(len(free))
@@ -328,12 +400,20 @@ class ProtocolCaregiver(Caregiver):
                 return place
         return max(pl for pl, w in zip(free, weights, strict=True) if w > 0)  # rounding
 
+    def _deal(self, names: tuple[str, ...], n: int) -> list[str]:
+        """``n`` names dealt from ``names`` in a random order (cycled), or ``""`` each."""
+        if not names:
+            return [""] * n
+        order = self._rng.permutation(len(names))
+        return [names[order[k % len(names)]] for k in range(n)]
+
     def _place_toys(self) -> None:
         p = self.params
         self.trial += 1
-        free = list(range(1, len(PLACES)))
+        free = list(range(1, len(self.places)))
         if p.target_sequence is not None:
-            target = place_index(p.target_sequence[self.trial % len(p.target_sequence)])
+            seq = p.target_sequence
+            target = self._index[seq[(self.trial + self.sequence_offset) % len(seq)]]
             self._rng.random()  # keep the random stream aligned with the drawing mode
         else:
             target = self._draw(free)
@@ -343,15 +423,13 @@ class ProtocolCaregiver(Caregiver):
             place = self._draw(free)
             free.remove(place)
             chosen.append(place)
-        colours = p.toy_colours
-        if colours:
-            order = self._rng.permutation(len(colours))
-            names = [colours[order[k % len(colours)]] for k in range(len(chosen))]
-        else:
-            names = [""] * len(chosen)
-        for place, colour in zip(chosen, names, strict=True):
+        colours = self._deal(p.toy_colours, len(chosen))
+        kinds = self._deal(p.toy_kinds, len(chosen)) if p.toy_kinds else [""] * len(chosen)
+        for place, colour, kind in zip(chosen, colours, kinds, strict=True):
             self.toy_at[place] = colour
-        self.toys = tuple((PLACES[pl], c) for pl, c in zip(chosen, names, strict=True))
+            self.kind_at[place] = kind
+        self.toys = tuple((self.places[pl], c) for pl, c in zip(chosen, colours, strict=True))
+        self.kinds = tuple(kinds) if p.toy_kinds else ()
         self.target = target
         self.gaze = CENTRE
 
@@ -374,6 +452,24 @@ def register_caregiver(name: str, factory: Callable[[CaregiverParams], Caregiver
     _REGISTRY[name] = (factory, params or CaregiverParams(), doc)
 
 
+def preset_params(name: str = "paper") -> CaregiverParams:
+    """The default parameters of a registered caregiver model.
+
+    Raises:
+        UnknownCaregiver: no model has this name (the message suggests the closest).
+    """
+    return _lookup(name)[1]
+
+
+def _lookup(name: str) -> tuple[Callable[[CaregiverParams], Caregiver], CaregiverParams, str]:
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        raise UnknownCaregiver(f"unknown caregiver model {name!r}"
+                               f"{did_you_mean(str(name), _REGISTRY)}"
+                               f" (models: {', '.join(_REGISTRY)})") from None
+
+
 def caregiver_names() -> dict[str, str]:
     """Return registered name -> one-line description."""
     return {name: doc for name, (_, _, doc) in _REGISTRY.items()}
@@ -391,11 +487,7 @@ def make_caregiver(name: str = "paper", params: CaregiverParams | Mapping[str, A
         UnknownCaregiver: no model has this name (the message suggests the closest).
         CaregiverConfigError: a parameter is unknown or has a bad value.
     """
-    try:
-        factory, preset, _ = _REGISTRY[name]
-    except KeyError:
-        raise UnknownCaregiver(f"unknown caregiver model {name!r}{did_you_mean(name, _REGISTRY)}"
-                               f" (models: {', '.join(_REGISTRY)})") from None
+    factory, preset, _ = _lookup(name)
     if isinstance(params, CaregiverParams):
         return factory(params)
     return factory(preset.replace(**dict(params or {})))

@@ -16,13 +16,21 @@ robot on the frontal face. An opportunity counts once it is over (a later number
 established; the last one, still open and not established, is left out. Uses
 ``opportunity``, ``focus`` and ``gaze``.
 
-Correct gaze index (Eq. 5, after Whalen & Schreibman): a *shift from the human* is a pair of
-consecutive records where the robot looked at the caregiver's face (``focus == "centre"``)
-while the caregiver was looking at a place (``gaze != "frontal"``), and then looks anywhere
-else. It is *correct* when the new focus is the place the caregiver was looking at (its gaze
-in the first record: what the robot saw when it decided). CGI = correct / shifts; shifts made
-while the caregiver looks at the robot have no correct location and are not counted. Uses
-``focus`` and ``gaze``.
+Correct gaze index (Eq. 5, after Whalen & Schreibman), in two readings. A *shift from the
+human* is a pair of consecutive records where the robot looked at the caregiver's face
+(``focus == "centre"``) and then looks anywhere else. It is *correct* when the new focus is
+the place the caregiver was looking at (its gaze in the first record: what the robot saw
+when it decided).
+
+* **relrl's CGI** (:meth:`GazeMetrics.cgi`) counts only the shifts made while the caregiver
+  was looking at a place (``gaze != "frontal"``): a shift while the caregiver looks at the
+  robot has no correct location, and counting it as wrong measures eye contact, not gaze
+  following.
+* **The literal CGI** (:meth:`GazeMetrics.cgi_literal`) is Eq. 5 as written: correct shifts
+  over *every* shift from the human, whatever the caregiver was looking at. Looking away
+  before the caregiver turns to a toy lowers it.
+
+Both use ``focus`` and ``gaze``; the correct shifts are the same in both.
 
 :class:`GazeMetrics` computes all three in one pass and can be fed record by record, so a
 long learning run needs no stored trace.
@@ -40,6 +48,7 @@ __all__ = [
     "GazeMetrics",
     "StepRecord",
     "cgi",
+    "cgi_literal",
     "eye_contacts",
     "mutual_gaze_events",
     "summarize",
@@ -63,6 +72,7 @@ class StepRecord(NamedTuple):
         target: the target's place, or ``None``.
         attention: the caregiver gives attention in this time unit (the reward).
         contact: eye contact was established in this time unit.
+        kinds: the kinds of ``toys``, in the same order (empty when toys have no kind).
     """
 
     t: int
@@ -75,6 +85,7 @@ class StepRecord(NamedTuple):
     target: str | None = None
     attention: bool = False
     contact: bool = False
+    kinds: tuple[str, ...] = ()
 
 
 class CGI(NamedTuple):
@@ -118,6 +129,10 @@ class GazeMetrics:
         #: shifts from the human while the caregiver looked at a place, and correct ones.
         self.shifts = 0
         self.correct_shifts = 0
+        #: every shift from the human, whatever the caregiver looked at (Eq. 5 literally).
+        self.all_shifts = 0
+        #: per place the caregiver looked at: [correct shifts, shifts] (relrl's CGI by place).
+        self.by_place: dict[str, list[int]] = {}
         self._finished: list[bool] = []
         self._streak = 0
         self._prev: StepRecord | None = None
@@ -142,11 +157,15 @@ class GazeMetrics:
             self._opp_done = True
         # CGI shifts
         prev = self._prev
-        if (prev is not None and prev.focus == CENTRE and prev.gaze != FRONTAL
-                and rec.focus != CENTRE):
-            self.shifts += 1
-            if rec.focus == prev.gaze:
-                self.correct_shifts += 1
+        if prev is not None and prev.focus == CENTRE and rec.focus != CENTRE:
+            self.all_shifts += 1
+            if prev.gaze != FRONTAL:
+                self.shifts += 1
+                counts = self.by_place.setdefault(prev.gaze, [0, 0])
+                counts[1] += 1
+                if rec.focus == prev.gaze:
+                    self.correct_shifts += 1
+                    counts[0] += 1
         self._prev = rec
 
     def extend(self, records: Iterable[StepRecord]) -> GazeMetrics:
@@ -156,9 +175,23 @@ class GazeMetrics:
         return self
 
     def cgi(self) -> CGI:
-        """The correct gaze index so far."""
+        """relrl's correct gaze index so far (shifts while the caregiver looks at a place)."""
         value = self.correct_shifts / self.shifts if self.shifts else math.nan
         return CGI(self.correct_shifts, self.shifts, value)
+
+    def cgi_literal(self) -> CGI:
+        """Eq. 5 read literally: correct shifts over every shift from the human."""
+        value = self.correct_shifts / self.all_shifts if self.all_shifts else math.nan
+        return CGI(self.correct_shifts, self.all_shifts, value)
+
+    def summary(self, first: int | None = 125) -> dict[str, float | int]:
+        """Every metric as a flat, JSON-ready dict (CGIs are NaN without shifts)."""
+        c, lit = self.cgi(), self.cgi_literal()
+        e = self.eye_contacts(first)
+        return {"cgi": c.value, "cgi_literal": lit.value, "correct_shifts": c.correct,
+                "shifts": c.shifts, "all_shifts": lit.shifts,
+                "mutual_gaze_events": self.mutual_gaze_events,
+                "eye_contacts": e.established, "opportunities": e.opportunities}
 
     def eye_contacts(self, first: int | None = None) -> EyeContacts:
         """Eye contacts in the first ``first`` opportunities (all when ``None``)."""
@@ -171,8 +204,13 @@ class GazeMetrics:
 
 
 def cgi(trace: Iterable[StepRecord]) -> CGI:
-    """The correct gaze index (Eq. 5) of a trace; see the module documentation."""
+    """relrl's correct gaze index (Eq. 5) of a trace; see the module documentation."""
     return GazeMetrics().extend(trace).cgi()
+
+
+def cgi_literal(trace: Iterable[StepRecord]) -> CGI:
+    """The correct gaze index of a trace with Eq. 5 read literally (every shift counts)."""
+    return GazeMetrics().extend(trace).cgi_literal()
 
 
 def mutual_gaze_events(trace: Iterable[StepRecord], hold: int = 3) -> int:
@@ -189,9 +227,4 @@ def eye_contacts(trace: Iterable[StepRecord], first: int | None = 125, hold: int
 def summarize(trace: Iterable[StepRecord], hold: int = 3, first: int | None = 125
               ) -> dict[str, float | int]:
     """All metrics of a trace as a flat, JSON-ready dict."""
-    m = GazeMetrics(hold).extend(trace)
-    c = m.cgi()
-    e = m.eye_contacts(first)
-    return {"cgi": c.value, "correct_shifts": c.correct, "shifts": c.shifts,
-            "mutual_gaze_events": m.mutual_gaze_events,
-            "eye_contacts": e.established, "opportunities": e.opportunities}
+    return GazeMetrics(hold).extend(trace).summary(first)

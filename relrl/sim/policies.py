@@ -23,7 +23,7 @@ __all__ = ["GazeFollower", "Policy", "RandomPolicy", "bench_step_rate", "rollout
 #: a policy: the percepts of a time unit -> a response term.
 Policy = Callable[[Sequence[Term]], Term]
 
-_LOOK = {p: ("look", p) for p in PLACES}
+_CENTRE = ("look", "centre")
 
 
 class GazeFollower:
@@ -37,19 +37,25 @@ class GazeFollower:
         """Choose the response for these percepts."""
         for p in percepts:
             if p[0] == "pose" and p[2] != "frontal":
-                return _LOOK[p[2]]
-        return _LOOK["centre"]
+                return ("look", p[2])
+        return _CENTRE
 
 
 class RandomPolicy:
-    """Look at one of the six places uniformly at random (seeded)."""
+    """Look at one of the places uniformly at random (seeded).
 
-    def __init__(self, seed: int | None = None) -> None:
+    Args:
+        seed: seeds the policy's own generator.
+        places: every place of the world, ``centre`` included (default: the paper's six).
+    """
+
+    def __init__(self, seed: int | None = None, places: Sequence[str] = PLACES) -> None:
         self._rng = np.random.default_rng(seed)
+        self._looks = [("look", p) for p in places]
 
     def __call__(self, percepts: Sequence[Term]) -> Term:
         """Choose a response, ignoring the percepts."""
-        return _LOOK[PLACES[int(self._rng.integers(len(PLACES)))]]
+        return self._looks[int(self._rng.integers(len(self._looks)))]
 
 
 def rollout(env, policy: Policy, steps: int, seed: int | None = None) -> list[StepRecord]:

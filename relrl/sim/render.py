@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from relrl.sim.errors import SimError
 from relrl.sim.metrics import StepRecord
-from relrl.sim.places import DISTANCE_CM, POSITIONS, TOY_PLACES
+from relrl.sim.places import DISTANCE_CM, TOY_PLACES, Layout, layout
 
 __all__ = ["IMAGE_SHAPE", "render_rgb", "render_text"]
 
@@ -34,8 +35,9 @@ _ROBOT_GAZE = (230, 120, 0)
 _ATTENTION = (250, 200, 0)
 
 
-def _pixel(place_or_xy: str | tuple[float, float]) -> tuple[float, float]:
-    x, y = POSITIONS[place_or_xy][:2] if isinstance(place_or_xy, str) else place_or_xy
+def _pixel(place_or_xy: str | tuple[float, float], positions: dict[str, tuple[float, ...]]
+           ) -> tuple[float, float]:
+    x, y = positions[place_or_xy][:2] if isinstance(place_or_xy, str) else place_or_xy
     return (_X_MAX - x) * _SCALE, (_Y_HALF - y) * _SCALE  # robot's left on the image's left
 
 
@@ -64,29 +66,38 @@ def _line(img: np.ndarray, a: tuple[float, float], b: tuple[float, float],
         img[r, c] = colour
 
 
-def render_rgb(rec: StepRecord) -> np.ndarray:
+def render_rgb(rec: StepRecord, where: Layout | None = None) -> np.ndarray:
     """Draw a record as a top view: caregiver above, robot below, toys on the table.
 
     The blue line is the caregiver's gaze, the orange one the robot's; a yellow ring around
-    the caregiver marks attention. Returns a ``uint8`` array of shape :data:`IMAGE_SHAPE`.
+    the caregiver marks attention. ``where`` is the world's layout (default: the paper's five
+    places). Returns a ``uint8`` array of shape :data:`IMAGE_SHAPE`.
     """
+    if where is None:
+        where = layout(5)
+    pos = where.positions
+    if any(p not in pos for p in (rec.focus, *(t for t, _ in rec.toys))):
+        raise SimError(f"cannot draw places outside the layout's {len(where.toy_places)}: "
+                       f"pass the world's layout to render_rgb")
     img = np.empty(IMAGE_SHAPE, dtype=np.uint8)
     img[:] = _BACKGROUND
-    top, left = _pixel((POSITIONS["left"][0] + 12.0, POSITIONS["left"][1] + 8.0))
-    bottom, right = _pixel((POSITIONS["down"][0] - 12.0, POSITIONS["right"][1] - 8.0))
+    first, last = where.toy_places[0], where.toy_places[-1]
+    top, left = _pixel((pos[first][0] + 12.0, pos[first][1] + 8.0), pos)
+    bottom, right = _pixel((25.0 - 12.0, pos[last][1] - 8.0), pos)
     img[int(top):int(bottom), int(left):int(right)] = _TABLE
-    caregiver, robot = _pixel("centre"), _pixel((0.0, 0.0))
-    for place in TOY_PLACES:
-        _disc(img, _pixel(place), 2.0, (170, 150, 120))
+    caregiver, robot = _pixel("centre", pos), _pixel((0.0, 0.0), pos)
+    radius = min(9.0, 45.0 / max(5, len(where.toy_places)) * 5)
+    for place in where.toy_places:
+        _disc(img, _pixel(place, pos), 2.0, (170, 150, 120))
     toys = dict(rec.toys)
     for place, colour in toys.items():
-        centre = _pixel(place)
-        _disc(img, centre, 9.0, _COLOURS.get(colour, _OTHER_TOY))
+        centre = _pixel(place, pos)
+        _disc(img, centre, radius, _COLOURS.get(colour, _OTHER_TOY))
         if place == rec.target:
-            _ring(img, centre, 10.0, 2.0, (30, 30, 30))
-    gaze_to = robot if rec.gaze == "frontal" else _pixel(rec.gaze)
+            _ring(img, centre, radius + 1.0, 2.0, (30, 30, 30))
+    gaze_to = robot if rec.gaze == "frontal" else _pixel(rec.gaze, pos)
     _line(img, caregiver, gaze_to, _CAREGIVER_GAZE)
-    _line(img, robot, _pixel(rec.focus), _ROBOT_GAZE)
+    _line(img, robot, _pixel(rec.focus, pos), _ROBOT_GAZE)
     if rec.attention:
         _ring(img, caregiver, 18.0, 4.0, _ATTENTION)
     _disc(img, caregiver, 16.0, _SKIN)
@@ -94,10 +105,11 @@ def render_rgb(rec: StepRecord) -> np.ndarray:
     return img
 
 
-def render_text(rec: StepRecord) -> str:
-    """Describe a record in a few lines of text (the ``ansi`` render mode)."""
+def render_text(rec: StepRecord, places: tuple[str, ...] = TOY_PLACES) -> str:
+    """Describe a record in a few lines of text (the ``ansi`` render mode); ``places`` are
+    the world's toy places (default: the paper's five)."""
     cells = []
-    for place in TOY_PLACES:
+    for place in places:
         colour = dict(rec.toys).get(place)
         mark = "." if colour is None else (colour or "toy")
         if place == rec.target:
@@ -114,7 +126,7 @@ def render_text(rec: StepRecord) -> str:
         + ("  EYE CONTACT" if rec.contact else "") + ("  ATTENTION" if rec.attention else ""),
         f"{face:^60}",
         f"{'caregiver looks at ' + looks:^60}",
-        "".join(f"{p:^12}" for p in TOY_PLACES),
+        "".join(f"{p:^12}" for p in places),
         "".join(cells),
         f"{'robot looks at ' + rec.focus:^60}",
     ]

@@ -78,7 +78,7 @@ def test_a_folder_of_other_files_is_refused_and_never_emptied(capsys, tmp_path):
     assert (out / "draft.tex").exists() and (out / "summary.json").exists()
 
 
-def _quick_sis(config, out, workers=1):
+def _quick_sis(config, out, workers=1, **engine):
     """Stands in for Experiment 1 (the folder policy is under test, not the experiment)."""
     from relrl.experiments.report import write_json_atomic
 

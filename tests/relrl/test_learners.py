@@ -180,7 +180,7 @@ def test_explanations() -> None:
 
 
 def test_registry_and_bad_parameters() -> None:
-    assert set(LEARNERS) == {"etg", "contingency", "qlearning"}
+    assert set(LEARNERS) == {"etg", "contingency", "qlearning", "tg"}
     with pytest.raises(ConfigError, match="unknown learner 'sarsa'"):
         make_learner("sarsa")
     with pytest.raises(ConfigError, match="unknown parameter 'alhpa'"):

@@ -113,6 +113,38 @@ def test_eye_contact_after_three_time_units_gives_attention_then_toys_and_turn()
     assert not cg.attention
 
 
+def test_attention_during_gaze_attends_the_first_look_at_the_face_once_per_opportunity(
+        ) -> None:
+    cg = start(CaregiverParams(attention_during_gaze=True), focus=1)
+    cg.update(C)                        # first mutual gaze of opportunity 0: attention
+    assert cg.attention and not cg.contact
+    cg.update(2)
+    cg.update(C)                        # back on the face: no second attention
+    assert not cg.attention
+    cg.update(C)
+    cg.update(C)                        # eye contact, already attended in this opportunity
+    assert cg.contact and not cg.attention
+    cg.update(C)                        # toys out
+    cg.update(cg.target)                # gaze following is still rewarded
+    assert cg.attention
+    cg.update(C)                        # opportunity 1 starts: on the face at once
+    assert cg.opportunity == 1 and cg.attention
+
+
+@pytest.mark.parametrize("during_gaze", [False, True])
+def test_looking_away_and_back_cannot_farm_attention(during_gaze: bool) -> None:
+    """The loophole an outside tabular agent found: look(centre), look(down) alternately."""
+    cg = start(CaregiverParams(attention_during_gaze=during_gaze), focus=1)
+    attended = []
+    for t in range(200):
+        cg.update(C if t % 2 == 0 else 3)
+        attended.append((cg.opportunity, cg.attention))
+    per_opportunity = Counter(opp for opp, a in attended if a)
+    assert not per_opportunity or max(per_opportunity.values()) == 1
+    assert sum(per_opportunity.values()) <= 200 // cg.params.contact_timeout + 1
+    assert bool(per_opportunity) == during_gaze   # without it, no eye contact: no attention
+
+
 def test_looking_away_breaks_the_streak() -> None:
     cg = start(focus=C)
     cg.update(C)

@@ -97,10 +97,39 @@ def test_streaming_equals_batch() -> None:
     assert m.cgi() == cgi(tr)
     assert m.mutual_gaze_events == mutual_gaze_events(tr) == 1
     assert m.eye_contacts() == eye_contacts(tr)
-    assert summarize(tr) == {"cgi": 1.0, "correct_shifts": 1, "shifts": 1,
-                             "mutual_gaze_events": 1, "eye_contacts": 1, "opportunities": 1}
+    assert summarize(tr) == {"cgi": 1.0, "cgi_literal": 1.0, "correct_shifts": 1,
+                             "shifts": 1, "all_shifts": 1, "mutual_gaze_events": 1,
+                             "eye_contacts": 1, "opportunities": 1}
 
 
 def test_hold_must_be_positive() -> None:
     with pytest.raises(ValueError, match="hold=0"):
         GazeMetrics(hold=0)
+
+
+# ---- Eq. 5 read literally beside relrl's reading ------------------------------------------------
+
+def test_literal_cgi_counts_shifts_while_the_caregiver_looks_at_the_robot() -> None:
+    # 1: leaves the face while the caregiver looks at the robot (literal: a wrong shift)
+    # 2: waits, sees the caregiver look left, follows (correct in both)
+    # 3: sees right, goes down (wrong in both)
+    tr = trace(("C", F), ("down", F),
+               ("C", F), ("C", "left"), ("left", "left"),
+               ("C", F), ("C", "right"), ("down", "right"))
+    m = GazeMetrics().extend(tr)
+    assert (m.cgi().correct, m.cgi().shifts) == (1, 2)
+    assert (m.cgi_literal().correct, m.cgi_literal().shifts) == (1, 3)
+    assert m.cgi().value == 0.5 and m.cgi_literal().value == pytest.approx(1 / 3)
+
+
+def test_literal_cgi_equals_relrls_when_the_robot_never_leaves_a_frontal_face() -> None:
+    tr = trace(("C", F), ("C", F), ("C", "down"), ("down", "down"), ("C", F), ("C", "left"),
+               ("right", "left"), ("C", F))
+    m = GazeMetrics().extend(tr)
+    assert m.cgi() == m.cgi_literal() and m.cgi().value == 0.5
+
+
+def test_a_robot_that_never_leaves_the_face_has_no_cgi_in_either_reading() -> None:
+    m = GazeMetrics().extend(trace(("C", F), ("C", "left"), ("C", F)))
+    assert math.isnan(m.cgi().value) and math.isnan(m.cgi_literal().value)
+    assert m.summary()["all_shifts"] == 0

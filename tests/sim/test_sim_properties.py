@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from collections import Counter
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -19,6 +20,7 @@ params = st.builds(
     contact_hold=st.integers(1, 4),
     contact_timeout=st.one_of(st.none(), st.integers(4, 12)),
     attention_on_contact=st.booleans(),
+    attention_during_gaze=st.booleans(),
     single_look=st.booleans(),
     target_sequence=st.one_of(st.none(), st.lists(st.sampled_from(TOY_PLACES), min_size=1,
                                                   max_size=5).map(tuple)),
@@ -42,14 +44,18 @@ def test_invariants(p: CaregiverParams, actions: list[int], seed: int) -> None:
             rec.target is None or rec.target == rec.toys[0][0])
         if rec.phase == "engage":
             assert rec.gaze == "frontal" and rec.toys == ()
-        if rec.attention:   # attention only for eye contact or for looking at the target
-            assert (rec.contact and p.attention_on_contact) or rec.focus == rec.target
+        if rec.attention:   # attention only for the face (once) or for looking at the target
+            assert ((rec.contact and p.attention_on_contact)
+                    or (p.attention_during_gaze and rec.focus == "centre")
+                    or rec.focus == rec.target)
         if rec.contact:
             assert rec.phase == "engage" and rec.focus == "centre"
         assert rec.opportunity in (prev.opportunity, prev.opportunity + 1)
         assert rec.trial in (prev.trial, prev.trial + 1)
         if p.reliability == 1.0 and rec.phase == "attend":
             assert rec.gaze == rec.target
+    face_attention = Counter(r.opportunity for r in trace if r.attention and r.phase == "engage")
+    assert all(n == 1 for n in face_attention.values())   # at most once per opportunity
     m = GazeMetrics(hold=p.contact_hold).extend(trace)
     contacts = sum(r.contact for r in trace)
     assert m.eye_contacts().established == contacts   # the metric agrees with the caregiver

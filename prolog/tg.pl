@@ -1,0 +1,462 @@
+:- module(relrl_tg,
+          [ tg_init/2,            % +KB, +Params
+            tg_state/2,           % +KB, -Facts
+            tg_q/5,               % +KB, +Facts, +Action, +Necessity, -Q
+            tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
+            tg_update/2,          % +KB, +Transition
+            tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
+            tg_size/2,            % +KB, -Size
+            tg_candidates/3       % +KB, ?LeafId, -Texts
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(random)).
+:- use_module(declarations).
+:- use_module(engine).
+:- use_module(tg_bias).
+:- use_module(tg_stats).
+:- use_module(tg_tree).
+:- reexport(tg_knowledge).
+
+/** <module> TG: a first-order incremental regression-tree Q-learner
+
+In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001). The Q-function is one
+first-order regression tree over examples (State, Action, Necessity, Q-target):
+
+  - State is the relational view of the domain (a sorted list of ground facts, see
+    engine:engine_relational_state/2), Action the response the value is for, Necessity the active
+    necessity;
+  - an internal node holds a conjunction of literals from the language bias (rmode/1); it
+    succeeds on an example when the conjunction of every test on the yes-branches from the
+    root down to it (the node's query) has a solution in the example — TILDE's semantics. A
+    variable introduced in a node is used only in its yes-subtree;
+  - a leaf holds the Q estimate and, for each candidate test the refinement operator gives
+    for it (tg_bias:refinements/4), the count, sum and sum of squares of the Q-targets of the
+    examples on which the candidate succeeds. With the leaf's own three numbers, they give
+    the F-test of every candidate split (tg_stats.pl). When the best candidate is
+    significant at level `significance` after at least `min_examples` examples, the leaf
+    becomes a test node; its two children start from their partitions' statistics (Q is the
+    partition's mean Q-target) and from fresh candidates.
+
+Q(s, a) for each allowed response comes from sorting (s, a) down the tree; each step one
+example with Q-target r + gamma * max_a' Q(s', a') is inserted (no table of examples).
+
+The learner's state and the compiled tree are kept by tg_tree.pl; explanations, drawings,
+rules and policy files are tg_knowledge.pl's (re-exported here).
+
+**Speed.** The hot path asserts nothing. The tree is compiled into one clause,
+tg_sort_/5, and each leaf's candidate tests into one clause, tg_cands_/6, whenever the tree
+changes (a split): sorting an example and testing every candidate are then compiled
+Prolog over the example's own fact list (never a query of working memory). The numbers
+live in a global term per knowledge base and are updated in place (nb_setarg/3).
+
+Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise the rate
+is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
+epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus
+(see tg_choose/6); the engine's reward_positive and reward_negative.
+*/
+
+% ---- starting ------------------------------------------------------------------------------
+
+%!  tg_init(+KB, +Params:list) is det.
+%
+%   Start KB's TG learner afresh: one leaf, Q = q_init, candidates from the domain's bias.
+
+tg_init(KB, Params) :-
+    must_be(atom, KB),
+    must_be(list, Params),
+    maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
+                            min_examples, stale_bonus, half_life],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0]),
+    MinEx is max(2, round(MinEx0)),
+    tg_bias(KB, Bias),
+    findall(R, kb_response(KB, R), Responses),
+    refinements(Bias, [], [], Cands),
+    Root = leaf(1, [], [], Cands),
+    length(Cands, K),
+    tg_new_stats(Qinit, 0, K, 0, L),
+    tg_empty_leaves(16, Leaves0),
+    setarg(1, Leaves0, L),
+    atom_concat('$tg:', KB, DK),
+    Half is max(0, round(Half0)),
+    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half), Leaves0, none,
+                     0, 0)),
+    tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
+    tg_forget_leaves(KB),
+    tg_compile_leaf(KB, Root),
+    tg_compile_tree(KB, Root).
+
+param(Params, Name, Value) :-
+    (   memberchk(Name=V, Params)
+    ->  must_be(number, V),
+        Value = V
+    ;   existence_error(tg_parameter, Name)
+    ).
+
+%!  tg_state(+KB, -Facts:list) is det.
+%
+%   The relational view of KB now (sorted ground facts; engine_relational_state/2).
+
+tg_state(KB, Facts) :-
+    engine_relational_state(KB, Facts).
+
+
+% ---- values and choices --------------------------------------------------------------------
+
+%!  tg_q(+KB, +Facts, +Action, +Necessity, -Q) is det.
+%
+%   Q is the tree's estimate for Action in the state Facts under Necessity.
+
+tg_q(KB, Facts, Action, N, Q) :-
+    tg_sort_(KB, Facts, Action, N, Leaf),
+    tg_leaf(KB, Leaf, L),
+    arg(1, L, Q).
+
+%!  tg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
+%
+%   Action is one of the Allowed responses. With Mode learn or explore: with temperature
+%   T > 0, drawn with probability proportional to exp(Q / T) (Boltzmann exploration);
+%   with T = 0, a random one with probability epsilon and otherwise a greedy one. With
+%   Mode greedy, one with the largest Q. Ties are broken at random. While learning (Mode
+%   learn), the Q of a leaf that no example has reached for the last K examples inserted
+%   in the tree counts as Q + stale_bonus * sqrt(K): a part of the Q-function that went
+%   stale while the rest moved is tried again (the exploration bonus of Sutton's Dyna-Q+,
+%   here per leaf). Explore and greedy choices, and the Q-targets, never include it.
+
+tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
+    Allowed = [_|_],
+    tg_data(KB, D),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _), Leaves, Cache, Version, Clock),
+    (   Mode \== greedy, Tau =:= 0,
+        random_float < Epsilon
+    ->  random_member(Action, Allowed)
+    ;   (   Cache = last(F1, N1, A1, Ids, Version), F1 == Facts, N1 == N, A1 == Allowed
+        ->  true
+        ;   maplist(sorted_leaf(KB, Facts, N), Allowed, Ids)
+        ),
+        (   Mode == learn, Kappa > 0
+        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
+        ;   maplist(leaf_q(Leaves), Ids, Qs)
+        ),
+        max_list(Qs, Best),
+        (   Mode \== greedy, Tau > 0
+        ->  softmax_member(Qs, Allowed, Best, Tau, Action)
+        ;   ties(Qs, Allowed, Best, Ties),
+            random_member(Action, Ties)
+        )
+    ).
+
+leaf_q(Leaves, Id, Q) :-
+    arg(Id, Leaves, L),
+    arg(1, L, Q).
+
+bonus_q(Leaves, Kappa, Clock, Id, Q) :-
+    arg(Id, Leaves, L),
+    arg(1, L, Q0),
+    arg(7, L, Last),
+    Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
+
+ties([], [], _, []).
+ties([Q|Qs], [A|As], Best, Ties) :-
+    (   Q =:= Best
+    ->  Ties = [A|Ties1]
+    ;   Ties = Ties1
+    ),
+    ties(Qs, As, Best, Ties1).
+
+softmax_member(Qs, Allowed, Best, Tau, Action) :-
+    weights(Qs, Best, Tau, Ws, 0.0, Total),
+    X is random_float * Total,
+    pick(Ws, Allowed, X, Action).
+
+weights([], _, _, [], T, T).
+weights([Q|Qs], Best, Tau, [W|Ws], T0, T) :-
+    W is exp((Q - Best) / Tau),
+    T1 is T0 + W,
+    weights(Qs, Best, Tau, Ws, T1, T).
+
+pick([W|Ws], [A|As], X, Action) :-
+    (   ( X < W ; Ws == [] )
+    ->  Action = A
+    ;   X1 is X - W,
+        pick(Ws, As, X1, Action)
+    ).
+
+%!  tg_update(+KB, +Transition) is det.
+%
+%   Learn from transition(S0, A0, N0, Reward, Reinforced, S1, N1, Allowed1): insert the
+%   example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the responses
+%   Allowed1 (over every response when none is allowed).
+
+tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
+    tg_data(KB, D),
+    D = tg(p(_, Gamma, _, _, _, _, _, _), Leaves, _, Version, _),
+    (   Allowed1 == []
+    ->  tg_get_tree(KB, tree(_, _, _, Next))
+    ;   Next = Allowed1
+    ),
+    maplist(sorted_leaf(KB, S1, N1), Next, Ids),
+    maplist(leaf_q(Leaves), Ids, Qs),
+    max_list(Qs, Max),
+    Target is Reward + Gamma * Max,
+    nb_setarg(3, D, last(S1, N1, Allowed1, Ids, Version)),
+    insert(KB, D, S0, A0, N0, Target).
+
+sorted_leaf(KB, Facts, N, A, Leaf) :-
+    tg_sort_(KB, Facts, A, N, Leaf).
+
+%!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
+%
+%   Insert one example: sort it to its leaf, move the leaf's Q towards Target, count Target
+%   in the leaf's statistics and in those of every candidate that succeeds on the example,
+%   and split the leaf when its best candidate is significant.
+
+tg_insert(KB, Facts, A, N, Target) :-
+    tg_data(KB, D),
+    insert(KB, D, Facts, A, N, Target).
+
+insert(KB, D, Facts, A, N, Target) :-
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half), Leaves, _, _, Clock0),
+    Clock is Clock0 + 1,
+    nb_setarg(5, D, Clock),
+    tg_sort_(KB, Facts, A, N, Leaf),
+    arg(Leaf, Leaves, L),
+    L = l(Q0, N0, _, _, _, C, _, _),
+    N1 is N0 + 1,
+    Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
+    nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
+    weight(L, Half, Clock, W),                      % (may rescale the sums)
+    arg(3, L, M0), arg(4, L, S0), arg(5, L, SS0),
+    M is M0 + W,
+    S is S0 + W * Target,
+    SS is SS0 + W * Target * Target,
+    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
+    tg_cands_(KB, Leaf, Facts, A, N, Hits),
+    count_hits(Hits, C, W, Target),
+    (   N1 /\ 3 =:= 0,                              % every fourth example
+        MinW is MinEx * W,                          % min_examples in stored units
+        M >= 2 * MinW,
+        best_candidate(C, M, S, MinW, I-s(M1, S1, SS1)),
+        F is 1 / W,                                 % stored sums -> today's weights
+        Mt is M * F, St is S * F, SSt is SS * F,
+        M1t is M1 * F, S1t is S1 * F, SS1t is SS1 * F,
+        split_f(s(Mt, St, SSt), s(M1t, S1t, SS1t), FStat, Dof),
+        functor(C, _, Arity),
+        Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
+        f_significant(FStat, Dof, Corrected)
+    ->  M2t is Mt - M1t,
+        QYes is S1 / M1, QNo is (S - S1) / (M - M1),
+        split(KB, D, Leaf, I, s(M1t, QYes), s(M2t, QNo))
+    ;   true
+    ).
+
+%   Forgetting (half_life H > 0): an example counts 2^(-k / H) in the split statistics
+%   once k more examples have been inserted in the tree. The Q-targets drift while the
+%   Q-function is learned: without forgetting, a leaf compares targets from long ago with
+%   today's, a test that merely tells early examples from later ones (a necessity active
+%   mostly at the start) looks significant, and its rarely visited side starts with an
+%   estimate from long ago. A leaf's sums are kept in units of the weight an example had
+%   when they were last rescaled (Base, the eighth argument of l/8): an example inserted
+%   now weighs W = 2^((Clock - Base) / H) there, and dividing by W gives today's weights.
+%   When W grows large the leaf's sums are rescaled (once every 64 half-lives at most).
+weight(L, Half, Clock, W) :-
+    (   Half =:= 0
+    ->  W = 1
+    ;   arg(8, L, Base),
+        E is (Clock - Base) / Half,
+        (   E > 64
+        ->  Scale is 2 ** (-E),
+            rescale(L, Scale),
+            nb_setarg(8, L, Clock),
+            W = 1.0
+        ;   W is 2 ** E
+        )
+    ).
+
+rescale(L, Scale) :-
+    forall(between(3, 5, I), scale_arg(L, Scale, I)),
+    arg(6, L, C),
+    functor(C, _, K),
+    forall(between(1, K, I), scale_arg(C, Scale, I)).
+
+scale_arg(T, Scale, I) :-
+    arg(I, T, X),
+    Y is X * Scale,
+    nb_setarg(I, T, Y).
+
+count_hits([], _, _, _).
+count_hits([I|Is], C, W, T) :-
+    J is 3 * I - 2, J2 is J + 1, J3 is J + 2,
+    arg(J, C, M0), M is M0 + W, nb_setarg(J, C, M),
+    arg(J2, C, S0), S is S0 + W * T, nb_setarg(J2, C, S),
+    arg(J3, C, SS0), SS is SS0 + W * T * T, nb_setarg(J3, C, SS),
+    count_hits(Is, C, W, T).
+
+%   The candidate whose split explains the most variance, among those that leave at least
+%   MinEx examples on each side: for a fixed total, F grows with S1^2/M1 + S2^2/M2, so only
+%   that is compared. Best = I-s(M1, S1, SS1).
+best_candidate(C, M, S, MinEx, I-s(M1, S1, SS1)) :-
+    functor(C, _, Arity),
+    Max is M - MinEx,
+    best_from(1, Arity, C, M, S, MinEx, Max, none, -1.0, I),
+    I \== none,
+    J is 3 * I - 2, J2 is J + 1, J3 is J + 2,
+    arg(J, C, M1), arg(J2, C, S1), arg(J3, C, SS1).
+
+best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
+    (   J > Arity
+    ->  B = B0
+    ;   arg(J, C, M1),
+        (   M1 >= Min, M1 =< Max
+        ->  J2 is J + 1, arg(J2, C, S1),
+            G is S1 * S1 / M1 + (S - S1) * (S - S1) / (M - M1),
+            (   G > G0
+            ->  B1 is (J + 2) // 3, G1 = G
+            ;   B1 = B0, G1 = G0
+            )
+        ;   B1 = B0, G1 = G0
+        ),
+        J1 is J + 3,
+        best_from(J1, Arity, C, M, S, Min, Max, B1, G1, B)
+    ).
+
+% ---- splitting -----------------------------------------------------------------------------
+
+%   Split leaf LeafId on its candidate I; the children start from their partitions:
+%   s(Weight, MeanQTarget) each (today's weights).
+split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
+    tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
+    YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
+    replace_leaf(Root0, LeafId, Leaf, Node, Root),
+    Leaf = leaf(LeafId, Path, Vars, Cands),
+    nth1(I, Cands, cand(Lits, New)),
+    append(Path, Lits, YesPath),
+    append(Vars, New, YesVars),
+    refinements(Bias, YesPath, YesVars, YesCands),
+    refinements(Bias, Path, Vars, NoCands0),
+    exclude(same_cand(Lits), NoCands0, NoCands),
+    Yes = leaf(YesId, YesPath, YesVars, YesCands),
+    No = leaf(NoId, Path, Vars, NoCands),
+    Node = node(LeafId, Lits, New, Yes, No),
+    length(YesCands, KY), length(NoCands, KN),
+    arg(5, D, Clock),
+    NYes is max(1, round(M1)), NNo is max(1, round(M2)),
+    tg_new_stats(QYes, NYes, KY, Clock, LYes),
+    tg_new_stats(QNo, NNo, KN, Clock, LNo),
+    put_leaf(D, LeafId, free),
+    put_leaf(D, YesId, LYes),
+    put_leaf(D, NoId, LNo),
+    arg(4, D, Version0),
+    Version is Version0 + 1,
+    nb_setarg(4, D, Version),
+    tg_put_tree(KB, tree(Root, Next, Bias, Responses)),
+    tg_forget_leaf(KB, LeafId),
+    tg_compile_leaf(KB, Yes),
+    tg_compile_leaf(KB, No),
+    tg_compile_tree(KB, Root).
+
+%   The no-branch of a test never needs the test again.
+same_cand(Lits, cand(Lits1, _)) :-
+    Lits1 =@= Lits.
+
+replace_leaf(leaf(Id, P, V, C), LeafId, Leaf, Node, Out) :-
+    (   Id == LeafId
+    ->  Leaf = leaf(Id, P, V, C), Out = Node
+    ;   Out = leaf(Id, P, V, C)
+    ).
+replace_leaf(node(Id, L, N, Y0, No0), LeafId, Leaf, Node, node(Id, L, N, Y, No)) :-
+    replace_leaf(Y0, LeafId, Leaf, Node, Y),
+    replace_leaf(No0, LeafId, Leaf, Node, No).
+
+put_leaf(D, Id, L) :-
+    arg(2, D, Leaves0),
+    functor(Leaves0, _, Cap),
+    (   Id =< Cap
+    ->  nb_setarg(Id, Leaves0, L)
+    ;   Cap2 is max(2 * Cap, Id),
+        Leaves0 =.. [F|Args0],
+        Extra is Cap2 - Cap,
+        length(More, Extra),
+        maplist(=(free), More),
+        append(Args0, More, Args),
+        Leaves =.. [F|Args],
+        setarg(Id, Leaves, L),
+        nb_setarg(2, D, Leaves)
+    ).
+
+% ---- size ----------------------------------------------------------------------------------
+
+%!  tg_size(+KB, -Size) is det.
+%
+%   Size is size(Positions, Details). Positions = nodes + entries in the paper's sense: every
+%   node (test or leaf) and every stored Q value (one per leaf). Details:
+%   [nodes=, tests=, leaves=, entries=, candidates=, statistics=]; statistics counts the
+%   numbers kept only to decide splits: count, sum and sum of squares for each leaf and for
+%   each candidate of each leaf.
+
+tg_size(KB, size(Positions, [nodes=Nodes, tests=Tests, leaves=Leaves, entries=Leaves,
+                             candidates=Cands, statistics=Stats])) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    tree_counts(Root, 0-0-0, Tests-Leaves-Cands),
+    Nodes is Tests + Leaves,
+    Positions is Nodes + Leaves,
+    Stats is 3 * (Leaves + Cands).
+
+tree_counts(leaf(_, _, _, Cs), T-L0-C0, T-L-C) :-
+    L is L0 + 1,
+    length(Cs, K),
+    C is C0 + K.
+tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
+    T1 is T0 + 1,
+    tree_counts(Y, T1-L0-C0, Mid),
+    tree_counts(N, Mid, Out).
+
+%!  tg_candidates(+KB, ?LeafId, -Texts:list) is nondet.
+%
+%   Texts are the candidate tests of leaf LeafId, written with their variables named.
+
+tg_candidates(KB, LeafId, Texts) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    tg_tree_leaf(Root, leaf(LeafId, _, Vars, Cands)),
+    findall(Text, ( member(cand(Lits, New), Cands),
+                    append(Vars, New, All),
+                    name_variables(All, Names),
+                    conj_text(Lits, Names, Text) ), Texts).
+
+% ---- the engine's hooks (see engine.pl) ----------------------------------------------------
+
+relrl_engine:learner(tg).
+
+relrl_engine:learner_init(tg, KB, Params) :-
+    tg_init(KB, Params).
+
+relrl_engine:learner_state(tg, KB, _Code, Facts) :-
+    tg_state(KB, Facts).
+
+relrl_engine:learner_choose(tg, KB, Facts, N, Allowed, Mode, Action) :-
+    tg_choose(KB, Facts, N, Allowed, Mode, Action).
+
+relrl_engine:learner_update(tg, KB, Transition) :-
+    tg_update(KB, Transition).
+
+relrl_engine:learner_explain(tg, KB, Facts, N, Explanation) :-
+    tg_explain(KB, Facts, N, Explanation).
+
+relrl_engine:learner_size(tg, KB, Size) :-
+    tg_size(KB, Size).
+
+relrl_engine:learner_save(tg, KB, Stream) :-
+    tg_save(KB, Stream).
+
+relrl_engine:learner_policy_term(tg, Term) :-
+    tg_policy_term(Term).
+
+relrl_engine:learner_restore(tg, KB, Terms) :-
+    tg_restore(KB, Terms).
+
+relrl_engine:learner_text(tg, KB, Text) :-
+    tg_text(KB, Text).
+
+relrl_engine:learner_graph(tg, KB, Graph) :-
+    tg_graph(KB, Graph).

@@ -1,0 +1,367 @@
+:- module(relrl_tg_knowledge,
+          [ tg_explain/4,         % +KB, +Facts, +Necessity, -Explanation
+            tg_text/2,            % +KB, -Text
+            tg_graph/2,           % +KB, -Graph
+            tg_leaf_clauses/2,    % +KB, -Clauses
+            tg_save/2,            % +KB, +Stream
+            tg_policy_term/1,     % ?Term
+            tg_restore/2          % +KB, +Terms
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(pairs)).
+:- use_module(library(aggregate)).
+:- use_module(library(occurs)).
+:- use_module(tg_bias).
+:- use_module(tg_tree).
+
+/** <module> The TG tree as knowledge a person reads
+
+Explanations (the first-order tests on an example's path with the bindings that made them
+true), the tree as indented text and as a graph, the leaves as q/3 rules, and policy files:
+written as Prolog that plain swipl consults, read back by relrl as terms (never run).
+*/
+
+% ---- explaining ----------------------------------------------------------------------------
+
+%!  tg_explain(+KB, +Facts, +Necessity, -Explanation) is det.
+%
+%   Explanation is tg(Ranked): for every response, choice(Action, Q, Leaf, Path) in
+%   decreasing Q (ties in declaration order). Path lists the tests from the root to the
+%   action's leaf as test(Id, Text, Outcome, Bindings): Text the conjunction with its
+%   variables named, Outcome true or false, Bindings the Name=Value pairs of the variables
+%   the test introduced, from the first solution of the query that made it true.
+
+tg_explain(KB, Facts, N, tg(Ranked)) :-
+    tg_get_tree(KB, tree(Root, _, _, Responses)),
+    findall(NegQ-choice(A, Q, Leaf, Path),
+            ( member(A, Responses),
+              explain_path(Root, [], [], Facts, A, N, Path, Leaf),
+              tg_leaf(KB, Leaf, L), arg(1, L, Q),
+              NegQ is -Q ),
+            Keyed),
+    keysort(Keyed, Sorted),
+    pairs_values(Sorted, Ranked).
+
+explain_path(leaf(Id, _, _, _), _, _, _, _, _, [], Id).
+explain_path(node(Id, Lits, New, Yes, No), Path, Vars, Facts, A, N, [Step|Steps], Leaf) :-
+    append(Path, Lits, Path1),
+    append(Vars, New, Vars1),
+    name_variables(Vars1, Names),
+    conj_text(Lits, Names, Text),
+    (   \+ \+ holds_all(Path1, Facts, A, N)
+    ->  copy_term(Path1-Names, Path2-Names2),
+        once(holds_all(Path2, Facts, A, N)),
+        include(introduced(New, Names), Names2, Bound0),
+        maplist(binding_pair, Bound0, Bound),
+        Step = test(Id, Text, true, Bound),
+        explain_path(Yes, Path1, Vars1, Facts, A, N, Steps, Leaf)
+    ;   Step = test(Id, Text, false, []),
+        explain_path(No, Path, Vars, Facts, A, N, Steps, Leaf)
+    ).
+
+holds_all(Lits, Facts, A, N) :-
+    maplist([L]>>literal_holds(L, Facts, A, N), Lits).
+
+introduced(New, Names, Name=_) :-
+    member(Name=V, Names),
+    member(W-_, New),
+    V == W,
+    !.
+
+binding_pair(Name=Value, Name-Value).
+
+% ---- the tree as text, as a graph, as rules ------------------------------------------------
+
+%!  tg_text(+KB, -Text:string) is det.
+%
+%   Text draws the tree, one line per node, indented by depth.
+
+tg_text(KB, Text) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    with_output_to(string(Text), text_node(KB, Root, [], "", "")).
+
+text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
+    format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
+text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
+    append(Vars, New, Vars1),
+    name_variables(Vars1, Names),
+    conj_text(Lits, Names, Text),
+    format("~w~w[~d] ~w ?~n", [Indent, Label, Id, Text]),
+    string_concat(Indent, "    ", Deeper),
+    text_node(KB, Yes, Vars1, Deeper, "yes: "),
+    text_node(KB, No, Vars, Deeper, "no:  ").
+
+%!  tg_graph(+KB, -Graph) is det.
+%
+%   Graph is graph(Nodes, Edges): node(Id, test, Label) and node(Id, leaf, Label) (Label a
+%   string), edge(From, To, yes) and edge(From, To, no).
+
+tg_graph(KB, graph(Nodes, Edges)) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    graph_node(KB, Root, [], Nodes, [], Edges, []).
+
+graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
+    format(string(Label), "Q=~2f (n=~d)", [Q, N]).
+graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
+           [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
+    append(Vars, New, Vars1),
+    name_variables(Vars1, Names),
+    conj_text(Lits, Names, Text),
+    arg(1, Yes, YId), arg(1, No, NId),
+    graph_node(KB, Yes, Vars1, Ns0, Ns1, Es0, Es1),
+    graph_node(KB, No, Vars, Ns1, Ns, Es1, Es).
+
+%!  tg_leaf_clauses(+KB, -Clauses:list) is det.
+%
+%   One clause per leaf, q(Action, Necessity, Q) :- Body, that a person can read and plain
+%   swipl can run in the domain's knowledge base: Body holds the leaf's path query and, for
+%   each no-branch on the path, the negation of that test's query (a renamed copy: TILDE's
+%   semantics). action(T) becomes the head's action, necessity(T) its necessity; Q is
+%   rounded to three decimals. Inside a negation, what the clause already makes true is
+%   left out (an action the head fixes, a ground literal of the body), and a negated
+%   equality is written as X \= Y on the arguments that differ. Variables are named by
+%   type (P for a place, T for a toy), Action and Necessity in the head; a variable used
+%   once is written _.
+
+tg_leaf_clauses(KB, Clauses) :-
+    leaf_rules(KB, Rules),
+    maplist(named_rule, Rules, Clauses).
+
+named_rule(Rule-Names, Rule) :-
+    term_variables(Rule, Vs),
+    foldl(occurrences(Rule), Vs, Counts, []),
+    maplist(name_var(Counts), Names).
+
+occurrences(Term, V, [V-N|Cs], Cs) :-
+    aggregate_all(count, ( sub_term(X, Term), X == V ), N).
+
+name_var(Counts, Name=V) :-
+    (   var(V)
+    ->  (   member(W-1, Counts), W == V
+        ->  V = '$VAR'('_')
+        ;   V = '$VAR'(Name)
+        )
+    ;   true
+    ).
+
+%   Rule-Names for every leaf: the rule with its variables, and Name=Var for each.
+leaf_rules(KB, Rules) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
+
+leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
+    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _)),
+    Q is round(Q0 * 1000) / 1000.0,
+    Head = q(Action, Necessity, Q),
+    foldl(positive(Action, Necessity), Pos, Goals0, []),
+    pairs_keys_values(Neg, NegTests, NegVars),
+    maplist(negative(Action, Necessity, Goals0), NegTests, NegGoals),
+    append(Goals0, NegGoals, Goals),
+    append([Vars|NegVars], AllVars),
+    name_variables(AllVars, Names0),
+    Names = ['Action'=Action, 'Necessity'=Necessity|Names0],
+    (   Goals == []
+    ->  Clause = Head
+    ;   list_conj_(Goals, Body),
+        Clause = (Head :- Body)
+    ).
+leaf_clause(KB, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
+    append(Pos, Lits, Pos1),
+    append(Vars, New, Vars1),
+    (   leaf_clause(KB, Yes, Pos1, Neg, Vars1, Clause)
+    ;   copy_term(Pos1-Vars1, Test-TestVars),
+        append(Neg, [Test-TestVars], Neg1),
+        leaf_clause(KB, No, Pos, Neg1, Vars, Clause)
+    ).
+
+positive(A, _, action(T), Gs, Gs) :- !, A = T.
+positive(_, N, necessity(T), Gs, Gs) :- !, N = T.
+positive(_, _, L, [L|Gs], Gs).
+
+%   The negation of a test's query (run after the positive goals Known).
+negative(A, N, Known, Lits, Goal) :-
+    maplist(body_literal(A, N), Lits, Goals0),
+    exclude(known_true(Known), Goals0, Goals),
+    (   Goals == []
+    ->  Goal = fail                        % the query holds whenever Known does
+    ;   Goals = [X = Y]
+    ->  differing(X, Y, X1, Y1),
+        Goal = (X1 \= Y1)
+    ;   list_conj_(Goals, Conj),
+        Goal = (\+ Conj)
+    ).
+
+body_literal(A, _, action(T), A = T) :- !.
+body_literal(_, N, necessity(T), N = T) :- !.
+body_literal(_, _, L, L).
+
+known_true(_, X = Y) :-
+    X == Y,
+    !.
+known_true(Known, G) :-
+    ground(G),
+    member(K, Known),
+    K == G,
+    !.
+
+%   f(..., X, ...) \= f(..., Y, ...) is X \= Y when every other argument is the same.
+differing(X, Y, X1, Y1) :-
+    (   compound(X), compound(Y),
+        X =.. [F|As], Y =.. [F|Bs],
+        same_length(As, Bs),
+        one_differs(As, Bs, A, B)
+    ->  differing(A, B, X1, Y1)
+    ;   X1 = X, Y1 = Y
+    ).
+
+one_differs([A|As], [B|Bs], X, Y) :-
+    (   A == B
+    ->  one_differs(As, Bs, X, Y)
+    ;   As == Bs,
+        X = A, Y = B
+    ).
+
+list_conj_([G], G) :- !.
+list_conj_([G|Gs], (G, C)) :- list_conj_(Gs, C).
+
+% ---- saving and restoring ------------------------------------------------------------------
+
+%!  tg_save(+KB, +Stream) is det.
+%
+%   Write the learned tree to Stream: tg_tree/1 (the tree itself, read back by relrl) and
+%   the leaves as q/3 rules (for a person, and for plain swipl).
+
+tg_save(KB, S) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    saved_tree(KB, Root, [], Saved, Vars),
+    name_variables(Vars, Names),
+    maplist([Name=V]>>(V = '$VAR'(Name)), Names),
+    format(S, "% The tree: tests (conjunctions; a variable is used only in the yes-branch of~n", []),
+    format(S, "% the test that introduces it) and leaves (Q estimate, examples counted).~n", []),
+    portray_clause(S, tg_tree(Saved)),
+    nl(S),
+    format(S, "% The same knowledge as rules: Q of an action in the state working memory~n", []),
+    format(S, "% holds now, under the active necessity (one clause per leaf).~n", []),
+    tg_leaf_clauses(KB, Clauses),
+    forall(member(C, Clauses), portray_clause(S, C)).
+
+saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)).
+saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
+    append(Vars, New, Vars1),
+    saved_tree(KB, Y, Vars1, SY, AY),
+    saved_tree(KB, N, Vars, SN, AN),
+    append([New, AY, AN], All).
+
+%!  tg_policy_term(?Term) is semidet.
+%
+%   Term may appear in a tg policy file: tg_tree/1 or a q/3 clause.
+
+tg_policy_term(Term) :-
+    nonvar(Term),
+    (   Term = tg_tree(_)
+    ->  true
+    ;   Term = (q(_, _, _) :- _)
+    ->  true
+    ;   Term = q(_, _, _)
+    ).
+
+%!  tg_restore(+KB, +Terms:list) is det.
+%
+%   Rebuild KB's tree from the terms of a policy file (tg_tree/1; the q/3 rules must be
+%   the ones the tree gives). Candidates and their statistics start afresh.
+%
+%   @error existence_error(tg_tree, Terms) if there is no tg_tree/1 term.
+%   @error domain_error(tg_tree, Node) for a malformed node.
+%   @error domain_error(tg_rules_match_tree, Clause) for a q/3 rule the tree does not give.
+
+tg_restore(KB, Terms) :-
+    (   memberchk(tg_tree(Saved), Terms)
+    ->  true
+    ;   existence_error(tg_tree, Terms)
+    ),
+    tg_get_tree(KB, tree(_, _, Bias, Responses)),
+    restored(Saved, Bias, [], [], Root, Stats),
+    pairs_keys(Stats, Ids),
+    (   sort(Ids, Unique), length(Unique, U), length(Ids, U)
+    ->  true
+    ;   domain_error(tg_tree_unique_ids, Ids)
+    ),
+    max_list(Ids, MaxId),
+    Cap is max(16, MaxId),
+    tg_empty_leaves(Cap, Leaves),
+    foldl(place_leaf(Leaves), Stats, _, _),
+    tg_data(KB, D),
+    nb_setarg(2, D, Leaves),
+    nb_setarg(3, D, none),
+    arg(4, D, Version0), Version is Version0 + 1, nb_setarg(4, D, Version),
+    nb_setarg(5, D, 0),
+    Next is MaxId + 1,
+    tg_put_tree(KB, tree(Root, Next, Bias, Responses)),
+    tg_forget_leaves(KB),
+    forall(tg_tree_leaf(Root, Leaf), tg_compile_leaf(KB, Leaf)),
+    tg_compile_tree(KB, Root),
+    check_rules(KB, Terms).
+
+restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) :-
+    !,
+    (   integer(Id), Id > 0, number(Q), integer(N), N >= 0
+    ->  true
+    ;   domain_error(tg_tree, leaf(Id, Q, N))
+    ),
+    refinements(Bias, Path, Vars, Cands),
+    length(Cands, K),
+    tg_new_stats(Q, N, K, 0, L).
+restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
+    !,
+    (   integer(Id), Id > 0, is_list(Lits), Lits \== [], maplist(callable, Lits),
+        is_list(New), maplist(typed_var, New)
+    ->  true
+    ;   domain_error(tg_tree, node(Id, Lits, New))
+    ),
+    append(Path, Lits, Path1),
+    append(Vars, New, Vars1),
+    restored(Y, Bias, Path1, Vars1, RY, SY),
+    restored(N, Bias, Path, Vars, RN, SN),
+    append([Id-test|SY], SN, Stats).
+restored(Other, _, _, _, _, _) :-
+    domain_error(tg_tree, Other).
+
+place_leaf(Leaves, Id-L, _, _) :-
+    (   L == test
+    ->  true
+    ;   setarg(Id, Leaves, L)
+    ).
+
+typed_var(V-T) :-
+    var(V),
+    atom(T).
+
+%   The q/3 rules of a policy are the tree written as rules: refuse a file whose rules
+%   say something else (an edited rule would otherwise be silently ignored).
+check_rules(KB, Terms) :-
+    leaf_rules(KB, Mine),
+    include(is_rule, Terms, Rules),
+    forall(member(R, Rules),
+           (   member(M-_, Mine), same_rule(R, M)
+           ->  true
+           ;   domain_error(tg_rules_match_tree, R)
+           )).
+
+is_rule((q(_, _, _) :- _)).
+is_rule(q(_, _, _)).
+
+same_rule(R, M) :-
+    rule_parts(R, q(A, N, Q), B),
+    rule_parts(M, q(A1, N1, Q1), B1),
+    number(Q),
+    abs(Q - Q1) =< 0.0011,
+    q(A, N)-B =@= q(A1, N1)-B1.
+
+rule_parts((H :- B), H, B) :- !.
+rule_parts(H, H, true).
+

@@ -1,0 +1,69 @@
+"""TG: a first-order incremental regression-tree Q-learner, held in Prolog (prolog/tg.pl).
+
+In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001): one regression tree over
+(relational state, action, necessity) examples whose tests are conjunctions of literals
+from the domain's language bias (``rmode/1``), split by an F-test on incremental statistics
+of the Q-targets. See docs/tg.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from relrl.errors import ConfigError
+from relrl.learners.base import Learner, register
+from relrl.terms import Term, format_term
+
+__all__ = ["TGLearner"]
+
+
+@register
+class TGLearner(Learner):
+    """A first-order Q-tree; choices, updates and splits run in Prolog (one call a step).
+
+    Parameters (defaults chosen by the sweep in docs/tg.md): alpha (0: a leaf's Q is the
+    mean of its Q-targets; otherwise the step size is max(1/n, alpha)), gamma,
+    temperature (> 0: Boltzmann exploration, P(a) proportional to exp(Q(s, a) / T)),
+    epsilon (used only with temperature 0: epsilon-greedy), q_init (Q of the first, empty
+    leaf), significance (of the F-test of the best of a leaf's candidates,
+    Bonferroni-corrected for their number), min_examples (a split must leave at least
+    this many examples on each side), stale_bonus (while learning, a leaf no example has
+    reached for the last k examples counts Q + stale_bonus * sqrt(k): Dyna-Q+'s
+    exploration bonus, per leaf; 0 turns it off), half_life (an example counts half in the
+    split statistics once this many more examples have been inserted; 0: never forget).
+    """
+
+    name = "tg"
+    engine_name = "tg"
+    defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
+                "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
+                "stale_bonus": 1.0, "half_life": 1000.0}
+
+    def _check_params(self) -> None:
+        super()._check_params()
+        p = self.params
+        if not 0.0 < p["significance"] < 1.0:
+            raise ConfigError(f"significance must be in (0, 1), not {p['significance']}")
+        if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
+            raise ConfigError(f"min_examples must be a whole number >= 3, not "
+                              f"{p['min_examples']}")
+        for key in ("temperature", "stale_bonus", "half_life"):
+            if p[key] < 0:
+                raise ConfigError(f"{key} must be >= 0, not {p[key]}")
+
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """``ranked``: every response's Q and leaf, best first; ``paths``: for each, the
+        first-order tests from the root to its leaf, with the bindings that made them
+        true; ``path`` and ``leaf``: the best response's."""
+        _, choices = detail
+        ranked, paths = [], {}
+        for _, action, q, leaf, path in choices:
+            response = format_term(action)
+            ranked.append({"response": response, "q": q, "leaf": leaf})
+            paths[response] = [{"test": str(text), "holds": outcome == "true",
+                                "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
+                               for (_, _, text, outcome, bindings) in path]
+        best = ranked[0]["response"] if ranked else None
+        return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
+                "path": paths.get(best, []) if best else [],
+                "leaf": ranked[0]["leaf"] if ranked else None}
