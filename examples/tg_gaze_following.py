@@ -36,7 +36,7 @@ def main() -> None:
     parser.add_argument("--policy", default="tg-sis.pl", help="where to save the policy")
     args = parser.parse_args()
 
-    params = {"attention_during_gaze": True}         # Experiment 1's caregiver
+    params: dict = {}                                # Experiment 1's caregiver (the default)
     if args.train_places:
         params["placement"] = {p: 1.0 for p in args.train_places.split(",")}
     with KnowledgeBase(DEFAULT_DOMAIN) as kb:

@@ -37,7 +37,7 @@ def bench_engine(learner: str, steps: int = 5000, seed: int = 0) -> dict[str, fl
 
     with KnowledgeBase(DEFAULT_DOMAIN) as kb:
         agent = Agent(kb, make_learner(learner), seed=seed)
-        env = SharedAttentionEnv(make_caregiver("paper", {"attention_during_gaze": True}),
+        env = SharedAttentionEnv(make_caregiver("paper"),
                                  max_steps=None, record_trace=False)
         interaction = Interaction(env, agent)
         interaction.reset(seed=seed)

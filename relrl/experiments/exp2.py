@@ -43,10 +43,10 @@ ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SCRIPT = ROOT / "examples" / "episodes" / "experiment2.toml"
 
 
-def run_job(script: str, learner: str, seed: int, progress: Any, time_unit: str,
-            overrides: dict[str, Any]) -> dict[str, Any]:
+def run_job(script: str, learner: str, seed: int, time_unit: str,
+            overrides: dict[str, Any], *, report: Any = None) -> dict[str, Any]:
     """Run the script for one learner, time unit and seed; the parts of its summary the
-    sweep needs (the progress callback gets ``(label, seed, "done")`` at the end)."""
+    sweep needs (``report`` gets one ``point`` event at the end: the progress bar)."""
     from relrl.episodes import RunOptions, load_episode, run_episode
     from relrl.learners import make_learner
 
@@ -64,8 +64,8 @@ def run_job(script: str, learner: str, seed: int, progress: Any, time_unit: str,
         ep.naming = None
     t0 = time.perf_counter()
     s = run_episode(ep, RunOptions(plots=False))
-    if progress is not None:
-        progress(f"{learner}/{time_unit}", seed, "done")
+    if report is not None:
+        report({"kind": "point", "learner": learner, "seed": int(seed), "point": "done"})
     return {"learner": learner, "time_unit": time_unit, "seed": int(seed),
             "params": s["learner"]["params"],
             "evaluation": s.get("evaluation", []), "table1": s.get("table1"),
@@ -285,11 +285,16 @@ def main(argv: list[str] | None = None) -> int:
         [u.strip() for u in args.table1_units.split(",") if u.strip()]
     overrides = {"every": args.every, "perception": args.perception,
                  "executions": args.executions, "table1_units": table1_units}
-    tasks = [(args.script, name, seed, None, unit, overrides)
+    tasks = [(args.script, name, seed, unit, overrides)
              for name in learners for unit in units for seed in seeds]
-    t0 = time.perf_counter()
-    jobs = run_jobs(run_job, tasks, workers=args.workers, units_per_job=1)
-    wall = time.perf_counter() - t0
+    outcome = run_jobs(run_job, tasks, workers=args.workers, units=1,
+                       label=lambda t: f"{t[1]}/{t[3]} seed {t[2]}")
+    if not outcome.complete:  # a signal or a failing job: nothing half-made is written
+        why = outcome.error or f"stopped by {outcome.interrupted}"
+        print(f"exp2: {why}; no tables written", file=sys.stderr)
+        return 2 if outcome.error else 130
+    jobs = list(outcome.results)
+    wall = outcome.seconds
     timing = {"wall_seconds": wall, "workers": args.workers,
               "python": platform.python_version(),
               "jobs": [{"learner": j["learner"], "time_unit": j["time_unit"], "seed": j["seed"],

@@ -32,7 +32,7 @@ def _rate(learner: str, steps: int, seed: int, on_step: Any = None) -> tuple[flo
 
     with KnowledgeBase(DEFAULT_DOMAIN) as kb:
         agent = Agent(kb, make_learner(learner), seed=seed)
-        env = SharedAttentionEnv(make_caregiver("paper", {"attention_during_gaze": True}),
+        env = SharedAttentionEnv(make_caregiver("paper"),
                                  max_steps=None, record_trace=False)
         tap = on_step(agent) if on_step is not None else None
         want = tap.want if tap is not None else tuple
