@@ -3,6 +3,7 @@
             tg_state/2,           % +KB, -Facts
             tg_q/5,               % +KB, +Facts, +Action, +Necessity, -Q
             tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
+            tg_bonus/5,           % +KB, +Facts, +Action, +Necessity, -Bonus
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
             tg_size/2,            % +KB, -Size
@@ -32,12 +33,19 @@ first-order regression tree over examples (State, Action, Necessity, Q-target):
     root down to it (the node's query) has a solution in the example — TILDE's semantics. A
     variable introduced in a node is used only in its yes-subtree;
   - a leaf holds the Q estimate and, for each candidate test the refinement operator gives
-    for it (tg_bias:refinements/4), the count, sum and sum of squares of the Q-targets of the
-    examples on which the candidate succeeds. With the leaf's own three numbers, they give
-    the F-test of every candidate split (tg_stats.pl). When the best candidate is
-    significant at level `significance` after at least `min_examples` examples, the leaf
-    becomes a test node; its two children start from their partitions' statistics (Q is the
-    partition's mean Q-target) and from fresh candidates.
+    for it (tg_bias:refinements/4), the count, sum and sum of squares of the TD errors
+    (Q-target minus the leaf's Q just before the example moved it) of the examples on
+    which the candidate succeeds. With the leaf's own three numbers, they give the F-test
+    of every candidate split (tg_stats.pl). When the best candidate is significant at
+    level `significance` after at least `min_examples` examples, the leaf becomes a test
+    node; its two children start from their partitions' statistics (Q is the leaf's Q plus
+    the partition's mean TD error) and from fresh candidates.
+
+The statistics are kept over TD errors rather than the Q-targets themselves because the
+targets drift while the Q-function is learned (from q_init towards the task's values): the
+drift the leaf's own Q follows is not in the TD errors, so a split answers "is the leaf's
+estimate wrong on one side of this test?" rather than "were the targets on that side from
+another time?".
 
 Q(s, a) for each allowed response comes from sorting (s, a) down the tree; each step one
 example with Q-target r + gamma * max_a' Q(s', a') is inserted (no table of examples).
@@ -53,8 +61,9 @@ live in a global term per knowledge base and are updated in place (nb_setarg/3).
 
 Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise the rate
 is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
-epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus
-(see tg_choose/6); the engine's reward_positive and reward_negative.
+epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus,
+half_life, novelty_bonus and novelty_confidence (see tg_choose/6); the engine's
+reward_positive and reward_negative.
 */
 
 % ---- starting ------------------------------------------------------------------------------
@@ -67,8 +76,9 @@ tg_init(KB, Params) :-
     must_be(atom, KB),
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
-                            min_examples, stale_bonus, half_life],
-            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0]),
+                            min_examples, stale_bonus, half_life, novelty_bonus,
+                            novelty_confidence],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf]),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
@@ -80,8 +90,8 @@ tg_init(KB, Params) :-
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
     Half is max(0, round(Half0)),
-    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half), Leaves0, none,
-                     0, 0)),
+    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
+                       novelty(Beta, Conf)), Leaves0, none, 0, 0)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -122,12 +132,25 @@ tg_q(KB, Facts, Action, N, Q) :-
 %   learn), the Q of a leaf that no example has reached for the last K examples inserted
 %   in the tree counts as Q + stale_bonus * sqrt(K): a part of the Q-function that went
 %   stale while the rest moved is tried again (the exploration bonus of Sutton's Dyna-Q+,
-%   here per leaf). Explore and greedy choices, and the Q-targets, never include it.
+%   here per leaf).
+%
+%   Directed exploration (novelty_bonus Beta > 0, Mode learn): Q(s, a) counts as
+%   Q + tg_bonus/5, an upper confidence bound (UCB, optimism in the face of uncertainty)
+%   over the tree's own partition of the space and its candidate refinements: the
+%   regions (s, a) falls in are its leaf and the yes-side of every candidate test of that
+%   leaf that succeeds on it; each region's bound is its mean TD error plus
+%   novelty_confidence standard errors, capped at Beta, and Beta for a region fewer than
+%   two examples have reached. A (s, a) in a rarely tried region, or in one whose TD
+%   errors say the leaf's estimate may be too low there, is tried until the evidence is in
+%   (a split, or a bound below 0). Counts are not tabular over ground states: one count
+%   covers every (s, a) a test is true of — look where the caregiver looks, at any place.
+%   Explore and greedy choices, and the Q-targets, never include either bonus.
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     tg_data(KB, D),
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _), Leaves, Cache, Version, Clock),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf)), Leaves, Cache,
+           Version, Clock),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
     ->  random_member(Action, Allowed)
@@ -135,7 +158,10 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
         ->  true
         ;   maplist(sorted_leaf(KB, Facts, N), Allowed, Ids)
         ),
-        (   Mode == learn, Kappa > 0
+        (   Mode == learn, Beta > 0
+        ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)), Allowed,
+                    Ids, Qs)
+        ;   Mode == learn, Kappa > 0
         ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
         ;   maplist(leaf_q(Leaves), Ids, Qs)
         ),
@@ -156,6 +182,61 @@ bonus_q(Leaves, Kappa, Clock, Id, Q) :-
     arg(1, L, Q0),
     arg(7, L, Last),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
+
+novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), A, Id, Q) :-
+    arg(Id, Leaves, L),
+    arg(1, L, Q0),
+    arg(7, L, Last),
+    novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus),
+    Q is Q0 + Kappa * sqrt(max(0, Clock - Last)) + Bonus.
+
+%!  tg_bonus(+KB, +Facts, +Action, +Necessity, -Bonus:number) is det.
+%
+%   Bonus is the novelty bonus the example (Facts, Action, Necessity) gets while learning
+%   (tg_choose/6; 0 when novelty_bonus is 0).
+
+tg_bonus(KB, Facts, A, N, Bonus) :-
+    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf)), Leaves, _, _, Clock)),
+    (   Beta > 0
+    ->  tg_sort_(KB, Facts, A, N, Id),
+        arg(Id, Leaves, L),
+        novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus)
+    ;   Bonus = 0
+    ).
+
+%   The regions of leaf Id's partition the example falls in are the leaf itself and the
+%   yes-side of every candidate test that succeeds on it. For each, the counts, sums and
+%   sums of squares the leaf keeps give n (today's weights), Mean and Var of its TD errors;
+%   its upper confidence bound is Mean + Conf * sqrt(Var / n), capped at Beta, and Beta
+%   when n < 2. The bonus is the largest bound, and 0 when all are below 0.
+novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus) :-
+    L = l(_, _, M, S, SS, C, _, Base),
+    (   Half =:= 0
+    ->  W = 1
+    ;   W is 2 ** ((Clock - Base) / Half)       % stored units / W = today's weights
+    ),
+    U = u(W, Conf, Beta),
+    ucb(U, M, S, SS, 0, B0),
+    tg_cands_(KB, Id, Facts, A, N, Hits),
+    ucb_hits(Hits, C, U, B0, Bonus).
+
+ucb_hits([], _, _, B, B).
+ucb_hits([I|Is], C, U, B0, B) :-
+    (   U = u(_, _, Beta), B0 >= Beta
+    ->  B = B0                                  % capped: nothing can be larger
+    ;   J is 3 * I - 2,
+        arg(J, C, M), J2 is J + 1, arg(J2, C, S), J3 is J + 2, arg(J3, C, SS),
+        ucb(U, M, S, SS, B0, B1),
+        ucb_hits(Is, C, U, B1, B)
+    ).
+
+%   With counts M in stored units (today's n = M / W): Mean = S / M and
+%   Var / n = W * (SS * M - S^2) / M^3.
+ucb(u(W, Conf, Beta), M, S, SS, B0, B) :-
+    (   M < 2 * W
+    ->  B is max(B0, Beta)
+    ;   B is max(B0, min(Beta, (S + Conf * sqrt(max(0.0, W * (SS * M - S * S) / M))) / M))
+    ).
 
 ties([], [], _, []).
 ties([Q|Qs], [A|As], Best, Ties) :-
@@ -191,7 +272,7 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _), Leaves, _, Version, _),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _), Leaves, _, Version, _),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
@@ -208,16 +289,17 @@ sorted_leaf(KB, Facts, N, A, Leaf) :-
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
-%   Insert one example: sort it to its leaf, move the leaf's Q towards Target, count Target
-%   in the leaf's statistics and in those of every candidate that succeeds on the example,
-%   and split the leaf when its best candidate is significant.
+%   Insert one example: sort it to its leaf, move the leaf's Q towards Target, count the TD
+%   error Target - Q (Q before the move) in the leaf's statistics and in those of every
+%   candidate that succeeds on the example, and split the leaf when its best candidate is
+%   significant.
 
 tg_insert(KB, Facts, A, N, Target) :-
     tg_data(KB, D),
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half), Leaves, _, _, Clock0),
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _), Leaves, _, _, Clock0),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
     tg_sort_(KB, Facts, A, N, Leaf),
@@ -227,13 +309,14 @@ insert(KB, D, Facts, A, N, Target) :-
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
     nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
     weight(L, Half, Clock, W),                      % (may rescale the sums)
+    E is Target - Q0,                               % the TD error (module doc)
     arg(3, L, M0), arg(4, L, S0), arg(5, L, SS0),
     M is M0 + W,
-    S is S0 + W * Target,
-    SS is SS0 + W * Target * Target,
+    S is S0 + W * E,
+    SS is SS0 + W * E * E,
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
     tg_cands_(KB, Leaf, Facts, A, N, Hits),
-    count_hits(Hits, C, W, Target),
+    count_hits(Hits, C, W, E),
     (   N1 /\ 3 =:= 0,                              % every fourth example
         MinW is MinEx * W,                          % min_examples in stored units
         M >= 2 * MinW,
@@ -246,19 +329,19 @@ insert(KB, D, Facts, A, N, Target) :-
         Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
         f_significant(FStat, Dof, Corrected)
     ->  M2t is Mt - M1t,
-        QYes is S1 / M1, QNo is (S - S1) / (M - M1),
+        QYes is Q + S1 / M1, QNo is Q + (S - S1) / (M - M1),
         split(KB, D, Leaf, I, s(M1t, QYes), s(M2t, QNo))
     ;   true
     ).
 
 %   Forgetting (half_life H > 0): an example counts 2^(-k / H) in the split statistics
-%   once k more examples have been inserted in the tree. The Q-targets drift while the
-%   Q-function is learned: without forgetting, a leaf compares targets from long ago with
-%   today's, a test that merely tells early examples from later ones (a necessity active
-%   mostly at the start) looks significant, and its rarely visited side starts with an
-%   estimate from long ago. A leaf's sums are kept in units of the weight an example had
-%   when they were last rescaled (Base, the eighth argument of l/8): an example inserted
-%   now weighs W = 2^((Clock - Base) / H) there, and dividing by W gives today's weights.
+%   once k more examples have been inserted in the tree. The Q-function moves while it is
+%   learned: without forgetting, a leaf compares TD errors from long ago (of a policy and
+%   of estimates since changed) with today's, and a test that merely tells early examples
+%   from later ones may look significant. A leaf's sums are kept in units of the weight an
+%   example had when they were last rescaled (Base, the eighth argument of l/8): an example
+%   inserted now weighs W = 2^((Clock - Base) / H) there, and dividing by W gives today's
+%   weights.
 %   When W grows large the leaf's sums are rescaled (once every 64 half-lives at most).
 weight(L, Half, Clock, W) :-
     (   Half =:= 0
@@ -324,7 +407,8 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
 % ---- splitting -----------------------------------------------------------------------------
 
 %   Split leaf LeafId on its candidate I; the children start from their partitions:
-%   s(Weight, MeanQTarget) each (today's weights).
+%   s(Weight, Q) each (today's weights; Q the leaf's estimate plus the mean TD error on
+%   that side).
 split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,

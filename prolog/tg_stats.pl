@@ -12,13 +12,13 @@
 
 /** <module> Incremental statistics and the F-test of a TG split
 
-A TG leaf keeps, for the Q-targets of the examples that reached it and for each candidate
-test, only three numbers: the count, the sum and the sum of squares, s(N, Sum, SumSq). They
-are enough for the regression tree's split criterion (Blockeel & De Raedt's TILDE, Driessens
-et al.'s TG): a test partitions a leaf's examples into those where it succeeds (Yes) and
-fails (No = Total - Yes), and the split is worth making when the two partitions' means
-differ by more than chance. The F statistic of the one-way analysis of variance with two
-groups is
+A TG leaf keeps, for the TD errors of the examples that reached it (tg.pl) and for each
+candidate test, only three numbers: the count, the sum and the sum of squares,
+s(N, Sum, SumSq). They are enough for the regression tree's split criterion (Blockeel & De
+Raedt's TILDE, Driessens et al.'s TG): a test partitions a leaf's examples into those where
+it succeeds (Yes) and fails (No = Total - Yes), and the split is worth making when the two
+partitions' means differ by more than chance. The F statistic of the one-way analysis of
+variance with two groups is
 
     F = (SSE_total - SSE_split) / (SSE_split / (N - 2)),      Dof = (1, N - 2)
 

@@ -44,12 +44,12 @@ explains, draws, saves and restores them.
 %                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last, Base)
 %                  for leaf i (or `free`): the Q estimate and the examples counted in it
 %                  (its partition's and its own), the count, sum and sum of squares of the
-%                  Q-targets since the leaf was made, C = c(M1, S1, SS1, M2, ...) the same
+%                  TD errors since the leaf was made (tg.pl), C = c(M1, S1, SS1, M2, ...) the same
 %                  for each candidate, in order, the Clock (examples inserted in the tree so
 %                  far) when the leaf was last updated, and the Clock its sums are weighed
 %                  from (forgetting, tg.pl's weight/4); the numbers are updated with
 %                  nb_setarg/3. Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples,
-%                  Kappa, HalfLife).
+%                  Kappa, HalfLife, Beta) (Kappa the stale bonus, Beta the novelty bonus).
 %                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
 %                  sorted the next state's allowed actions, reused by the choice that
 %                  follows in the same step while the tree is unchanged (Version).

@@ -35,9 +35,10 @@ class TGLearner(Learner):
 
     name = "tg"
     engine_name = "tg"
-    defaults = {"alpha": 0.1, "gamma": 0.9, "epsilon": 0.05, "temperature": 2.0,
+    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "temperature": 1.0,
                 "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
-                "stale_bonus": 1.0, "half_life": 1000.0}
+                "stale_bonus": 1.0, "half_life": 1000.0, "novelty_bonus": 20.0,
+                "novelty_confidence": 2.0}
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -47,9 +48,12 @@ class TGLearner(Learner):
         if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
             raise ConfigError(f"min_examples must be a whole number >= 3, not "
                               f"{p['min_examples']}")
-        for key in ("temperature", "stale_bonus", "half_life"):
+        for key in ("temperature", "stale_bonus", "half_life", "novelty_bonus"):
             if p[key] < 0:
                 raise ConfigError(f"{key} must be >= 0, not {p[key]}")
+        if p["novelty_confidence"] < 0:
+            raise ConfigError(f"novelty_confidence must be >= 0, not "
+                              f"{p['novelty_confidence']}")
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
         """``ranked``: every response's Q and leaf, best first; ``paths``: for each, the
