@@ -229,6 +229,8 @@ def test_example_learns_gaze_following_on_the_sis(tmp_path: Path) -> None:
     ({"temperature": -1}, "temperature must be >= 0"),
     ({"stale_bonus": -0.5}, "stale_bonus must be >= 0"),
     ({"half_life": -10}, "half_life must be >= 0"),
+    ({"novelty_bonus": -1}, "novelty_bonus must be >= 0"),
+    ({"novelty_confidence": -2}, "novelty_confidence must be >= 0"),
 ])
 def test_bad_parameters(params: dict, message: str) -> None:
     from relrl.errors import ConfigError
