@@ -377,12 +377,7 @@ declaration(KB, Head, Ref) :-
     \+ predicate_property(KB:Head, imported_from(_)),
     clause(KB:Head, true, Ref).
 
+%   Where a declaration came from (relrl_check's one definition; check.pl loads this
+%   module, so the call is qualified rather than imported).
 clause_where(Ref, File, Line) :-
-    (   clause_property(Ref, file(File0))
-    ->  File = File0
-    ;   File = ''
-    ),
-    (   clause_property(Ref, line_count(Line0))
-    ->  Line = Line0
-    ;   Line = 0
-    ).
+    relrl_check:clause_location(Ref, File, Line).

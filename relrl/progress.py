@@ -38,8 +38,12 @@ class Progress:
         if enabled and bar:
             from tqdm import tqdm
 
+            # a terminal that reports no size (a bare pseudo-terminal, as a test harness or
+            # a supervisor opens) makes tqdm draw nothing at all: give it 80 x 20
+            sized = _terminal_size() > (0, 0)
             self._bar = tqdm(total=total, desc=desc, unit=unit, file=sys.stderr,
-                             dynamic_ncols=True, leave=False)
+                             dynamic_ncols=sized, ncols=None if sized else 80,
+                             nrows=None if sized else 20, leave=False)
 
     def update(self, n: int = 1) -> None:
         """``n`` more done."""
@@ -79,6 +83,17 @@ class Progress:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _terminal_size() -> tuple[int, int]:
+    """Columns and lines of the terminal on standard error (0s when it reports none)."""
+    import os
+
+    try:
+        size = os.get_terminal_size(sys.stderr.fileno())
+    except (OSError, ValueError, AttributeError):
+        return (0, 0)
+    return (size.columns, size.lines) if size.columns > 0 and size.lines > 0 else (0, 0)
 
 
 def progress(total: int | None, desc: str, *, unit: str = "it", enabled: bool = True,

@@ -40,6 +40,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 from perception.vocabulary import OBJECT_PLACES
+from perception.vocabulary import PLACES as _VOCABULARY_PLACES
 
 __all__ = [
     "ANGLE_BETWEEN",
@@ -169,10 +170,12 @@ def layout(n: int = 5) -> Layout:
 
 
 _PAPER = layout(5)
-#: the places of the paper's world, robot's view; index 0 is the caregiver's face.
-PLACES: tuple[str, ...] = _PAPER.places
+assert _PAPER.places == _VOCABULARY_PLACES and _PAPER.toy_places == OBJECT_PLACES
+#: the places of the paper's world, robot's view; index 0 is the caregiver's face (the one
+#: definition, :mod:`perception.vocabulary`, which ``layout(5)`` reproduces).
+PLACES: tuple[str, ...] = _VOCABULARY_PLACES
 #: the places a toy can be put at (every place but the caregiver).
-TOY_PLACES: tuple[str, ...] = _PAPER.toy_places
+TOY_PLACES: tuple[str, ...] = OBJECT_PLACES
 #: place -> (x, y, z) in centimetres, robot frame (see the module documentation).
 POSITIONS: dict[str, tuple[float, float, float]] = _PAPER.positions
 #: place -> (pan, tilt) in degrees the robot's head turns to look at it.

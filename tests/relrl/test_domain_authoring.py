@@ -124,8 +124,10 @@ def test_add_warns_about_a_percept_the_domain_does_not_know(shell) -> None:
                   "colour(object, red), at(object, left), see(dog)\n", ":memory\n"])
     lines = out.getvalue().splitlines()
     assert lines[0] == "inserted 7 elements"
-    assert [line.split(" is not")[0] for line in lines[1:4]] == [
-        "warning: se(face)", "warning: pose(face,left)", "warning: see(dog)"]
+    # fruits.pl's relational view (for tg) reads every see(_) and pose(_, _) in working
+    # memory (sees(Thing), gaze(Who, Place)), so only the typo is unread
+    assert [line for line in lines if line.startswith("warning:")] == [lines[1]]
+    assert lines[1].split(" is not")[0] == "warning: se(face)"
     assert "no stimulus, fact or rule perceives it" in lines[1]
     assert "age 0   se(face)" in out.getvalue()             # a warning, not a refusal
     assert sh.errors == 0

@@ -43,6 +43,31 @@ def test_progress_on_a_terminal_is_a_tqdm_bar(monkeypatch) -> None:
     assert "2/5" in tty.getvalue() and "point" in tty.getvalue()
 
 
+def test_a_terminal_that_reports_no_size_still_shows_the_bar() -> None:
+    """A bare pseudo-terminal (0 x 0, as test harnesses and supervisors open) once made
+    tqdm draw nothing at all."""
+    import os
+    import pty
+    import select
+    import subprocess
+    import sys
+
+    master, slave = pty.openpty()
+    code = ("import time; from relrl.progress import progress; p = progress(10, 'x', "
+            "unit='point'); p.update(1); time.sleep(0.3); p.update(1); time.sleep(0.3)")
+    proc = subprocess.Popen([sys.executable, "-c", code], stderr=slave)
+    os.close(slave)
+    text = b""
+    while proc.poll() is None or select.select([master], [], [], 0.1)[0]:
+        if select.select([master], [], [], 0.1)[0]:
+            try:
+                text += os.read(master, 4096)
+            except OSError:
+                break
+    os.close(master)
+    assert b"2/10" in text, text
+
+
 def test_quiet_means_no_progress(monkeypatch) -> None:
     err = io.StringIO()
     monkeypatch.setattr("sys.stderr", err)
