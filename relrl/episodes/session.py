@@ -100,6 +100,8 @@ class RunOptions:
         record: record frames, trees and events into ``out`` (:mod:`.recording`).
         record_rate: recorded frames per second at most (0: every time unit).
         record_quality: JPEG quality of recorded frames.
+        timeout: seconds one control step (one gateway call) may run before the run stops
+            naming the rule (the robot's 10 s; batch sweeps on a loaded machine need more).
     """
 
     out: Path | None = None
@@ -116,6 +118,7 @@ class RunOptions:
     record: bool = False
     record_rate: float = 10.0
     record_quality: int = 85
+    timeout: float = 10.0
 
 
 def _json_num(x: float) -> float | None:
@@ -134,7 +137,7 @@ class _Run:
         from relrl.speech import Speaker
 
         self.episode, self.opts = episode, opts
-        self.kb = KnowledgeBase(episode.domain)
+        self.kb = KnowledgeBase(episode.domain, timeout=opts.timeout)
         self.learner = make_learner(episode.learner, **episode.learner_params)
         self.agent = Agent(self.kb, self.learner, seed=episode.seed)
         if episode.policy_load is not None:

@@ -63,7 +63,7 @@ def run_job(script: str, learner: str, seed: int, time_unit: str,
     if time_unit not in overrides.get("table1_units", (time_unit,)):
         ep.naming = None
     t0 = time.perf_counter()
-    s = run_episode(ep, RunOptions(plots=False))
+    s = run_episode(ep, RunOptions(plots=False, timeout=float(overrides.get("timeout", 60.0))))
     if report is not None:
         report({"kind": "point", "learner": learner, "seed": int(seed), "point": "done"})
     return {"learner": learner, "time_unit": time_unit, "seed": int(seed),
@@ -239,6 +239,9 @@ def _options(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--perception", choices=["render", "symbolic"], default=None,
                         help="override the script's perception (symbolic: no Table 1)")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1))
+    parser.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
+                        help="seconds one control step may run before the job stops, naming "
+                             "the rule (default 60: a loaded machine; the robot's own is 10)")
     parser.add_argument("--out", default="runs/exp2-sweep", help="output folder")
     return parser.parse_args(argv)
 
@@ -266,6 +269,8 @@ def _check(args: argparse.Namespace) -> tuple[list[str], list[str], list[int]]:
         raise UserError("give at least one seed, learner and time unit")
     if args.every < 1 or args.workers < 1:
         raise UserError("--every and --workers must be at least 1")
+    if not (args.timeout > 0 and args.timeout < float("inf")):
+        raise UserError(f"--timeout must be a number of seconds > 0, not {args.timeout}")
     load_episode(args.script)  # check it here, not in a worker
     return learners, units, seeds
 
@@ -284,16 +289,18 @@ def main(argv: list[str] | None = None) -> int:
     table1_units = units if args.table1_units == "all" else \
         [u.strip() for u in args.table1_units.split(",") if u.strip()]
     overrides = {"every": args.every, "perception": args.perception,
-                 "executions": args.executions, "table1_units": table1_units}
+                 "executions": args.executions, "table1_units": table1_units,
+                 "timeout": args.timeout}
     tasks = [(args.script, name, seed, unit, overrides)
              for name in learners for unit in units for seed in seeds]
     outcome = run_jobs(run_job, tasks, workers=args.workers, units=1,
                        label=lambda t: f"{t[1]}/{t[3]} seed {t[2]}")
-    if not outcome.complete:  # a signal or a failing job: nothing half-made is written
+    jobs = [j for j in outcome.results if j is not None]
+    if not outcome.complete:  # a signal or a failing job: the finished jobs are kept
         why = outcome.error or f"stopped by {outcome.interrupted}"
-        print(f"exp2: {why}; no tables written", file=sys.stderr)
-        return 2 if outcome.error else 130
-    jobs = list(outcome.results)
+        if not jobs:
+            print(f"exp2: {why}; no job finished, nothing written", file=sys.stderr)
+            return 2 if outcome.error else 130
     wall = outcome.seconds
     timing = {"wall_seconds": wall, "workers": args.workers,
               "python": platform.python_version(),
@@ -307,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
                else str(script),
                "learners": learners, "time_units": units, "seeds": seeds,
                "overrides": overrides, "summary": summarise(jobs), "jobs": jobs,
-               "paper": PAPER}
+               "partial": not outcome.complete, "paper": PAPER}
     files = write_outputs(Path(args.out), results, timing)
     for key, s in results["summary"].items():
         line = f"{key:28s}"
@@ -320,6 +327,10 @@ def main(argv: list[str] | None = None) -> int:
                  "; Table 1: no presentation")
         print(line)
     print(f"wrote {len(files)} files to {args.out}/ in {wall:.0f} s")
+    if not outcome.complete:
+        print(f"exp2: {why}; the {len(jobs)} finished jobs of {len(tasks)} are written "
+              "(results.json marked partial)", file=sys.stderr)
+        return 2 if outcome.error else 130
     return 0
 
 
