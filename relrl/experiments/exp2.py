@@ -138,7 +138,8 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
         for seed, r in [*t1["per_seed"].items(), ("all", t1["all_executions"])]:
             rows.append([s["learner"], s["time_unit"], seed]
                         + ([f"{r[o][0]:.2f} +- {r[o][1]:.2f}" for o in OUTCOMES] if r else
-                           ["no presentation"] * len(OUTCOMES)))
+                           [("no presentation" if t1["executions"] else "not run")]
+                           * len(OUTCOMES)))
     _write_csv(files[3], ["learner", "time_unit", "seed", *OUTCOMES], rows)
     _write_csv(files[4], ["learner", "time_unit", "shown", "said", "count", "percent_of_shown"],
                [[s["learner"], s["time_unit"], shown, said, n,
@@ -324,7 +325,8 @@ def main(argv: list[str] | None = None) -> int:
                      f"{last['cgi_sd_over_seeds']:.3f} over seeds")
         t1 = s["table1"]["all_executions"]
         line += (f"; success {t1['success'][0]:.2f} +- {t1['success'][1]:.2f} %" if t1 else
-                 "; Table 1: no presentation")
+                 "; Table 1: no presentation" if s["table1"]["executions"] else
+                 "; Table 1 not run for this time unit (--table1-units)")
         print(line)
     print(f"wrote {len(files)} files to {args.out}/ in {wall:.0f} s")
     if not outcome.complete:
