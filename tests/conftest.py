@@ -19,3 +19,15 @@ def write_domain(tmp_path: Path):
         path.write_text(text)
         return path
     return write
+
+
+def default_signals() -> None:
+    """For ``subprocess.Popen(preexec_fn=...)``: the child starts with SIGINT and SIGTERM at
+    their defaults and unblocked, as from a user's shell, whatever this test process (with
+    SWI-Prolog, Ray and browser drivers loaded in it) has done to its own dispositions."""
+    import signal
+
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
+

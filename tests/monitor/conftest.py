@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import default_signals
+
 ROOT = Path(__file__).resolve().parents[2]
 FRUITS = ROOT / "examples" / "domains" / "fruits.pl"
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
@@ -77,7 +79,7 @@ class RelrlProcess:
     def __init__(self, *args: str) -> None:
         self.proc = subprocess.Popen([sys.executable, "-m", "relrl", *args],
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                     text=True, cwd=ROOT)
+                                     text=True, cwd=ROOT, preexec_fn=default_signals)
         self.lines: list[str] = []
 
     def wait_for(self, pattern: str, timeout: float = 60.0) -> re.Match[str]:

@@ -17,7 +17,7 @@ import pytest
 
 from relrl.kb import KnowledgeBase
 from relrl.shell import Shell
-from tests.conftest import FRUITS, ROOT
+from tests.conftest import FRUITS, ROOT, default_signals
 
 
 @pytest.fixture
@@ -212,7 +212,8 @@ class _Terminal:
 
         self.master, slave = os.openpty()
         self.proc = subprocess.Popen(args, stdin=slave, stdout=slave, stderr=slave, env=env,
-                                     cwd=ROOT, start_new_session=True)
+                                     cwd=ROOT, start_new_session=True,
+                                     preexec_fn=default_signals)
         os.close(slave)
         self.seen = ""
 
