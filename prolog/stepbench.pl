@@ -1,0 +1,289 @@
+:- module(relrl_stepbench,
+          [ stepbench_read/2,     % +File, -Recording
+            stepbench_replay/3,   % +Recording, +Options, -Figures
+            stepbench_main/0
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(option)).
+:- use_module(library(pairs)).
+:- use_module(library(statistics)).
+:- use_module(library(http/json)).
+:- use_module(gateway).
+:- use_module(engine).
+
+/** <module> The Prolog side of a control step, measured alone
+
+A benchmark tool, not part of the knowledge layer. A *recording* of a run (written by
+relrl/stepbench.py from a seeded run of an agent on the simulator) lists, step by step, the
+percepts, the index of the response emitted at the previous step, the step's mode and what
+engine_step/6 returned. This module replays it in plain swipl: it loads the recorded domain
+into a knowledge base as relrl's gateway does, configures the engine with the recorded
+learner, parameters and seed, and calls engine_step/6 once per recorded step — the knowledge
+side of the robot's control step without Python and without the bridge.
+
+Every replayed step must return exactly what the recording says (state code, necessity,
+unit outputs, reward, allowed responses, the learner's choice); the first difference is an
+error. So the figures are of the same decisions the Python run made.
+
+Figures (per timed step; the warm-up steps are replayed untimed first): wall-clock and CPU
+microseconds and inferences, net of the replay loop's own cost (measured by the same loop
+with engine_step/6 left out), both with engine_step/6 called directly and through the
+gateway's time-limited call (gw_run/3, what Python calls). With profile(true), SWI-Prolog's
+profiler runs over the timed steps and the figures include each predicate's share of the
+time and its calls per step.
+
+    swipl -g relrl_stepbench:stepbench_main -t halt prolog/stepbench.pl -- REC [--passes N]
+          [--profile] [--top N]
+
+prints the figures as one JSON object (relrl bench --prolog-step runs it).
+*/
+
+%!  stepbench_read(+File, -Recording) is det.
+%
+%   Read a recording, as data (nothing in it is run). Recording is
+%   recording(Domain, Learner, Params, Seed, Warmup, Events), Events a list of
+%   s(Percepts, Emitted, Mode, Expected) and end_episode in order.
+%
+%   @error domain_error(stepbench_term, T) for a term that is not part of a recording.
+
+stepbench_read(File, recording(Domain, Learner, Params, Seed, Warmup, Events)) :-
+    setup_call_cleanup(
+        open(File, read, S, [encoding(utf8)]),
+        read_terms(S, Terms),
+        close(S)),
+    (   Terms = [stepbench(Domain, Learner, Params, Seed, Warmup)|Events]
+    ->  must_be(atom, Learner),
+        must_be(list, Params),
+        must_be(nonneg, Warmup),
+        maplist(check_event, Events)
+    ;   domain_error(stepbench_recording, File)
+    ).
+
+read_terms(S, Terms) :-
+    read_term(S, T, []),
+    (   T == end_of_file
+    ->  Terms = []
+    ;   Terms = [T|Terms1],
+        read_terms(S, Terms1)
+    ).
+
+check_event(end_episode) :- !.
+check_event(s(Percepts, Emitted, Mode, r(_, _, _, _, _, _, _))) :-
+    is_list(Percepts), ground(Percepts), integer(Emitted), atom(Mode),
+    !.
+check_event(T) :-
+    domain_error(stepbench_term, T).
+
+%!  stepbench_replay(+Recording, +Options, -Figures:dict) is det.
+%
+%   Replay Recording, checking every step, and measure it. Options: passes(N) (default 3:
+%   each pass starts the engine afresh and replays the whole recording; the figures are the
+%   median pass), profile(Bool) (default false), top(N) (predicates listed in the profile,
+%   default 25).
+%
+%   @error stepbench_mismatch(Step, Expected, Got) when a replayed step differs from the
+%   recording.
+
+stepbench_replay(recording(Domain, Learner, Params, Seed, Warmup, Events), Options,
+                 Figures) :-
+    option(passes(Passes), Options, 3),
+    must_be(positive_integer, Passes),
+    option(profile(Profile), Options, false),
+    option(top(Top), Options, 25),
+    kb_for(Domain, KB),
+    split_warmup(Warmup, Events, Before, Timed),
+    count_steps(Timed, Steps),
+    Steps > 0,
+    Setup = setup(KB, Learner, Params, Seed, Before),
+    findall(P, ( between(1, Passes, _),
+                 pass(Setup, Timed, direct, P) ), Direct),
+    findall(P, ( between(1, Passes, _),
+                 pass(Setup, Timed, gateway, P) ), Gateway),
+    findall(P, ( between(1, Passes, _),
+                 pass(Setup, Timed, overhead, P) ), Overhead),
+    median_pass(Direct, D),
+    median_pass(Gateway, G),
+    median_pass(Overhead, O),
+    per_step(D, O, Steps, DirectFig),
+    per_step(G, O, Steps, GatewayFig),
+    Figures0 = _{learner:Learner, domain:Domain, seed:Seed, warmup:Warmup,
+                 steps:Steps, passes:Passes, direct:DirectFig, gateway:GatewayFig,
+                 loop_us_per_step:LoopUs},
+    LoopUs is 1e6 * O.wall / Steps,
+    (   Profile == true
+    ->  profile_timed(Setup, Timed, Steps, Top, ProfileFig),
+        Figures = Figures0.put(profile, ProfileFig)
+    ;   Figures = Figures0
+    ).
+
+kb_for(Domain, KB) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_gateway:gw_load(Domain, KB, 10, Problems),
+    (   member(problem(error, F, L, M), Problems)
+    ->  throw(error(stepbench_domain(F:L, M), _))
+    ;   true
+    ).
+
+%   The events up to the Warmup-th step, and the rest.
+split_warmup(0, Events, [], Events) :- !.
+split_warmup(N, [E|Es], [E|Before], Timed) :-
+    !,
+    (   E == end_episode
+    ->  N1 = N
+    ;   N1 is N - 1
+    ),
+    split_warmup(N1, Es, Before, Timed).
+split_warmup(N, [], _, _) :-
+    domain_error(stepbench_warmup, N).
+
+count_steps(Events, N) :-
+    aggregate_all(count, member(s(_, _, _, _), Events), N).
+
+%   One pass: the engine afresh, the warm-up, then the timed steps (How: direct, gateway,
+%   or overhead — the loop alone). pass(Wall, Cpu, Inferences) in seconds and counts.
+pass(setup(KB, Learner, Params, Seed, Before), Timed, How,
+     pass{wall:Wall, cpu:Cpu, inferences:Inf}) :-
+    relrl_engine:engine_configure(KB, Learner, Params, Seed),
+    replay(Before, KB, direct, 0, I0),
+    garbage_collect,
+    statistics(inferences, Inf0),
+    statistics(cputime, C0),
+    get_time(T0),
+    replay(Timed, KB, How, I0, _),
+    get_time(T1),
+    statistics(cputime, C1),
+    statistics(inferences, Inf1),
+    Wall is T1 - T0,
+    Cpu is C1 - C0,
+    Inf is Inf1 - Inf0.
+
+%   Events replayed in a failure-driven loop (each step's terms are freed after it, as in a
+%   gateway call); I counts the steps for error messages.
+replay([], _, _, I, I).
+replay([E|Es], KB, How, I0, I) :-
+    (   E == end_episode
+    ->  relrl_engine:engine_end_episode(KB),
+        I1 = I0
+    ;   I1 is I0 + 1,
+        \+ \+ replay_step(How, KB, E, I1)
+    ),
+    replay(Es, KB, How, I1, I).
+
+replay_step(direct, KB, s(Percepts, Emitted, Mode, Expected), I) :-
+    relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
+    same(I, Expected, Out).
+replay_step(gateway, KB, s(Percepts, Emitted, Mode, Expected), I) :-
+    relrl_gateway:gw_run(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
+                         60, Result),
+    (   Result == true
+    ->  same(I, Expected, Out)
+    ;   throw(error(stepbench_step(I, Result), _))
+    ).
+replay_step(overhead, _, s(_, _, _, r(C, N, Ys, R, Rf, M, A)), I) :-
+    same(I, r(C, N, Ys, R, Rf, M, A), step(C, N, Ys, R, Rf, M, A, [])).
+
+same(I, r(Code, N, Ys, Reward, Reinforced, Mask, Action), Out) :-
+    (   Out = step(Code1, N1, Ys1, Reward1, Reinforced1, Mask1, Action1, _),
+        Code1 == Code, N1 == N, Ys1 == Ys, Reward1 == Reward,
+        Reinforced1 == Reinforced, Mask1 == Mask, Action1 == Action
+    ->  true
+    ;   throw(error(stepbench_mismatch(I, r(Code, N, Ys, Reward, Reinforced, Mask,
+                                            Action), Out), _))
+    ).
+
+%   The median of each figure over the passes (each on its own: the wall clock of a busy
+%   machine moves more than its CPU time).
+median_pass(Passes, pass{wall:Wall, cpu:Cpu, inferences:Inf}) :-
+    median_of(wall, Passes, Wall),
+    median_of(cpu, Passes, Cpu),
+    median_of(inferences, Passes, Inf).
+
+median_of(Key, Passes, Median) :-
+    maplist(get_dict(Key), Passes, Values),
+    msort(Values, Sorted),
+    length(Sorted, L),
+    Mid is L // 2,
+    nth0(Mid, Sorted, Median).
+
+per_step(P, O, Steps, _{us_per_step:Us, cpu_us_per_step:CpuUs,
+                        inferences_per_step:Inf}) :-
+    Us is 1e6 * (P.wall - O.wall) / Steps,
+    CpuUs is 1e6 * (P.cpu - O.cpu) / Steps,
+    Inf is (P.inferences - O.inferences) / Steps.
+
+%   ---- The profile -------------------------------------------------------------------------
+
+%   The profiler runs over the timed steps only (off during the warm-up) of 8 passes.
+%   Per predicate: its share of the time with what it calls (cumulative) and alone (self),
+%   in percent, and how often it is entered per step (a recursive predicate's calls to
+%   itself are not counted).
+profile_timed(setup(KB, Learner, Params, Seed, Before), Timed, Steps, Top,
+              _{passes:Passes, samples:Samples, ticks:Ticks, predicates:Rows}) :-
+    Passes = 8,
+    reset_profiler,
+    forall(between(1, Passes, _),
+           ( relrl_engine:engine_configure(KB, Learner, Params, Seed),
+             replay(Before, KB, direct, 0, I0),
+             profiler(_, cputime),
+             replay(Timed, KB, direct, I0, _),
+             profiler(_, false) )),
+    profile_data(Data),
+    Samples = Data.summary.samples,
+    Ticks = Data.summary.ticks,
+    Calls is Passes * Steps,
+    findall(Row, profile_row(Data.nodes, Ticks, Calls, Row), Rows0),
+    sort(cumulative, @>=, Rows0, Rows1),
+    length(Rows1, NRows),
+    Keep is min(Top, NRows),
+    length(Rows, Keep),
+    append(Rows, _, Rows1).
+
+profile_row(Nodes, Ticks, Steps, _{predicate:Name, cumulative:Cum, self:Self,
+                                    calls_per_step:PerStep}) :-
+    Ticks > 0,
+    member(Node, Nodes),
+    Node.ticks_self + Node.ticks_siblings > 0,
+    format(string(Name), "~q", [Node.predicate]),
+    Cum is 100 * (Node.ticks_self + Node.ticks_siblings) / Ticks,
+    Self is 100 * Node.ticks_self / Ticks,
+    PerStep is Node.call / Steps.
+
+%   ---- Command line ------------------------------------------------------------------------
+
+%!  stepbench_main is det.
+%
+%   The command line: stepbench.pl -- RECORDING [--passes N] [--profile] [--top N]; prints
+%   the figures as JSON on standard output.
+
+stepbench_main :-
+    current_prolog_flag(argv, Argv),
+    argv_options(Argv, Positional, Opts),
+    (   Positional = [File]
+    ->  true
+    ;   throw(error(stepbench_usage(Argv), _))
+    ),
+    stepbench_read(File, Recording),
+    option(passes(Passes), Opts, 3),
+    option(top(Top), Opts, 25),
+    (   option(profile(true), Opts)
+    ->  Profile = true
+    ;   Profile = false
+    ),
+    stepbench_replay(Recording, [passes(Passes), profile(Profile), top(Top)], Figures),
+    json_write_dict(current_output, Figures, [width(0)]),
+    nl.
+
+:- multifile prolog:error_message//1.
+
+prolog:error_message(stepbench_mismatch(I, Expected, Got)) -->
+    [ 'step ~w of the recording: the engine returned ~q, the recording says ~q'-
+      [I, Got, Expected] ].
+prolog:error_message(stepbench_step(I, Result)) -->
+    [ 'step ~w of the recording: the gateway call gave ~q'-[I, Result] ].
+prolog:error_message(stepbench_domain(Where, Message)) -->
+    [ 'the recording''s domain does not load: ~w: ~w'-[Where, Message] ].
+prolog:error_message(stepbench_usage(Argv)) -->
+    [ 'usage: stepbench.pl -- RECORDING [--passes N] [--profile] [--top N] (got ~q)'-
+      [Argv] ].
