@@ -100,37 +100,47 @@ gateway can name the rule.
     learner_snapshot/3,
     learner_resume/3.
 
-%   Each knowledge base's engine lives in two global variables (per KB, so one KB never
-%   sees another's):
-%     '$relrl_run:KB'  run(Learner, Params, Features, Responses, Units, Reinforcers,
-%                          Constraints, Necessities) — fixed for a run, read without copying
-%     '$relrl_eng:KB'  eng(Prev, Random) — Prev is prev(State, Necessity) of the last step
-%                      or none; Random the KB's random state.
+%   Each knowledge base's engine lives in one global variable, '$relrl_engine:KB' (per KB,
+%   so one KB never sees another's), holding engine(Run, Eng):
+%     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
+%               Necessities, Plan) — fixed for a run, read without copying; Plan is the
+%               state code's plan (relrl_state:state_plan/3)
+%     Eng = eng(Prev, Random) — Prev is prev(State, Necessity) of the last step or none;
+%               Random the KB's random state. Replaced in place (nb_setarg/3) every step.
 
-run_key(KB, Key) :- atom_concat('$relrl_run:', KB, Key).
-eng_key(KB, Key) :- atom_concat('$relrl_eng:', KB, Key).
+engine_key(KB, Key) :-
+    (   engine_key_(KB, Key0)
+    ->  Key = Key0
+    ;   must_be(atom, KB),
+        atom_concat('$relrl_engine:', KB, Key),
+        assertz(engine_key_(KB, Key))
+    ).
 
-run(KB, Run) :-
-    run_key(KB, Key),
-    (   nb_current(Key, Run0)
-    ->  Run = Run0
+:- dynamic engine_key_/2.           % KB, the name of its global variable (made once)
+
+engine(KB, Engine) :-
+    engine_key(KB, Key),
+    (   nb_current(Key, Engine0)
+    ->  Engine = Engine0
     ;   existence_error(engine_configuration, KB)
     ).
 
+run(KB, Run) :-
+    engine(KB, engine(Run, _)).
+
 eng(KB, Eng) :-
-    eng_key(KB, Key),
-    nb_getval(Key, Eng).
+    engine(KB, engine(_, Eng)).
 
 set_eng(KB, Eng) :-
-    eng_key(KB, Key),
-    nb_setval(Key, Eng).
+    engine(KB, Engine),
+    nb_setarg(2, Engine, Eng).
 
 %!  engine_learner(+KB, -Learner) is det.
 %
 %   The learner KB's engine was configured with.
 
 engine_learner(KB, Learner) :-
-    run(KB, run(Learner, _, _, _, _, _, _, _)).
+    run(KB, run(Learner, _, _, _, _, _, _, _, _)).
 
 %!  engine_param(+KB, ?Name, ?Value) is nondet.
 %!  engine_param(+KB, +Name, -Value) is semidet.
@@ -138,7 +148,7 @@ engine_learner(KB, Learner) :-
 %   A parameter of KB's learner (alpha, gamma, epsilon, ...).
 
 engine_param(KB, Name, Value) :-
-    run(KB, run(_, Params, _, _, _, _, _, _)),
+    run(KB, run(_, Params, _, _, _, _, _, _, _)),
     (   atom(Name)
     ->  memberchk(Name=Value, Params)
     ;   member(Name=Value, Params)
@@ -149,7 +159,7 @@ engine_param(KB, Name, Value) :-
 %   The learner's parameters, Name=Value (what learners read in every step).
 
 engine_params(KB, Params) :-
-    run(KB, run(_, Params, _, _, _, _, _, _)).
+    run(KB, run(_, Params, _, _, _, _, _, _, _)).
 
 %!  engine_config(+KB, ?Key, ?Value) is nondet.
 %!  engine_config(+KB, +Key, -Value) is semidet.
@@ -160,7 +170,7 @@ engine_params(KB, Params) :-
 
 engine_config(KB, Key, Value) :-
     run(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
-                Necessities)),
+                Necessities, _)),
     (   Constraints == true
     ->  HasConstraints = true
     ;   HasConstraints = false
@@ -178,14 +188,14 @@ engine_config(KB, Key, Value) :-
 %   The responses in the order engine_step/6 indexes them.
 
 engine_responses(KB, Responses) :-
-    run(KB, run(_, _, _, Responses, _, _, _, _)).
+    run(KB, run(_, _, _, Responses, _, _, _, _, _)).
 
 %!  engine_necessities(+KB, -Necessities:list) is det.
 %
 %   The necessities in declaration order (the order of a step's unit outputs).
 
 engine_necessities(KB, Necessities) :-
-    run(KB, run(_, _, _, _, _, _, _, Necessities)).
+    run(KB, run(_, _, _, _, _, _, _, Necessities, _)).
 
 %!  engine_configure(+KB, +Learner, +Params:list, +Seed) is det.
 %
@@ -209,25 +219,33 @@ engine_configure(KB, Learner, Params, Seed) :-
     findall(S, kb_reinforcer(KB, S), Reinforcers),
     findall(N, kb_necessity(KB, N), Necessities),
     motivation_units(KB, Units),
-    (   domain_defines(KB, forbidden(_))
+    state_plan(KB, Features, Plan),
+    (   has_constraints(KB)
     ->  Constraints = true
     ;   findall(I, nth0(I, Responses, _), AllIx),     % no constraint rules: all allowed,
         foldl(set_bit, AllIx, 0, AllMask),            % always (computed once)
         Constraints = none(AllIx, AllMask)
     ),
-    run_key(KB, RunKey),
-    nb_setval(RunKey, run(Learner, Params, Features, Responses, Units, Reinforcers,
-                          Constraints, Necessities)),
     fresh_random(Seed, Random),
-    set_eng(KB, eng(none, Random)),
+    engine_key(KB, Key),
+    nb_setval(Key, engine(run(Learner, Params, Features, Responses, Units, Reinforcers,
+                              Constraints, Necessities, Plan),
+                          eng(none, Random))),
     wm_clear(KB),
     motivation_reset(KB),
     with_random(KB, learner_init(Learner, KB, Params)).
 
-domain_defines(KB, Head) :-
-    functor(Head, Name, Arity),
-    current_predicate(KB:Name/Arity),
-    \+ predicate_property(KB:Head, imported_from(_)).
+%   The domain has constraint rules: forbidden/1 has clauses, or may get them (dynamic).
+%   (relrl declares forbidden/1 in every knowledge base, so it always exists.)
+has_constraints(KB) :-
+    Head = forbidden(_),
+    current_predicate(KB:forbidden/1),
+    \+ predicate_property(KB:Head, imported_from(_)),
+    (   predicate_property(KB:Head, dynamic)
+    ->  true
+    ;   predicate_property(KB:Head, number_of_clauses(N)),
+        N > 0
+    ).
 
 fresh_random(Seed, Random) :-
     (   integer(Seed)
@@ -263,7 +281,7 @@ engine_reseed(KB, Seed) :-
 %   the necessity units start afresh.
 
 engine_end_episode(KB) :-
-    run(KB, run(Learner, _, _, _, _, _, _, _)),
+    run(KB, run(Learner, _, _, _, _, _, _, _, _)),
     eng(KB, eng(_, Random)),
     set_eng(KB, eng(none, Random)),
     wm_clear(KB),
@@ -278,13 +296,11 @@ engine_end_episode(KB) :-
 %   Forget KB's engine (its configuration, last step and random stream).
 
 engine_forget(KB) :-
-    run_key(KB, RunKey),
-    eng_key(KB, EngKey),
-    forall(member(K, [RunKey, EngKey]),
-           (   nb_current(K, _)
-           ->  nb_delete(K)
-           ;   true
-           )).
+    engine_key(KB, Key),
+    (   nb_current(Key, _)
+    ->  nb_delete(Key)
+    ;   true
+    ).
 
 %!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
 %
@@ -303,14 +319,14 @@ engine_forget(KB) :-
 %   Extras, a list of Key-Value pairs for Want.
 
 engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
-    run(KB, Run),
-    eng(KB, eng(Prev, Random0)),
+    engine(KB, Engine),
+    Engine = engine(Run, eng(Prev, Random0)),
     set_random(state(Random0)),
     step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
     random_property(state(Random)),
-    set_eng(KB, eng(Next, Random)).
+    nb_setarg(2, Engine, eng(Next, Random)).
 
-step(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints, _),
+step(KB, run(Learner, Params, _, Responses, Units, Reinforcers, Constraints, _, Plan),
      Prev, Percepts, EmittedIx, Mode, Want,
      step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
      prev(State, Active)) :-
@@ -319,13 +335,12 @@ step(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constrain
         wm_insert(KB, [emitted(Emitted)|Percepts])
     ;   wm_insert(KB, Percepts)
     ),
-    features_code(KB, Features, Code),
+    plan_code(KB, Plan, Reinforcers, Code, Reinforced),
     learner_view(Learner, KB, Code, State),
-    motivation_step(KB, Units, Outputs, Active),
-    pairs_values(Outputs, Ys),
-    (   reinforced(KB, Reinforcers)
-    ->  Reinforced = true, memberchk(reward_positive=Reward, Params)
-    ;   Reinforced = false, memberchk(reward_negative=Reward, Params)
+    motivation_values(KB, Units, _, Ys, Active),
+    (   Reinforced == true
+    ->  memberchk(reward_positive=Reward, Params)
+    ;   memberchk(reward_negative=Reward, Params)
     ),
     allowed(KB, Constraints, Responses, Allowed, AllowedMask),
     (   Mode == learn,
@@ -362,13 +377,6 @@ extra(KB, Learner, State, N, explain, [explain-E|T], T) :- !,
     explanation(KB, Learner, State, N, E).
 extra(_, _, _, _, What, _, _) :-
     domain_error(step_report, What).
-
-reinforced(KB, Reinforcers) :-
-    member(S, Reinforcers),
-    sense(Sense),
-    Percept =.. [Sense, S],
-    wm_now(KB, Percept),
-    !.
 
 allowed(KB, Constraints, Responses, Allowed, Mask) :-
     (   Constraints = none(_, AllMask)
@@ -423,11 +431,11 @@ engine_relational_state(KB, Facts) :-
 
 engine_explain(KB, When, Explanation) :-
     must_be(oneof([last, now]), When),
-    run(KB, run(Learner, _, Features, _, Units, _, _, _)),
+    run(KB, run(Learner, _, _, _, Units, _, _, _, Plan)),
     (   When == last,
         eng(KB, eng(prev(State, N), _))
     ->  true
-    ;   features_code(KB, Features, Code),
+    ;   plan_code(KB, Plan, Code),
         learner_view(Learner, KB, Code, State),
         motivation_peek(KB, Units, _, N)
     ),
@@ -544,7 +552,7 @@ slot_key(KB, Slot, Key) :-
 %   and renamed into place, so a reader never sees half a policy.
 
 engine_save(KB, File, Header) :-
-    run(KB, run(Learner, _, Features, Responses, _, _, _, _)),
+    run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
     atom_concat(File, '.tmp', Tmp),
     setup_call_cleanup(
         open(Tmp, write, S, [encoding(utf8)]),

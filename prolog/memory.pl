@@ -5,6 +5,7 @@
             wm_has_chk/2,         % +KB, ?Element
             wm_now/2,             % +KB, ?Element
             wm_has_stimulus/2,    % +KB, +Stimulus
+            wm_scan/5,            % +KB, +StimulusMasks, +Reinforcers, -Mask, -Reinforced
             wm_elements/2,        % +KB, -Pairs
             wm_clear/1,           % +KB
             wm_span/2,            % +KB, -Span
@@ -46,18 +47,17 @@ key(KB, Key) :-
     (   key_(KB, Key0)
     ->  Key = Key0
     ;   atom_concat('$relrl_wm:', KB, Key),
+        nb_setval(Key, wm(0, default, [])),
         assertz(key_(KB, Key))
     ).
 
 :- dynamic key_/2.                  % KB, the name of its global variable (made once)
 
+%   The variable exists from the moment its name is made (key/2), so reading it is one
+%   nb_getval/2: the perception predicates read memory many times a step.
 get(KB, State) :-
     (   key_(KB, Key)
-    ->  true
-    ;   key(KB, Key)
-    ),
-    (   nb_current(Key, State0)
-    ->  State = State0
+    ->  nb_getval(Key, State)
     ;   State = wm(0, default, [])
     ).
 
@@ -128,18 +128,18 @@ wm_insert(KB, New) :-
     ),
     Clock is Clock0 + 1,
     Oldest is Clock - Span,
-    stamp(New, Clock, Fresh),
+    stamp(New, Clock, Elements, Kept),
     keep_old(Old, New, Oldest, Kept),
-    append(Fresh, Kept, Elements),
     put(KB, wm(Clock, Span, Elements)).
 
-stamp([], _, []).
-stamp([E|Es], Clock, Out) :-
+%   The new elements stamped, in front of Tail.
+stamp([], _, Tail, Tail).
+stamp([E|Es], Clock, Out, Tail) :-
     (   memberchk(E, Es)                   % the same element twice in one insertion
     ->  Out = Out1
     ;   Out = [E-Clock|Out1]
     ),
-    stamp(Es, Clock, Out1).
+    stamp(Es, Clock, Out1, Tail).
 
 keep_old([], _, _, []).
 keep_old([E-S|Es], New, Oldest, Out) :-
@@ -207,6 +207,51 @@ sense_name(see).
 sense_name(hear).
 sense_name(smell).
 sense_name(at).
+
+%!  wm_scan(+KB, +StimulusMasks:list, +Reinforcers:list, -Mask, -Reinforced) is det.
+%
+%   One pass over KB's memory for the control step. Mask is the bitwise or of the masks of
+%   the stimuli perceived (StimulusMasks lists Stimulus-Mask pairs of ground stimuli; a
+%   stimulus is perceived as in wm_has_stimulus/2). Reinforced is `true` when a stimulus
+%   of Reinforcers is sensed now (a Sense(S) percept of age 0, Sense one of see, hear,
+%   smell, at), else `false`.
+
+wm_scan(KB, Masks, Reinforcers, Mask, Reinforced) :-
+    get(KB, wm(Clock, _, Elements)),
+    scan(Elements, Clock, Masks, Reinforcers, 0, Mask, false, Reinforced).
+
+scan([], _, _, _, Mask, Mask, R, R).
+scan([E-Stamp|Es], Clock, Masks, Rs, Mask0, Mask, R0, R) :-
+    (   compound(E),
+        scanned_stimulus(E, S, Sensed)
+    ->  (   memberchk(S-M, Masks)
+        ->  Mask1 is Mask0 \/ M
+        ;   Mask1 = Mask0
+        ),
+        (   R0 == false,
+            Sensed == true,
+            Stamp =:= Clock,
+            \+ \+ memberchk(S, Rs)
+        ->  R1 = true
+        ;   R1 = R0
+        )
+    ;   Mask1 = Mask0,
+        R1 = R0
+    ),
+    scan(Es, Clock, Masks, Rs, Mask1, Mask, R1, R).
+
+%   The stimulus an element perceives, and whether it is a sense percept Sense(S).
+scanned_stimulus(E, S, Sensed) :-
+    compound_name_arity(E, Name, Arity),
+    (   Arity =:= 1
+    ->  sense_name(Name),
+        arg(1, E, S),
+        Sensed = true
+    ;   Arity =:= 2,
+        Name == at,
+        arg(1, E, S),
+        Sensed = false
+    ).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
 %

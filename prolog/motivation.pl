@@ -4,6 +4,7 @@
             motivation_units/2,     % +KB, -Units
             motivation_step/4,      % +KB, +Units, -Outputs, -Active
             motivation_peek/4,      % +KB, +Units, -Outputs, -Active
+            motivation_values/5,    % +KB, +Units, -Outputs, -Ys, -Active
             motivation_outputs/2,   % +KB, -Outputs
             motivation_set_outputs/2, % +KB, +Outputs
             unit_activation/5,      % +Inputs, +Wr, +Ir, +Bias, -U
@@ -134,9 +135,21 @@ motivation_units(KB, Units) :-
 %   As motivation_step/3 with the units from motivation_units/2.
 
 motivation_step(KB, Units, Outputs, Active) :-
-    get_outputs(KB, Previous),
-    maplist(unit_value(KB, Previous), Units, Outputs),
-    put_outputs(KB, Outputs),
+    motivation_values(KB, Units, Outputs, _, Active).
+
+%!  motivation_values(+KB, +Units, -Outputs:list, -Ys:list, -Active) is det.
+%
+%   motivation_step/4 that also gives the outputs alone, Ys (in declaration order): the
+%   control step's one pass over the units.
+
+motivation_values(KB, Units, Outputs, Ys, Active) :-
+    outputs_key(KB, Key),
+    (   nb_current(Key, Previous)
+    ->  true
+    ;   Previous = []
+    ),
+    unit_values(Units, KB, Previous, Outputs, Ys),
+    nb_setval(Key, Outputs),
     mediate(Units, Outputs, Active).
 
 %!  motivation_peek(+KB, +Units, -Outputs, -Active) is det.
@@ -145,32 +158,45 @@ motivation_step(KB, Units, Outputs, Active) :-
 
 motivation_peek(KB, Units, Outputs, Active) :-
     get_outputs(KB, Previous),
-    maplist(unit_value(KB, Previous), Units, Outputs),
+    unit_values(Units, KB, Previous, Outputs, _),
     mediate(Units, Outputs, Active).
 
-unit_value(KB, Previous, unit(N, B, Wr, Delta, _, Y0, Goals), N-Y) :-
+%   Eq. 1 and 2 for every unit; Ir, the recurrent input, is the unit's previous output.
+unit_values([], _, _, [], []).
+unit_values([unit(N, B, Wr, Delta, _, Y0, Goals)|Us], KB, Previous, [N-Y|Os], [Y|Ys]) :-
     (   memberchk(N-Ir, Previous)
     ->  true
     ;   Ir = Y0
     ),
-    maplist(input_signal(KB), Goals, Inputs),
-    unit_activation(Inputs, Wr, Ir, B, U),
-    unit_output(U, Delta, Y).
+    inputs_sum(Goals, KB, 0, Sum),
+    U is Sum + Wr*Ir + B,
+    Y is 1 / (1 + exp(-(U + Delta))),
+    unit_values(Us, KB, Previous, Os, Ys).
 
-input_signal(KB, Goal-W, W-I) :-
+%   sum_j w_j * i_j, i_j 1 when the j-th input goal holds: unit_activation/5's sum, term by
+%   term (the same floating-point operations in the same order).
+inputs_sum([], _, Sum, Sum).
+inputs_sum([Goal-W|Gs], KB, Sum0, Sum) :-
     (   rule_holds(KB, Goal)
     ->  I = 1
     ;   I = 0
-    ).
+    ),
+    Sum1 is Sum0 + W*I,
+    inputs_sum(Gs, KB, Sum1, Sum).
 
 mediate(_, [], none) :- !.
 mediate(Units, Outputs, Active) :-
-    foldl(stronger, Outputs, none-(-1.0), Best-Y),
+    strongest(Outputs, none, -1.0, Best, Y),
     memberchk(unit(Best, _, _, _, T, _, _), Units),
     (   Y > T
     ->  Active = Best
     ;   Active = none
     ).
 
-stronger(N-Y, _-Y0, N-Y) :- Y > Y0, !.
-stronger(_, Best, Best).
+%   The first unit with the largest output.
+strongest([], Best, Y, Best, Y).
+strongest([N-Y|Os], Best0, Y0, Best, YBest) :-
+    (   Y > Y0
+    ->  strongest(Os, N, Y, Best, YBest)
+    ;   strongest(Os, Best0, Y0, Best, YBest)
+    ).

@@ -5,6 +5,9 @@
             state_terms/2,        % +KB, -Terms
             state_code/2,         % +KB, -Code
             features_code/3,      % +KB, +Features, -Code
+            state_plan/3,         % +KB, +Features, -Plan
+            plan_code/3,          % +KB, +Plan, -Code
+            plan_code/5,          % +KB, +Plan, +Reinforcers, -Code, -Reinforced
             state_decode/3,       % +KB, +Code, -Terms
             state_encode/3        % +KB, +Terms, -Code
           ]).
@@ -14,6 +17,7 @@
 :- use_module(declarations).
 :- use_module(perception).
 :- use_module(rules).
+:- use_module(memory).
 
 /** <module> The state code
 
@@ -93,6 +97,76 @@ active(stimulus(S), KB) :-
     stimulus_perceived(KB, S).
 active(fact(F), KB) :-
     rule_holds(KB, F).
+
+%!  state_plan(+KB, +Features:list, -Plan) is det.
+%
+%   Plan computes the code of Features (a list from state_features/2) with plan_code/3:
+%   the same code as features_code/3, for less work. The stimuli are read off working
+%   memory in one pass (memory elements indexed to the stimuli's bits: a stimulus holds
+%   when perceived, whatever rules say); each fact is still its goal, run by its rules
+%   through rule_holds/2 (errors and time limits propagate as there).
+
+state_plan(KB, Features, plan(Masks, Facts)) :-
+    must_be(atom, KB),
+    must_be(list, Features),
+    plan_(Features, 1, Masks0, Facts),
+    stimulus_masks(Masks0, Masks).
+
+plan_([], _, [], []).
+plan_([F|Fs], Bit, Masks, Facts) :-
+    (   F = stimulus(S)
+    ->  Masks = [S-Bit|Masks1], Facts = Facts1
+    ;   F = fact(G)
+    ->  Masks = Masks1, Facts = [G-Bit|Facts1]
+    ;   domain_error(feature, F)
+    ),
+    Bit1 is Bit << 1,
+    plan_(Fs, Bit1, Masks1, Facts1).
+
+%   One Stimulus-Mask pair per ground stimulus (a stimulus declared twice owns both bits);
+%   a stimulus that is not ground is never perceived (stimulus_perceived/2 compares with
+%   ==), so it has no entry.
+stimulus_masks(Pairs, Masks) :-
+    include(ground, Pairs, Ground),
+    msort(Ground, Sorted),
+    merge_masks(Sorted, Masks).
+
+merge_masks([], []).
+merge_masks([S-B|Ps], Masks) :-
+    (   Ps = [S1-B1|Ps1], S1 == S
+    ->  B2 is B \/ B1,
+        merge_masks([S-B2|Ps1], Masks)
+    ;   Masks = [S-B|Masks1],
+        merge_masks(Ps, Masks1)
+    ).
+
+%!  plan_code(+KB, +Plan, -Code:integer) is det.
+%
+%   Code is the state code now, by a plan from state_plan/3.
+
+plan_code(KB, plan(Masks, Facts), Code) :-
+    (   Masks == []
+    ->  Code0 = 0
+    ;   wm_scan(KB, Masks, [], Code0, _)
+    ),
+    facts_code(Facts, KB, Code0, Code).
+
+%!  plan_code(+KB, +Plan, +Reinforcers:list, -Code, -Reinforced) is det.
+%
+%   plan_code/3, and Reinforced (true or false) as wm_scan/5 gives it for Reinforcers, from
+%   the same pass over working memory.
+
+plan_code(KB, plan(Masks, Facts), Reinforcers, Code, Reinforced) :-
+    wm_scan(KB, Masks, Reinforcers, Code0, Reinforced),
+    facts_code(Facts, KB, Code0, Code).
+
+facts_code([], _, Code, Code).
+facts_code([G-Bit|Fs], KB, Code0, Code) :-
+    (   rule_holds(KB, G)
+    ->  Code1 is Code0 \/ Bit
+    ;   Code1 = Code0
+    ),
+    facts_code(Fs, KB, Code1, Code).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %
