@@ -34,6 +34,7 @@
 :- use_module(state).
 :- use_module(motivation).
 :- use_module(rules).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The control step, inside Prolog
 

@@ -13,6 +13,7 @@
 :- use_module(engine).
 :- use_module(declarations).
 :- use_module(rules).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Economic TG (ETG)
 
@@ -59,18 +60,28 @@ etg_init(KB, Tests) :-
 
 etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
     Allowed \== [],
-    leaf_entries(KB, D, Entries),
     param(Params, q_init, Q0),
     param(Params, epsilon, Epsilon),
+    choose(KB, D, N, Allowed, Q0, Epsilon, Action, Q).
+
+choose(KB, D, N, Allowed, Q0, Epsilon, Action, Q) :-
+    leaf_entries(KB, D, Entries),
     Allowed = [A1|As],
     entry_q(Entries, A1, N, Q0, Q1),
     scores(As, Entries, N, Q0, Scored1, Q1, Best),
     Scored = [Q1-A1|Scored1],
     (   random_float < Epsilon
-    ->  random_member(Q-Action, Scored)
+    ->  random_element(Scored, Q-Action)
     ;   ties(Scored, Best, Ties),
-        random_member(Q-Action, Ties)
+        random_element(Ties, Q-Action)
     ).
+
+%   random_member/2 of library(random) for a list known to be proper and non-empty: the
+%   same draw (random(Length)).
+random_element(List, X) :-
+    length(List, Len),
+    I is random(Len),
+    nth0(I, List, X).
 
 %   Q of each allowed action (in order), and the largest.
 scores([], _, _, _, [], Best, Best).
@@ -115,6 +126,9 @@ etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params) :-
     param(Params, gamma, Gamma),
     param(Params, q_init, Qinit),
     param(Params, split_threshold, Threshold),
+    update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold).
+
+update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold) :-
     leaf_entries(KB, D1, Next),
     max_q(Next, N1, Allowed1, Qinit, MaxNext),
     Target is R + Gamma * MaxNext,
@@ -197,22 +211,42 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   order, then its etg_test/1 goals. A state's description is its code with a bit for each
 %   extra test above the features' bits.
 
-tests_key(KB, Key) :- atom_concat('$relrl_etg:', KB, Key).
+%   What the hooks read every step, in a global variable per KB (its name made once):
+%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra, and Numbers =
+%   numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or `params` when
+%   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
+
+config_key(KB, Key) :-
+    (   config_key_(KB, Key0)
+    ->  Key = Key0
+    ;   atom_concat('$relrl_etg:', KB, Key),
+        assertz(config_key_(KB, Key))
+    ).
+
+:- dynamic config_key_/2.
+
+config(KB, Config) :-
+    config_key(KB, Key),
+    nb_getval(Key, Config).
 
 relrl_engine:learner(etg).
 
-relrl_engine:learner_init(etg, KB, _Params) :-
+relrl_engine:learner_init(etg, KB, Params) :-
     engine_config(KB, features, Features),
     findall(G, declared(KB, etg_test(G)), Extra),
     length(Features, NF),
-    tests_key(KB, Key),
-    nb_setval(Key, extra(NF, Extra)),
+    (   maplist(param(Params), [alpha, gamma, epsilon, q_init, split_threshold],
+                [Alpha, Gamma, Epsilon, Qinit, Threshold])
+    ->  Numbers = numbers(Alpha, Gamma, Epsilon, Qinit, Threshold)
+    ;   Numbers = params
+    ),
+    config_key(KB, Key),
+    nb_setval(Key, etg(NF, Extra, Numbers)),
     append(Features, Extra, Tests),
     etg_init(KB, Tests).
 
 relrl_engine:learner_state(etg, KB, Code, D) :-
-    tests_key(KB, Key),
-    nb_getval(Key, extra(NF, Extra)),
+    config(KB, etg(NF, Extra, _)),
     (   Extra == []
     ->  D = Code
     ;   foldl(extra_bit(KB), Extra, NF-Code, _-D)
@@ -226,16 +260,29 @@ extra_bit(KB, Goal, I-D0, I1-D) :-
     ).
 
 relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
-    engine_params(KB, Params0),
-    (   Mode == greedy
-    ->  Params = [epsilon=0|Params0]
-    ;   Params = Params0
-    ),
-    etg_choose(KB, D, N, Allowed, Params, Action, _).
+    config(KB, etg(_, _, Numbers)),
+    (   Numbers = numbers(_, _, Epsilon0, Qinit, _)
+    ->  Allowed \== [],
+        (   Mode == greedy
+        ->  Epsilon = 0
+        ;   Epsilon = Epsilon0
+        ),
+        choose(KB, D, N, Allowed, Qinit, Epsilon, Action, _)
+    ;   engine_params(KB, Params0),
+        (   Mode == greedy
+        ->  Params = [epsilon=0|Params0]
+        ;   Params = Params0
+        ),
+        etg_choose(KB, D, N, Allowed, Params, Action, _)
+    ).
 
 relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, R, _, D1, N1, Allowed1)) :-
-    engine_params(KB, Params),
-    etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params).
+    config(KB, etg(_, _, Numbers)),
+    (   Numbers = numbers(Alpha, Gamma, _, Qinit, Threshold)
+    ->  update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold)
+    ;   engine_params(KB, Params),
+        etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params)
+    ).
 
 relrl_engine:learner_explain(etg, KB, D, N, etg(Path, Ranked)) :-
     etg_explain(KB, D, N, explain(Path, Ranked)).

@@ -36,6 +36,7 @@ argument of every predicate names it. This module is the only one that stores pe
 */
 
 :- use_module(library(pairs)).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 %   The memory of knowledge base KB is one term, wm(Clock, Span, Elements), in a global
 %   variable (b/nb_setval) named after KB: Clock counts insertions, Span is the expiry age

@@ -15,6 +15,7 @@
 :- use_module(library(apply)).
 :- use_module(declarations).
 :- use_module(rules).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Consequence control: necessity units and the mediator
 

@@ -22,6 +22,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Relational Q-trees
 
@@ -37,14 +38,78 @@ test i held when the state was perceived. The tests were run as Prolog goals aga
 memory at that moment (relrl_engine), so a state can still be sorted after memory has moved
 on (to update the previous step's example).
 
-Nodes are node_(Tree, Id, Node) facts with Node = test(Index, Goal, Yes, No) or
-leaf(Rep, Entries); Rep is `none` until the first example arrives. Id 0 is the root.
+A node is test(Index, Goal, Yes, No) or leaf(Rep, Entries); Rep is `none` until the first
+example arrives. Id 0 is the root.
+
+A tree is one term in a global variable (named after the tree), qtree(Tests, Next, Nodes):
+Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument Id+1
+holds node Id (`free` beyond the last). The control step reads nodes in place (arg/3, no
+copy: sorting a state down the tree is a few argument look-ups) and replaces a leaf in place
+(nb_setarg/3, which copies only that leaf); a full Nodes is copied into one twice its size.
+What this module gives to callers that may bind variables (qtree_node/3, qtree_tests/2, the
+goals of qtree_path/3) is a copy (copy_term/2 shares ground parts).
 */
 
-:- dynamic
-    node_/3,        % Tree, Id, Node
-    next_id_/2,     % Tree, NextId
-    tests_/2.       % Tree, Tests
+%   The name of Tree's global variable (made once per tree).
+tree_key(Tree, Key) :-
+    (   tree_key_(Tree, Key0)
+    ->  Key = Key0
+    ;   must_be(atom, Tree),
+        atom_concat('$relrl_qtree:', Tree, Key),
+        assertz(tree_key_(Tree, Key))
+    ).
+
+:- dynamic tree_key_/2.
+
+%   Tree's term; fails when Tree was never made (or was cleared).
+tree(Tree, T) :-
+    tree_key(Tree, Key),
+    nb_current(Key, T0),
+    T0 = qtree(_, _, _),
+    T = T0.
+
+%   Tree's term; an existence error when there is none.
+the_tree(Tree, T) :-
+    (   tree(Tree, T0)
+    ->  T = T0
+    ;   existence_error(qtree, Tree)
+    ).
+
+node(Nodes, Id, Node) :-
+    I is Id + 1,
+    arg(I, Nodes, Node).
+
+%   Node Id of T, which must exist.
+existing_node(T, Tree, Id, Node) :-
+    T = qtree(_, Next, Nodes),
+    (   integer(Id), Id >= 0, Id < Next
+    ->  node(Nodes, Id, Node)
+    ;   existence_error(qtree_node, Tree-Id)
+    ).
+
+set_node(T, Id, Node) :-
+    arg(3, T, Nodes),
+    I is Id + 1,
+    nb_setarg(I, Nodes, Node).
+
+%   A new node id in T (Nodes grows when full).
+new_id(T, Id) :-
+    T = qtree(_, Id, Nodes),
+    Next is Id + 1,
+    functor(Nodes, _, Capacity),
+    (   Next =< Capacity
+    ->  true
+    ;   Bigger is 2 * Capacity,
+        nodes_term(Bigger, Nodes1),
+        forall(between(1, Capacity, I),
+               ( arg(I, Nodes, Node), nb_setarg(I, Nodes1, Node) )),
+        nb_setarg(3, T, Nodes1)
+    ),
+    nb_setarg(2, T, Next).
+
+nodes_term(Capacity, Nodes) :-
+    functor(Nodes, nodes, Capacity),
+    forall(between(1, Capacity, I), nb_setarg(I, Nodes, free)).
 
 %!  qtree_new(+Tree, +Tests:list) is det.
 %
@@ -52,16 +117,14 @@ leaf(Rep, Entries); Rep is `none` until the first example arrives. Id 0 is the r
 
 qtree_new(Tree, Tests) :-
     must_be(list, Tests),
-    qtree_clear(Tree),
-    assertz(tests_(Tree, Tests)),
-    assertz(node_(Tree, 0, leaf(none, []))),
-    assertz(next_id_(Tree, 1)).
+    qtree_restore_(Tree, Tests, [0-leaf(none, [])], 1).
 
 %!  qtree_restore(+Tree, +Tests, +Nodes:list) is det.
 %
 %   Make Tree the tree given by Nodes, a list of Id-Node pairs as saved by the engine.
 %
 %   @error domain_error(qtree, Nodes) if there is no root (Id 0).
+%   @error domain_error(qtree_node_id, Id) if two nodes have the same Id.
 
 qtree_restore(Tree, Tests, Nodes) :-
     must_be(list, Nodes),
@@ -69,12 +132,22 @@ qtree_restore(Tree, Tests, Nodes) :-
     ->  true
     ;   domain_error(qtree, Nodes)
     ),
-    qtree_clear(Tree),
-    assertz(tests_(Tree, Tests)),
-    forall(member(Id-Node, Nodes), assertz(node_(Tree, Id, Node))),
     aggregate_all(max(Id), member(Id-_, Nodes), Max),
     Next is Max + 1,
-    assertz(next_id_(Tree, Next)).
+    qtree_restore_(Tree, Tests, Nodes, Next).
+
+qtree_restore_(Tree, Tests, Nodes, Next) :-
+    must_be(atom, Tree),
+    Capacity is max(16, Next),
+    nodes_term(Capacity, Term),
+    forall(member(Id-Node, Nodes),
+           (   node(Term, Id, free)
+           ->  I is Id + 1,
+               nb_setarg(I, Term, Node)
+           ;   domain_error(qtree_node_id, Id)
+           )),
+    tree_key(Tree, Key),
+    nb_setval(Key, qtree(Tests, Next, Term)).
 
 %!  qtree_clear(+Tree) is det.
 %
@@ -82,24 +155,27 @@ qtree_restore(Tree, Tests, Nodes) :-
 
 qtree_clear(Tree) :-
     must_be(atom, Tree),
-    memo_key(Tree, Key),
-    nb_setval(Key, none),
-    retractall(node_(Tree, _, _)),
-    retractall(next_id_(Tree, _)),
-    retractall(tests_(Tree, _)).
+    tree_key(Tree, Key),
+    nb_setval(Key, none).
 
 %!  qtree_tests(+Tree, -Tests:list) is det.
 
 qtree_tests(Tree, Tests) :-
-    tests_(Tree, Tests).
+    tree(Tree, qtree(Tests0, _, _)),
+    copy_term(Tests0, Tests).
 
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
+    tree(Tree, qtree(_, Next, Nodes)),
     (   integer(Id)
-    ->  once(node_(Tree, Id, Node))
-    ;   node_(Tree, Id, Node)
-    ).
+    ->  Id >= 0, Id < Next
+    ;   Last is Next - 1,
+        between(0, Last, Id)
+    ),
+    node(Nodes, Id, Node0),
+    Node0 \== free,
+    copy_term(Node0, Node).
 
 %!  test_holds(+Description, +Index) is semidet.
 
@@ -119,46 +195,31 @@ first_difference(D1, D2, Index) :-
 %
 %   Sort a state down Tree. Where is leaf(Id), or null(Parent, Branch) when the state
 %   reaches an empty branch (Branch is yes or no).
+%
+%   @error existence_error(qtree, Tree) if there is no such tree.
 
 qtree_sort(Tree, D, Where) :-
-    memo_key(Tree, Key),
-    next_id_(Tree, Version),
-    (   nb_current(Key, memo(Version, D1-W1, D2-W2))
-    ->  (   D1 =:= D
-        ->  Where = W1
-        ;   D2 =:= D
-        ->  Where = W2
-        ;   sort_from(Tree, 0, D, Where),
-            nb_setval(Key, memo(Version, D-Where, D1-W1))
-        )
-    ;   sort_from(Tree, 0, D, Where),
-        nb_setval(Key, memo(Version, D-Where, -1-none))
-    ).
+    the_tree(Tree, qtree(_, _, Nodes)),
+    arg(1, Nodes, Root),
+    sort_from(Root, 0, Nodes, D, Where).
 
-%   The last two states sorted and where they went, valid while the tree's shape is the
-%   same (every grow or split takes a new node id, so the next id is the shape's version):
-%   the control step sorts each state twice (to choose, then to learn from it).
-memo_key(Tree, Key) :-
-    (   memo_key_(Tree, Key0)
-    ->  Key = Key0
-    ;   atom_concat('$relrl_qsort:', Tree, Key),
-        assertz(memo_key_(Tree, Key))
+sort_from(test(I, _, Yes, No), Id, Nodes, D, Where) :-
+    !,
+    (   D /\ (1 << I) =\= 0
+    ->  down(Yes, yes, Id, Nodes, D, Where)
+    ;   down(No, no, Id, Nodes, D, Where)
     ).
+sort_from(_, Id, _, _, leaf(Id)).
 
-:- dynamic memo_key_/2.
-
-sort_from(Tree, Id, D, Where) :-
-    (   step_down(Tree, Id, D, _, Branch, Next)
-    ->  (   Next == nil
-        ->  Where = null(Id, Branch)
-        ;   sort_from(Tree, Next, D, Where)
-        )
-    ;   Where = leaf(Id)
-    ).
+down(nil, Branch, Id, _, _, null(Id, Branch)) :- !.
+down(Next, _, _, Nodes, D, Where) :-
+    I is Next + 1,
+    arg(I, Nodes, Node),
+    sort_from(Node, Next, Nodes, D, Where).
 
 %   Id is a test node; the state described by D takes its Branch (yes or no) to Next.
-step_down(Tree, Id, D, Goal, Branch, Next) :-
-    once(node_(Tree, Id, test(I, Goal, Yes, No))),
+step_down(Nodes, Id, D, Goal, Branch, Next) :-
+    node(Nodes, Id, test(I, Goal, Yes, No)),
     (   test_holds(D, I)
     ->  Branch = yes, Next = Yes
     ;   Branch = no, Next = No
@@ -170,40 +231,47 @@ step_down(Tree, Id, D, Goal, Branch, Next) :-
 %   ends, followed by leaf(Id) or null.
 
 qtree_path(Tree, D, Path) :-
-    path_from(Tree, 0, D, Path).
+    the_tree(Tree, qtree(_, _, Nodes)),
+    path_from(Nodes, 0, D, Path0),
+    copy_term(Path0, Path).
 
-path_from(Tree, Id, D, Path) :-
-    (   step_down(Tree, Id, D, Goal, Branch, Next)
+path_from(Nodes, Id, D, Path) :-
+    (   step_down(Nodes, Id, D, Goal, Branch, Next)
     ->  ( Branch == yes -> Outcome = true ; Outcome = false ),
         Path = [Goal-Outcome|Rest],
         (   Next == nil
         ->  Rest = [null]
-        ;   path_from(Tree, Next, D, Rest)
+        ;   path_from(Nodes, Next, D, Rest)
         )
     ;   Path = [leaf(Id)]
     ).
 
 %!  qtree_leaf(+Tree, ?Id, -Rep, -Entries) is nondet.
+%
+%   Leaf Id of Tree. With Id given, Rep and Entries are the tree's own (not copied: the
+%   control step reads them every time unit); they are ground.
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
     (   integer(Id)
-    ->  once(node_(Tree, Id, leaf(Rep, Entries)))
-    ;   node_(Tree, Id, leaf(Rep, Entries))
+    ->  tree(Tree, T),
+        T = qtree(_, Next, Nodes),
+        Id >= 0, Id < Next,
+        node(Nodes, Id, leaf(Rep, Entries))
+    ;   qtree_node(Tree, Id, leaf(Rep, Entries))
     ).
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.
+%
+%   @error existence_error(qtree_leaf, Tree-Id) if node Id is not a leaf.
 
 qtree_set_leaf(Tree, Id, Rep, Entries) :-
-    retract(node_(Tree, Id, leaf(_, _))),
-    !,
-    assertz(node_(Tree, Id, leaf(Rep, Entries))).
-qtree_set_leaf(Tree, Id, _, _) :-
-    existence_error(qtree_leaf, Tree-Id).
-
-new_id(Tree, Id) :-
-    once(retract(next_id_(Tree, Id))),
-    Id1 is Id + 1,
-    assertz(next_id_(Tree, Id1)).
+    (   tree(Tree, T),
+        T = qtree(_, Next, Nodes),
+        integer(Id), Id >= 0, Id < Next,
+        node(Nodes, Id, leaf(_, _))
+    ->  set_node(T, Id, leaf(Rep, Entries))
+    ;   existence_error(qtree_leaf, Tree-Id)
+    ).
 
 %!  qtree_grow(+Tree, +Parent, +Branch, +Rep, +Entries, -Id) is det.
 %
@@ -211,14 +279,23 @@ new_id(Tree, Id) :-
 
 qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
     must_be(oneof([yes, no]), Branch),
-    once(retract(node_(Tree, Parent, test(I, Goal, Yes, No)))),
-    new_id(Tree, Id),
-    (   Branch == yes
-    ->  must_be(oneof([nil]), Yes), Node = test(I, Goal, Id, No)
-    ;   must_be(oneof([nil]), No), Node = test(I, Goal, Yes, Id)
+    the_tree(Tree, T),
+    existing_node(T, Tree, Parent, Node0),
+    (   Node0 = test(I, Goal, Yes, No)
+    ->  true
+    ;   domain_error(qtree_test_node, Parent)
     ),
-    assertz(node_(Tree, Parent, Node)),
-    assertz(node_(Tree, Id, leaf(Rep, Entries))).
+    (   Branch == yes
+    ->  must_be(oneof([nil]), Yes)
+    ;   must_be(oneof([nil]), No)
+    ),
+    new_id(T, Id),
+    (   Branch == yes
+    ->  Node = test(I, Goal, Id, No)
+    ;   Node = test(I, Goal, Yes, Id)
+    ),
+    set_node(T, Parent, Node),
+    set_node(T, Id, leaf(Rep, Entries)).
 
 %!  qtree_split(+Tree, +LeafId, +TestIndex) is det.
 %
@@ -226,16 +303,21 @@ qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
 %   representative takes; the other branch is empty (nil).
 
 qtree_split(Tree, LeafId, I) :-
-    once(retract(node_(Tree, LeafId, leaf(Rep, Entries)))),
-    tests_(Tree, Tests),
+    the_tree(Tree, T),
+    existing_node(T, Tree, LeafId, Leaf),
+    (   Leaf = leaf(Rep, Entries)
+    ->  true
+    ;   existence_error(qtree_leaf, Tree-LeafId)
+    ),
+    T = qtree(Tests, _, _),
     nth0(I, Tests, Goal),
-    new_id(Tree, Id),
+    new_id(T, Id),
     (   test_holds(Rep, I)
     ->  Node = test(I, Goal, Id, nil)
     ;   Node = test(I, Goal, nil, Id)
     ),
-    assertz(node_(Tree, LeafId, Node)),
-    assertz(node_(Tree, Id, leaf(Rep, Entries))).
+    set_node(T, LeafId, Node),
+    set_node(T, Id, leaf(Rep, Entries)).
 
 %!  qtree_size(+Tree, -Nodes, -Leaves, -Entries) is det.
 %
@@ -243,9 +325,9 @@ qtree_split(Tree, LeafId, I) :-
 %   entries. The paper's memory in "positions" is Nodes + Entries.
 
 qtree_size(Tree, Nodes, Leaves, Entries) :-
-    aggregate_all(count, node_(Tree, _, _), Nodes),
-    aggregate_all(count, node_(Tree, _, leaf(_, _)), Leaves),
-    aggregate_all(sum(L), ( node_(Tree, _, leaf(_, Es)), length(Es, L) ), Entries).
+    aggregate_all(count, qtree_node(Tree, _, _), Nodes),
+    aggregate_all(count, qtree_node(Tree, _, leaf(_, _)), Leaves),
+    aggregate_all(sum(L), ( qtree_node(Tree, _, leaf(_, Es)), length(Es, L) ), Entries).
 
 %!  qtree_put_entry(+Entries0, +Entry, -Entries) is det.
 %
@@ -253,21 +335,30 @@ qtree_size(Tree, Nodes, Leaves, Entries) :-
 %   decreasing Q (ties keep their order).
 
 qtree_put_entry(Entries0, e(A, Q, N), Entries) :-
-    exclude(same_key(A, N), Entries0, Entries1),
-    insert_by_q(Entries1, e(A, Q, N), Entries).
+    put_entry(Entries0, A, Q, N, Entries).
 
-same_key(A, N, e(A1, _, N1)) :-
-    A1 == A, N1 == N.
-
-insert_by_q([], E, [E]).
-insert_by_q([E0|Es], E, Out) :-
-    E = e(_, Q, _),
-    E0 = e(_, Q0, _),
-    (   Q > Q0
-    ->  Out = [E, E0|Es]
+%   One pass: the entry for (A, N) left out, e(A, Q, N) put before the first remaining
+%   entry of smaller Q.
+put_entry([], A, Q, N, [e(A, Q, N)]).
+put_entry([E0|Es], A, Q, N, Out) :-
+    E0 = e(A0, Q0, N0),
+    (   A0 == A, N0 == N
+    ->  put_entry(Es, A, Q, N, Out)
+    ;   Q > Q0
+    ->  Out = [e(A, Q, N), E0|Rest],
+        drop_key(Es, A, N, Rest)
     ;   Out = [E0|Out1],
-        insert_by_q(Es, E, Out1)
+        put_entry(Es, A, Q, N, Out1)
     ).
+
+drop_key([], _, _, []).
+drop_key([E0|Es], A, N, Out) :-
+    E0 = e(A0, _, N0),
+    (   A0 == A, N0 == N
+    ->  Out = Out1
+    ;   Out = [E0|Out1]
+    ),
+    drop_key(Es, A, N, Out1).
 
 %!  qtree_entry_q(+Entries, +Action, +Necessity, +Default, -Q) is det.
 
@@ -286,7 +377,7 @@ qtree_format(Tree, Text) :-
     with_output_to(string(Text), format_node(Tree, 0, "", "")).
 
 format_node(Tree, Id, Indent, Label) :-
-    node_(Tree, Id, Node),
+    qtree_node(Tree, Id, Node),
     (   Node = test(_, Goal, Yes, No)
     ->  format("~w~w[~d] ~q ?~n", [Indent, Label, Id, Goal]),
         string_concat(Indent, "    ", Deeper),
@@ -316,20 +407,20 @@ qtree_graph(Tree, graph(Nodes, Edges)) :-
     findall(E, graph_edge(Tree, E), Edges).
 
 graph_node(Tree, node(Id, test, Label)) :-
-    node_(Tree, Id, test(_, Goal, _, _)),
+    qtree_node(Tree, Id, test(_, Goal, _, _)),
     format(string(Label), "~q", [Goal]).
 graph_node(Tree, node(Id, leaf, Label)) :-
-    node_(Tree, Id, leaf(_, Entries)),
+    qtree_node(Tree, Id, leaf(_, Entries)),
     findall(L, ( member(e(A, Q, N), Entries),
                  format(string(L), "~q ~2f [~q]", [A, Q, N]) ), Lines),
     atomic_list_concat(Lines, '\n', Atom),
     atom_string(Atom, Label).
 graph_node(Tree, node(nil(Id, Branch), null, "null")) :-
-    node_(Tree, Id, test(_, _, Yes, No)),
+    qtree_node(Tree, Id, test(_, _, Yes, No)),
     member(Branch-nil, [yes-Yes, no-No]).
 
 graph_edge(Tree, edge(Id, To, Branch)) :-
-    node_(Tree, Id, test(_, _, Yes, No)),
+    qtree_node(Tree, Id, test(_, _, Yes, No)),
     member(Branch-Child, [yes-Yes, no-No]),
     (   Child == nil
     ->  To = nil(Id, Branch)

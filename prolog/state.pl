@@ -18,6 +18,7 @@
 :- use_module(perception).
 :- use_module(rules).
 :- use_module(memory).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The state code
 

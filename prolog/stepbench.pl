@@ -1,5 +1,5 @@
 :- module(relrl_stepbench,
-          [ stepbench_read/2,     % +File, -Recording
+          [ stepbench_load/2,     % +File, -Recording
             stepbench_replay/3,   % +Recording, +Options, -Figures
             stepbench_main/0
           ]).
@@ -40,33 +40,41 @@ time and its calls per step.
 prints the figures as one JSON object (relrl bench --prolog-step runs it).
 */
 
-%!  stepbench_read(+File, -Recording) is det.
+%!  stepbench_load(+File, -Recording) is det.
 %
-%   Read a recording, as data (nothing in it is run). Recording is
-%   recording(Domain, Learner, Params, Seed, Warmup, Events), Events a list of
-%   s(Percepts, Emitted, Mode, Expected) and end_episode in order.
+%   Read a recording, as data (nothing in it is run), and keep its events in this module's
+%   database (as Python's gateway keeps recurring percept lists: a step copies its terms
+%   onto the stacks, and the recording is no live data for the garbage collector).
+%   Recording is recording(Domain, Learner, Params, Seed, Warmup, Events), Events the
+%   number of events: s(Percepts, Emitted, Mode, Expected) terms and end_episode.
 %
 %   @error domain_error(stepbench_term, T) for a term that is not part of a recording.
 
-stepbench_read(File, recording(Domain, Learner, Params, Seed, Warmup, Events)) :-
+:- dynamic event_/2.                % N, Event (1-based, in order)
+
+stepbench_load(File, recording(Domain, Learner, Params, Seed, Warmup, Events)) :-
+    retractall(event_(_, _)),
     setup_call_cleanup(
         open(File, read, S, [encoding(utf8)]),
-        read_terms(S, Terms),
-        close(S)),
-    (   Terms = [stepbench(Domain, Learner, Params, Seed, Warmup)|Events]
-    ->  must_be(atom, Learner),
-        must_be(list, Params),
-        must_be(nonneg, Warmup),
-        maplist(check_event, Events)
-    ;   domain_error(stepbench_recording, File)
-    ).
+        (   read_term(S, Header, []),
+            (   Header = stepbench(Domain, Learner, Params, Seed, Warmup)
+            ->  must_be(atom, Learner),
+                must_be(list, Params),
+                must_be(nonneg, Warmup)
+            ;   domain_error(stepbench_recording, File)
+            ),
+            load_events(S, 0, Events)
+        ),
+        close(S)).
 
-read_terms(S, Terms) :-
+load_events(S, N0, N) :-
     read_term(S, T, []),
     (   T == end_of_file
-    ->  Terms = []
-    ;   Terms = [T|Terms1],
-        read_terms(S, Terms1)
+    ->  N = N0
+    ;   check_event(T),
+        N1 is N0 + 1,
+        assertz(event_(N1, T)),
+        load_events(S, N1, N)
     ).
 
 check_event(end_episode) :- !.
@@ -78,10 +86,10 @@ check_event(T) :-
 
 %!  stepbench_replay(+Recording, +Options, -Figures:dict) is det.
 %
-%   Replay Recording, checking every step, and measure it. Options: passes(N) (default 3:
-%   each pass starts the engine afresh and replays the whole recording; the figures are the
-%   median pass), profile(Bool) (default false), top(N) (predicates listed in the profile,
-%   default 25).
+%   Replay the loaded Recording (stepbench_load/2), checking every step, and measure it.
+%   Options: passes(N) (default 3: each pass starts the engine afresh and replays the whole
+%   recording; each figure is its median over the passes), profile(Bool) (default false),
+%   top(N) (predicates listed in the profile, default 25).
 %
 %   @error stepbench_mismatch(Step, Expected, Got) when a replayed step differs from the
 %   recording.
@@ -93,10 +101,15 @@ stepbench_replay(recording(Domain, Learner, Params, Seed, Warmup, Events), Optio
     option(profile(Profile), Options, false),
     option(top(Top), Options, 25),
     kb_for(Domain, KB),
-    split_warmup(Warmup, Events, Before, Timed),
-    count_steps(Timed, Steps),
-    Steps > 0,
-    Setup = setup(KB, Learner, Params, Seed, Before),
+    warmup_end(Warmup, 0, Events, Last),
+    First is Last + 1,
+    aggregate_all(count, ( between(First, Events, N), event_(N, s(_, _, _, _)) ), Steps),
+    (   Steps > 0
+    ->  true
+    ;   domain_error(stepbench_timed_steps, Steps)
+    ),
+    Setup = setup(KB, Learner, Params, Seed, Last),
+    Timed = First-Events,
     findall(P, ( between(1, Passes, _),
                  pass(Setup, Timed, direct, P) ), Direct),
     findall(P, ( between(1, Passes, _),
@@ -108,10 +121,10 @@ stepbench_replay(recording(Domain, Learner, Params, Seed, Warmup, Events), Optio
     median_pass(Overhead, O),
     per_step(D, O, Steps, DirectFig),
     per_step(G, O, Steps, GatewayFig),
+    LoopUs is 1e6 * O.wall / Steps,
     Figures0 = _{learner:Learner, domain:Domain, seed:Seed, warmup:Warmup,
                  steps:Steps, passes:Passes, direct:DirectFig, gateway:GatewayFig,
                  loop_us_per_step:LoopUs},
-    LoopUs is 1e6 * O.wall / Steps,
     (   Profile == true
     ->  profile_timed(Setup, Timed, Steps, Top, ProfileFig),
         Figures = Figures0.put(profile, ProfileFig)
@@ -126,32 +139,31 @@ kb_for(Domain, KB) :-
     ;   true
     ).
 
-%   The events up to the Warmup-th step, and the rest.
-split_warmup(0, Events, [], Events) :- !.
-split_warmup(N, [E|Es], [E|Before], Timed) :-
+%   Last is the number of the event of the Warmup-th step (0 for none).
+warmup_end(0, N, _, N) :- !.
+warmup_end(W, N0, Events, Last) :-
+    N0 < Events,
     !,
-    (   E == end_episode
-    ->  N1 = N
-    ;   N1 is N - 1
+    N is N0 + 1,
+    (   event_(N, s(_, _, _, _))
+    ->  W1 is W - 1
+    ;   W1 = W
     ),
-    split_warmup(N1, Es, Before, Timed).
-split_warmup(N, [], _, _) :-
-    domain_error(stepbench_warmup, N).
-
-count_steps(Events, N) :-
-    aggregate_all(count, member(s(_, _, _, _), Events), N).
+    warmup_end(W1, N, Events, Last).
+warmup_end(W, _, _, _) :-
+    domain_error(stepbench_warmup, W).
 
 %   One pass: the engine afresh, the warm-up, then the timed steps (How: direct, gateway,
-%   or overhead — the loop alone). pass(Wall, Cpu, Inferences) in seconds and counts.
-pass(setup(KB, Learner, Params, Seed, Before), Timed, How,
+%   or overhead — the loop alone). pass{wall, cpu, inferences} in seconds and counts.
+pass(setup(KB, Learner, Params, Seed, Last), First-Events, How,
      pass{wall:Wall, cpu:Cpu, inferences:Inf}) :-
     relrl_engine:engine_configure(KB, Learner, Params, Seed),
-    replay(Before, KB, direct, 0, I0),
+    replay(1, Last, KB, direct),
     garbage_collect,
     statistics(inferences, Inf0),
     statistics(cputime, C0),
     get_time(T0),
-    replay(Timed, KB, How, I0, _),
+    replay(First, Events, KB, How),
     get_time(T1),
     statistics(cputime, C1),
     statistics(inferences, Inf1),
@@ -159,18 +171,20 @@ pass(setup(KB, Learner, Params, Seed, Before), Timed, How,
     Cpu is C1 - C0,
     Inf is Inf1 - Inf0.
 
-%   Events replayed in a failure-driven loop (each step's terms are freed after it, as in a
-%   gateway call); I counts the steps for error messages.
-replay([], _, _, I, I).
-replay([E|Es], KB, How, I0, I) :-
-    (   E == end_episode
-    ->  relrl_engine:engine_end_episode(KB),
-        I1 = I0
-    ;   I1 is I0 + 1,
-        \+ \+ replay_step(How, KB, E, I1)
-    ),
-    replay(Es, KB, How, I1, I).
+%   Events From..To replayed in a failure-driven loop: each step's terms are copied from
+%   the database and freed after it, as in a gateway call.
+replay(From, To, KB, How) :-
+    (   between(From, To, N),
+        event_(N, E),
+        (   E == end_episode
+        ->  relrl_engine:engine_end_episode(KB)
+        ;   replay_step(How, KB, E, N)
+        ),
+        fail
+    ;   true
+    ).
 
+%   I is the event's number (in messages).
 replay_step(direct, KB, s(Percepts, Emitted, Mode, Expected), I) :-
     relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
     same(I, Expected, Out).
@@ -219,15 +233,15 @@ per_step(P, O, Steps, _{us_per_step:Us, cpu_us_per_step:CpuUs,
 %   Per predicate: its share of the time with what it calls (cumulative) and alone (self),
 %   in percent, and how often it is entered per step (a recursive predicate's calls to
 %   itself are not counted).
-profile_timed(setup(KB, Learner, Params, Seed, Before), Timed, Steps, Top,
+profile_timed(setup(KB, Learner, Params, Seed, Last), First-Events, Steps, Top,
               _{passes:Passes, samples:Samples, ticks:Ticks, predicates:Rows}) :-
     Passes = 8,
     reset_profiler,
     forall(between(1, Passes, _),
            ( relrl_engine:engine_configure(KB, Learner, Params, Seed),
-             replay(Before, KB, direct, 0, I0),
+             replay(1, Last, KB, direct),
              profiler(_, cputime),
-             replay(Timed, KB, direct, I0, _),
+             replay(First, Events, KB, direct),
              profiler(_, false) )),
     profile_data(Data),
     Samples = Data.summary.samples,
@@ -264,7 +278,7 @@ stepbench_main :-
     ->  true
     ;   throw(error(stepbench_usage(Argv), _))
     ),
-    stepbench_read(File, Recording),
+    stepbench_load(File, Recording),
     option(passes(Passes), Opts, 3),
     option(top(Top), Opts, 25),
     (   option(profile(true), Opts)
