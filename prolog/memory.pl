@@ -38,17 +38,20 @@ argument of every predicate names it. This module is the only one that stores pe
 :- use_module(library(pairs)).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
-%   The memory of knowledge base KB is one term, wm(Clock, Span, Elements), in a global
-%   variable (b/nb_setval) named after KB: Clock counts insertions, Span is the expiry age
-%   (or `default` until the domain's memory_span/1 is read), Elements are Element-Stamp
-%   pairs, newest first. A global term instead of asserted clauses keeps the robot's
-%   control step free of assert/retract churn.
+%   The memory of knowledge base KB is one term, wm(Clock, Span, Pairs, Elements, Now), in a
+%   global variable (nb_setval/2) named after KB: Clock counts insertions, Span is the expiry
+%   age (or `default` until the domain's memory_span/1 is read), Pairs are Element-Stamp
+%   pairs, newest first; Elements are the same elements alone and Now those of the latest
+%   insertion (age 0), both in the same order: the perception predicates look elements up
+%   many times a step, and memberchk/2 over plain terms takes half the time of a look-up
+%   over pairs. A global term instead of asserted clauses keeps the robot's control step
+%   free of assert/retract churn.
 
 key(KB, Key) :-
     (   key_(KB, Key0)
     ->  Key = Key0
     ;   atom_concat('$relrl_wm:', KB, Key),
-        nb_setval(Key, wm(0, default, [])),
+        nb_setval(Key, wm(0, default, [], [], [])),
         assertz(key_(KB, Key))
     ).
 
@@ -59,7 +62,7 @@ key(KB, Key) :-
 get(KB, State) :-
     (   key_(KB, Key)
     ->  nb_getval(Key, State)
-    ;   State = wm(0, default, [])
+    ;   State = wm(0, default, [], [], [])
     ).
 
 put(KB, State) :-
@@ -73,7 +76,7 @@ put(KB, State) :-
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    get(KB, wm(_, Span0, _)),
+    get(KB, wm(_, Span0, _, _, _)),
     (   Span0 == default
     ->  domain_span(KB, Span)
     ;   Span = Span0
@@ -96,15 +99,15 @@ domain_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    get(KB, wm(Clock, _, Elements)),
-    put(KB, wm(Clock, Span, Elements)).
+    get(KB, wm(Clock, _, Pairs, Elements, Now)),
+    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
 
 %!  wm_clock(+KB, -Clock) is det.
 %
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    get(KB, wm(Clock, _, _)).
+    get(KB, wm(Clock, _, _, _, _)).
 
 %!  wm_insert(+KB, +Elements:list) is det.
 %
@@ -122,41 +125,44 @@ wm_insert(KB, New) :-
     ->  instantiation_error(E)
     ;   true
     ),
-    get(KB, wm(Clock0, Span0, Old)),
+    get(KB, wm(Clock0, Span0, Old, _, _)),
     (   Span0 == default
     ->  domain_span(KB, Span)
     ;   Span = Span0
     ),
     Clock is Clock0 + 1,
     Oldest is Clock - Span,
-    stamp(New, Clock, Elements, Kept),
-    keep_old(Old, New, Oldest, Kept),
-    put(KB, wm(Clock, Span, Elements)).
+    stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
+    keep_old(Old, New, Oldest, KeptPairs, KeptElements),
+    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
 
-%   The new elements stamped, in front of Tail.
-stamp([], _, Tail, Tail).
-stamp([E|Es], Clock, Out, Tail) :-
+%   The new elements stamped, in front of PairsTail, and alone (Now), in front of Tail.
+stamp([], _, PairsTail, PairsTail, [], Tail, Tail).
+stamp([E|Es], Clock, Pairs, PairsTail, Now, Elements, Tail) :-
     (   memberchk(E, Es)                   % the same element twice in one insertion
-    ->  Out = Out1
-    ;   Out = [E-Clock|Out1]
-    ),
-    stamp(Es, Clock, Out1, Tail).
+    ->  stamp(Es, Clock, Pairs, PairsTail, Now, Elements, Tail)
+    ;   Pairs = [E-Clock|Pairs1],
+        Now = [E|Now1],
+        Elements = [E|Elements1],
+        stamp(Es, Clock, Pairs1, PairsTail, Now1, Elements1, Tail)
+    ).
 
-keep_old([], _, _, []).
-keep_old([E-S|Es], New, Oldest, Out) :-
+keep_old([], _, _, [], []).
+keep_old([E-S|Es], New, Oldest, Pairs, Elements) :-
     (   ( S < Oldest ; memberchk(E, New) )
-    ->  Out = Out1
-    ;   Out = [E-S|Out1]
-    ),
-    keep_old(Es, New, Oldest, Out1).
+    ->  keep_old(Es, New, Oldest, Pairs, Elements)
+    ;   Pairs = [E-S|Pairs1],
+        Elements = [E|Elements1],
+        keep_old(Es, New, Oldest, Pairs1, Elements1)
+    ).
 
 %!  wm_element(?KB, ?Element, ?Age) is nondet.
 %
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    get(KB, wm(Clock, _, Elements)),
-    member(Element-Stamp, Elements),
+    get(KB, wm(Clock, _, Pairs, _, _)),
+    member(Element-Stamp, Pairs),
     Age is Clock - Stamp.
 
 %!  wm_has(+KB, ?Element) is nondet.
@@ -165,10 +171,13 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    get(KB, wm(_, _, Elements)),
-    (   ground(Element)
-    ->  memberchk(Element-_, Elements)
-    ;   member(Element-_, Elements)
+    (   key_(KB, Key)
+    ->  nb_getval(Key, wm(_, _, _, Elements, _)),
+        (   ground(Element)                 % one copy of an element at most
+        ->  memberchk(Element, Elements)
+        ;   member(Element, Elements)
+        )
+    ;   fail                            % no memory yet
     ).
 
 %!  wm_has_chk(+KB, ?Element) is semidet.
@@ -176,16 +185,20 @@ wm_has(KB, Element) :-
 %   once(wm_has(KB, Element)).
 
 wm_has_chk(KB, Element) :-
-    get(KB, wm(_, _, Elements)),
-    memberchk(Element-_, Elements).
+    key_(KB, Key),
+    nb_getval(Key, wm(_, _, _, Elements, _)),
+    memberchk(Element, Elements).
 
 %!  wm_now(+KB, ?Element) is nondet.
 %
 %   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
 
 wm_now(KB, Element) :-
-    get(KB, wm(Clock, _, Elements)),
-    member(Element-Clock, Elements).
+    get(KB, wm(_, _, _, _, Now)),
+    (   ground(Element)                 % one copy of an element at most
+    ->  memberchk(Element, Now)
+    ;   member(Element, Now)
+    ).
 
 %!  wm_has_stimulus(+KB, +Stimulus) is semidet.
 %
@@ -193,8 +206,8 @@ wm_now(KB, Element) :-
 %   (at(S, Place)) in KB's memory.
 
 wm_has_stimulus(KB, S) :-
-    get(KB, wm(_, _, Elements)),
-    member(E-_, Elements),
+    get(KB, wm(_, _, _, Elements, _)),
+    member(E, Elements),
     compound(E),
     (   compound_name_arguments(E, Sense, [S1])
     ->  S1 == S,
@@ -218,8 +231,8 @@ sense_name(at).
 %   smell, at), else `false`.
 
 wm_scan(KB, Masks, Reinforcers, Mask, Reinforced) :-
-    get(KB, wm(Clock, _, Elements)),
-    scan(Elements, Clock, Masks, Reinforcers, 0, Mask, false, Reinforced).
+    get(KB, wm(Clock, _, Pairs, _, _)),
+    scan(Pairs, Clock, Masks, Reinforcers, 0, Mask, false, Reinforced).
 
 scan([], _, _, _, Mask, Mask, R, R).
 scan([E-Stamp|Es], Clock, Masks, Rs, Mask0, Mask, R0, R) :-
@@ -272,29 +285,37 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    get(KB, wm(_, Span, _)),
-    put(KB, wm(0, Span, [])).
+    get(KB, wm(_, Span, _, _, _)),
+    put(KB, wm(0, Span, [], [], [])).
 
 %!  wm_size(+KB, -Size:nonneg) is det.
 %
 %   Size is the number of elements in KB's memory.
 
 wm_size(KB, Size) :-
-    get(KB, wm(_, _, Elements)),
-    length(Elements, Size).
+    get(KB, wm(_, _, Pairs, _, _)),
+    length(Pairs, Size).
 
 %!  wm_state(+KB, -State) is det.
 %!  wm_set_state(+KB, +State) is det.
 %
-%   Save KB's whole memory (clock, span and elements) as one term, and put it back: an
-%   evaluation can use the memory and leave it as it found it.
+%   Save KB's whole memory as one term, wm(Clock, Span, Pairs) (Pairs: Element-Stamp,
+%   newest first), and put it back: an evaluation can use the memory and leave it as it
+%   found it.
+%
+%   @error domain_error(working_memory_state, State) if State is not such a term.
 
-wm_state(KB, State) :-
-    get(KB, State).
+wm_state(KB, wm(Clock, Span, Pairs)) :-
+    get(KB, wm(Clock, Span, Pairs, _, _)).
 
 wm_set_state(KB, State) :-
     must_be(atom, KB),
-    (   State = wm(Clock, _, Elements), integer(Clock), is_list(Elements)
-    ->  put(KB, State)
+    (   State = wm(Clock, Span, Pairs), integer(Clock), is_list(Pairs),
+        maplist(stamped, Pairs, Elements)
+    ->  findall(E, ( member(E-S, Pairs), S =:= Clock ), Now),
+        put(KB, wm(Clock, Span, Pairs, Elements, Now))
     ;   domain_error(working_memory_state, State)
     ).
+
+stamped(E-S, E) :-
+    integer(S).

@@ -56,6 +56,7 @@ tree_key(Tree, Key) :-
     ->  Key = Key0
     ;   must_be(atom, Tree),
         atom_concat('$relrl_qtree:', Tree, Key),
+        nb_setval(Key, none),
         assertz(tree_key_(Tree, Key))
     ).
 
@@ -63,8 +64,8 @@ tree_key(Tree, Key) :-
 
 %   Tree's term; fails when Tree was never made (or was cleared).
 tree(Tree, T) :-
-    tree_key(Tree, Key),
-    nb_current(Key, T0),
+    tree_key_(Tree, Key),
+    nb_getval(Key, T0),
     T0 = qtree(_, _, _),
     T = T0.
 
