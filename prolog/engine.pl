@@ -102,12 +102,14 @@ gateway can name the rule.
     learner_resume/3.
 
 %   Each knowledge base's engine lives in one global variable, '$relrl_engine:KB' (per KB,
-%   so one KB never sees another's), holding engine(Run, Eng):
+%   so one KB never sees another's), holding engine(Run, Prev, Random):
 %     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
 %               Necessities, Plan) — fixed for a run, read without copying; Plan is the
 %               state code's plan (relrl_state:state_plan/3)
-%     Eng = eng(Prev, Random) — Prev is prev(State, Necessity) of the last step or none;
-%               Random the KB's random state. Replaced in place (nb_setarg/3) every step.
+%     Prev    prev(State, Necessity) of the last step, or none
+%     Random  the KB's random state
+%   Prev and Random are replaced in place (nb_setarg/3) every step; eng(Prev, Random) is
+%   how the rest of this module sees the pair.
 
 engine_key(KB, Key) :-
     (   engine_key_(KB, Key0)
@@ -127,14 +129,15 @@ engine(KB, Engine) :-
     ).
 
 run(KB, Run) :-
-    engine(KB, engine(Run, _)).
+    engine(KB, engine(Run, _, _)).
 
-eng(KB, Eng) :-
-    engine(KB, engine(_, Eng)).
+eng(KB, eng(Prev, Random)) :-
+    engine(KB, engine(_, Prev, Random)).
 
-set_eng(KB, Eng) :-
+set_eng(KB, eng(Prev, Random)) :-
     engine(KB, Engine),
-    nb_setarg(2, Engine, Eng).
+    nb_setarg(2, Engine, Prev),
+    nb_setarg(3, Engine, Random).
 
 %!  engine_learner(+KB, -Learner) is det.
 %
@@ -231,7 +234,7 @@ engine_configure(KB, Learner, Params, Seed) :-
     engine_key(KB, Key),
     nb_setval(Key, engine(run(Learner, Params, Features, Responses, Units, Reinforcers,
                               Constraints, Necessities, Plan),
-                          eng(none, Random))),
+                          none, Random)),
     wm_clear(KB),
     motivation_reset(KB),
     with_random(KB, learner_init(Learner, KB, Params)).
@@ -321,11 +324,12 @@ engine_forget(KB) :-
 
 engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     engine(KB, Engine),
-    Engine = engine(Run, eng(Prev, Random0)),
+    Engine = engine(Run, Prev, Random0),
     set_random(state(Random0)),
     step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
     random_property(state(Random)),
-    nb_setarg(2, Engine, eng(Next, Random)).
+    nb_setarg(2, Engine, Next),
+    nb_setarg(3, Engine, Random).
 
 step(KB, run(Learner, Params, _, Responses, Units, Reinforcers, Constraints, _, Plan),
      Prev, Percepts, EmittedIx, Mode, Want,

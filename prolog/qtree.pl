@@ -41,9 +41,10 @@ on (to update the previous step's example).
 A node is test(Index, Goal, Yes, No) or leaf(Rep, Entries); Rep is `none` until the first
 example arrives. Id 0 is the root.
 
-A tree is one term in a global variable (named after the tree), qtree(Tests, Next, Nodes):
-Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument Id+1
-holds node Id (`free` beyond the last). The control step reads nodes in place (arg/3, no
+A tree is one term in a global variable (named after the tree), qtree(Tests, Next, Nodes,
+Memo): Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument
+Id+1 holds node Id (`free` beyond the last). Memo remembers where the last two states sorted
+went (see qtree_sort/3). The control step reads nodes in place (arg/3, no
 copy: sorting a state down the tree is a few argument look-ups) and replaces a leaf in place
 (nb_setarg/3, which copies only that leaf); a full Nodes is copied into one twice its size.
 What this module gives to callers that may bind variables (qtree_node/3, qtree_tests/2, the
@@ -66,7 +67,7 @@ tree_key(Tree, Key) :-
 tree(Tree, T) :-
     tree_key_(Tree, Key),
     nb_getval(Key, T0),
-    T0 = qtree(_, _, _),
+    T0 = qtree(_, _, _, _),
     T = T0.
 
 %   Tree's term; an existence error when there is none.
@@ -82,7 +83,7 @@ node(Nodes, Id, Node) :-
 
 %   Node Id of T, which must exist.
 existing_node(T, Tree, Id, Node) :-
-    T = qtree(_, Next, Nodes),
+    T = qtree(_, Next, Nodes, _),
     (   integer(Id), Id >= 0, Id < Next
     ->  node(Nodes, Id, Node)
     ;   existence_error(qtree_node, Tree-Id)
@@ -95,7 +96,7 @@ set_node(T, Id, Node) :-
 
 %   A new node id in T (Nodes grows when full).
 new_id(T, Id) :-
-    T = qtree(_, Id, Nodes),
+    T = qtree(_, Id, Nodes, _),
     Next is Id + 1,
     functor(Nodes, _, Capacity),
     (   Next =< Capacity
@@ -148,7 +149,7 @@ qtree_restore_(Tree, Tests, Nodes, Next) :-
            ;   domain_error(qtree_node_id, Id)
            )),
     tree_key(Tree, Key),
-    nb_setval(Key, qtree(Tests, Next, Term)).
+    nb_setval(Key, qtree(Tests, Next, Term, none)).
 
 %!  qtree_clear(+Tree) is det.
 %
@@ -162,13 +163,13 @@ qtree_clear(Tree) :-
 %!  qtree_tests(+Tree, -Tests:list) is det.
 
 qtree_tests(Tree, Tests) :-
-    tree(Tree, qtree(Tests0, _, _)),
+    tree(Tree, qtree(Tests0, _, _, _)),
     copy_term(Tests0, Tests).
 
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
-    tree(Tree, qtree(_, Next, Nodes)),
+    tree(Tree, qtree(_, Next, Nodes, _)),
     (   integer(Id)
     ->  Id >= 0, Id < Next
     ;   Last is Next - 1,
@@ -200,7 +201,26 @@ first_difference(D1, D2, Index) :-
 %   @error existence_error(qtree, Tree) if there is no such tree.
 
 qtree_sort(Tree, D, Where) :-
-    the_tree(Tree, qtree(_, _, Nodes)),
+    the_tree(Tree, T),
+    T = qtree(_, Version, Nodes, Memo),
+    (   Memo = memo(Version, D1, W1, D2, W2)
+    ->  (   D1 =:= D
+        ->  Where = W1
+        ;   D2 =:= D
+        ->  Where = W2
+        ;   sort_root(Nodes, D, Where),
+            nb_setarg(4, T, memo(Version, D, Where, D1, W1))
+        )
+    ;   sort_root(Nodes, D, Where),
+        nb_setarg(4, T, memo(Version, D, Where, -1, none))
+    ).
+
+%   The memo: the control step sorts each state three times (to learn, as the next state
+%   of the previous example; to choose; then, at the next step, to insert its example).
+%   It holds while the tree's shape does: every grow or split takes a new node id, so the
+%   next id is the shape's version.
+
+sort_root(Nodes, D, Where) :-
     arg(1, Nodes, Root),
     sort_from(Root, 0, Nodes, D, Where).
 
@@ -232,7 +252,7 @@ step_down(Nodes, Id, D, Goal, Branch, Next) :-
 %   ends, followed by leaf(Id) or null.
 
 qtree_path(Tree, D, Path) :-
-    the_tree(Tree, qtree(_, _, Nodes)),
+    the_tree(Tree, qtree(_, _, Nodes, _)),
     path_from(Nodes, 0, D, Path0),
     copy_term(Path0, Path).
 
@@ -255,7 +275,7 @@ path_from(Nodes, Id, D, Path) :-
 qtree_leaf(Tree, Id, Rep, Entries) :-
     (   integer(Id)
     ->  tree(Tree, T),
-        T = qtree(_, Next, Nodes),
+        T = qtree(_, Next, Nodes, _),
         Id >= 0, Id < Next,
         node(Nodes, Id, leaf(Rep, Entries))
     ;   qtree_node(Tree, Id, leaf(Rep, Entries))
@@ -267,7 +287,7 @@ qtree_leaf(Tree, Id, Rep, Entries) :-
 
 qtree_set_leaf(Tree, Id, Rep, Entries) :-
     (   tree(Tree, T),
-        T = qtree(_, Next, Nodes),
+        T = qtree(_, Next, Nodes, _),
         integer(Id), Id >= 0, Id < Next,
         node(Nodes, Id, leaf(_, _))
     ->  set_node(T, Id, leaf(Rep, Entries))
@@ -310,7 +330,7 @@ qtree_split(Tree, LeafId, I) :-
     ->  true
     ;   existence_error(qtree_leaf, Tree-LeafId)
     ),
-    T = qtree(Tests, _, _),
+    T = qtree(Tests, _, _, _),
     nth0(I, Tests, Goal),
     new_id(T, Id),
     (   test_holds(Rep, I)

@@ -1,9 +1,11 @@
 :- module(relrl_rules,
           [ rule_holds/2,         % +KB, +Goal
+            rules_mask/4,         % +KB, +GoalBits, +Mask0, -Mask
             rule_solution/2,      % +KB, +Goal
             rule_where/3          % +KB, +Goal, -Where
           ]).
 :- use_module(library(error)).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Running the domain's goals
 
@@ -27,6 +29,19 @@ unchanged (it names the innermost rule the engine called).
 rule_holds(KB, Goal) :-
     catch(KB:Goal, E, rule_error(KB, Goal, E)),
     !.
+
+%!  rules_mask(+KB, +GoalBits:list, +Mask0, -Mask) is det.
+%
+%   Mask is Mask0 with the Bit of every Goal-Bit pair of GoalBits whose Goal holds
+%   (rule_holds/2 for each, in order: the same errors): the state code's facts in one loop.
+
+rules_mask(_, [], Mask, Mask).
+rules_mask(KB, [Goal-Bit|Gs], Mask0, Mask) :-
+    (   catch(KB:Goal, E, rule_error(KB, Goal, E))
+    ->  Mask1 is Mask0 \/ Bit
+    ;   Mask1 = Mask0
+    ),
+    rules_mask(KB, Gs, Mask1, Mask).
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %

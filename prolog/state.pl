@@ -150,7 +150,7 @@ plan_code(KB, plan(Masks, Facts), Code) :-
     ->  Code0 = 0
     ;   wm_scan(KB, Masks, [], Code0, _)
     ),
-    facts_code(Facts, KB, Code0, Code).
+    rules_mask(KB, Facts, Code0, Code).
 
 %!  plan_code(+KB, +Plan, +Reinforcers:list, -Code, -Reinforced) is det.
 %
@@ -159,15 +159,7 @@ plan_code(KB, plan(Masks, Facts), Code) :-
 
 plan_code(KB, plan(Masks, Facts), Reinforcers, Code, Reinforced) :-
     wm_scan(KB, Masks, Reinforcers, Code0, Reinforced),
-    facts_code(Facts, KB, Code0, Code).
-
-facts_code([], _, Code, Code).
-facts_code([G-Bit|Fs], KB, Code0, Code) :-
-    (   rule_holds(KB, G)
-    ->  Code1 is Code0 \/ Bit
-    ;   Code1 = Code0
-    ),
-    facts_code(Fs, KB, Code1, Code).
+    rules_mask(KB, Facts, Code0, Code).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %
