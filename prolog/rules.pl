@@ -35,13 +35,16 @@ rule_holds(KB, Goal) :-
 %   Mask is Mask0 with the Bit of every Goal-Bit pair of GoalBits whose Goal holds
 %   (rule_holds/2 for each, in order: the same errors): the state code's facts in one loop.
 
-rules_mask(_, [], Mask, Mask).
-rules_mask(KB, [Goal-Bit|Gs], Mask0, Mask) :-
+rules_mask(KB, GoalBits, Mask0, Mask) :-
+    rules_mask_(GoalBits, KB, Mask0, Mask).
+
+rules_mask_([], _, Mask, Mask).
+rules_mask_([Goal-Bit|Gs], KB, Mask0, Mask) :-
     (   catch(KB:Goal, E, rule_error(KB, Goal, E))
     ->  Mask1 is Mask0 \/ Bit
     ;   Mask1 = Mask0
     ),
-    rules_mask(KB, Gs, Mask1, Mask).
+    rules_mask_(Gs, KB, Mask1, Mask).
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %
