@@ -212,7 +212,8 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   extra test above the features' bits.
 
 %   What the hooks read every step, in a global variable per KB (its name made once):
-%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra, and Numbers =
+%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra as Goal-Bit pairs (their
+%   bits above the features'), and Numbers =
 %   numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or `params` when
 %   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
 
@@ -235,28 +236,28 @@ relrl_engine:learner_init(etg, KB, Params) :-
     engine_config(KB, features, Features),
     findall(G, declared(KB, etg_test(G)), Extra),
     length(Features, NF),
+    extra_bits(Extra, NF, ExtraBits),
     (   maplist(param(Params), [alpha, gamma, epsilon, q_init, split_threshold],
                 [Alpha, Gamma, Epsilon, Qinit, Threshold])
     ->  Numbers = numbers(Alpha, Gamma, Epsilon, Qinit, Threshold)
     ;   Numbers = params
     ),
     config_key(KB, Key),
-    nb_setval(Key, etg(NF, Extra, Numbers)),
+    nb_setval(Key, etg(NF, ExtraBits, Numbers)),
     append(Features, Extra, Tests),
     etg_init(KB, Tests).
 
-relrl_engine:learner_state(etg, KB, Code, D) :-
-    config(KB, etg(NF, Extra, _)),
-    (   Extra == []
-    ->  D = Code
-    ;   foldl(extra_bit(KB), Extra, NF-Code, _-D)
-    ).
-
-extra_bit(KB, Goal, I-D0, I1-D) :-
+extra_bits([], _, []).
+extra_bits([G|Gs], I, [G-Bit|Bits]) :-
+    Bit is 1 << I,
     I1 is I + 1,
-    (   rule_holds(KB, Goal)
-    ->  D is D0 \/ (1 << I)
-    ;   D = D0
+    extra_bits(Gs, I1, Bits).
+
+relrl_engine:learner_state(etg, KB, Code, D) :-
+    config(KB, etg(_, ExtraBits, _)),
+    (   ExtraBits == []
+    ->  D = Code
+    ;   rules_mask(KB, ExtraBits, Code, D)
     ).
 
 relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-

@@ -116,11 +116,13 @@ motivation_step(KB, Outputs, Active) :-
 %!  motivation_units(+KB, -Units:list) is det.
 %
 %   Units describes every necessity unit of KB as
-%   unit(N, Bias, Wr, Delta, Threshold, Initial, Inputs), Inputs a list of Goal-Weight.
-%   The engine computes it once per run and passes it to motivation_step/4.
+%   unit(N, Bias, Wr, Delta, Threshold, Initial, Inputs), Inputs = inputs(GoalBits, Weights)
+%   for the unit's inputs (necessity_inputs/3) in order: Goal-Bit pairs (bit j for the j-th
+%   input, as relrl_rules:rules_mask/4 takes them) and the weights. The engine computes it
+%   once per run and passes it to motivation_step/4.
 
 motivation_units(KB, Units) :-
-    findall(unit(N, B, Wr, Delta, T, Y0, Goals),
+    findall(unit(N, B, Wr, Delta, T, Y0, inputs(GoalBits, Weights)),
             ( kb_necessity(KB, N),
               unit_parameters(KB, N, Params),
               memberchk(bias=B, Params),
@@ -128,8 +130,14 @@ motivation_units(KB, Units) :-
               memberchk(delta=Delta, Params),
               memberchk(threshold=T, Params),
               memberchk(initial=Y0, Params),
-              necessity_inputs(KB, N, Goals) ),
+              necessity_inputs(KB, N, Inputs),
+              input_bits(Inputs, 1, GoalBits, Weights) ),
             Units).
+
+input_bits([], _, [], []).
+input_bits([Goal-W|Is], Bit, [Goal-Bit|Gs], [W|Ws]) :-
+    Bit1 is Bit << 1,
+    input_bits(Is, Bit1, Gs, Ws).
 
 %!  motivation_step(+KB, +Units, -Outputs:list, -Active) is det.
 %
@@ -164,26 +172,30 @@ motivation_peek(KB, Units, Outputs, Active) :-
 
 %   Eq. 1 and 2 for every unit; Ir, the recurrent input, is the unit's previous output.
 unit_values([], _, _, [], []).
-unit_values([unit(N, B, Wr, Delta, _, Y0, Goals)|Us], KB, Previous, [N-Y|Os], [Y|Ys]) :-
+unit_values([unit(N, B, Wr, Delta, _, Y0, inputs(GoalBits, Weights))|Us], KB, Previous,
+            [N-Y|Os], [Y|Ys]) :-
     (   memberchk(N-Ir, Previous)
     ->  true
     ;   Ir = Y0
     ),
-    inputs_sum(Goals, KB, 0, Sum),
+    rules_mask(KB, GoalBits, 0, Holds),
+    inputs_sum(Weights, Holds, 1, 0, Sum),
     U is Sum + Wr*Ir + B,
     Y is 1 / (1 + exp(-(U + Delta))),
     unit_values(Us, KB, Previous, Os, Ys).
 
-%   sum_j w_j * i_j, i_j 1 when the j-th input goal holds: unit_activation/5's sum, term by
-%   term (the same floating-point operations in the same order).
-inputs_sum([], _, Sum, Sum).
-inputs_sum([Goal-W|Gs], KB, Sum0, Sum) :-
-    (   rule_holds(KB, Goal)
+%   sum_j w_j * i_j, i_j 1 when the j-th input goal holds (bit j of Holds):
+%   unit_activation/5's sum, term by term (the same floating-point operations in the same
+%   order).
+inputs_sum([], _, _, Sum, Sum).
+inputs_sum([W|Ws], Holds, Bit, Sum0, Sum) :-
+    (   Holds /\ Bit =\= 0
     ->  I = 1
     ;   I = 0
     ),
     Sum1 is Sum0 + W*I,
-    inputs_sum(Gs, KB, Sum1, Sum).
+    Bit1 is Bit << 1,
+    inputs_sum(Ws, Holds, Bit1, Sum1, Sum).
 
 mediate(_, [], none) :- !.
 mediate(Units, Outputs, Active) :-

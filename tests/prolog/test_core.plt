@@ -1,5 +1,6 @@
 /*  plunit tests of the learning core: motivation (Eq. 1, 2), contingency, the Q-tree and
-    ETG (Algorithm 3, Eq. 4), and the control step on hand-made percept streams.
+    ETG (Algorithm 3, Eq. 4), the control step on hand-made percept streams, and the parts
+    of the step made fast (the state plan, the rules loop, working memory's look-ups).
     Run from pytest (tests/prolog/test_plunit.py) or:
         swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_core.plt
 */
@@ -272,3 +273,103 @@ test(unknown_learner, [error(domain_error(learner(_), sarsa))]) :-
     relrl_engine:engine_configure(KB, sarsa, [], 0).
 
 :- end_tests(engine_step).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(step_parts).
+
+%   The state plan gives the code testing each feature gives (features_code/3), on random
+%   memories over the Social Interactive Simulator's percepts (and some outside them).
+sis_percept(P) :-
+    member(P, [see(face), see(toy), see(environment), hear(attention), at(toy, left),
+               at(toy, down), at(centre), at(left), at(right), pose(face, frontal),
+               pose(face, left), pose(face, down), colour(toy, red), colour(toy, green),
+               emitted(look(left)), smell(nothing), at(face), see(environment(x))]).
+
+random_memory(Elements) :-
+    findall(P, ( sis_percept(P), random(X), X < 0.3 ), Elements).
+
+test(plan_code_is_features_code, [true(Pairs1 == Pairs2)]) :-
+    kb_with('examples/domains/sis.pl', KB),
+    relrl_state:state_features(KB, Features),
+    relrl_state:state_plan(KB, Features, Plan),
+    set_random(seed(5)),
+    findall(C1-C2,
+            ( between(1, 300, _),
+              random_memory(Elements),
+              relrl_memory:wm_insert(KB, Elements),
+              relrl_state:features_code(KB, Features, C1),
+              relrl_state:plan_code(KB, Plan, C2) ),
+            Pairs),
+    pairs_keys(Pairs, Pairs1),
+    pairs_values(Pairs, Pairs2).
+
+%   A stimulus declared twice owns both bits; the reinforcement check reads age 0 only.
+test(scan_masks_and_reinforcer, [true(R1-R2-M == true-false-5)]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 1),
+    relrl_memory:wm_insert(KB, [hear(food), at(light, left)]),
+    relrl_state:state_plan(KB, [stimulus(light), stimulus(dark), stimulus(light)], Plan),
+    relrl_state:plan_code(KB, Plan, [food], M, R1),
+    relrl_memory:wm_insert(KB, []),
+    relrl_state:plan_code(KB, Plan, [food], _, R2).
+
+test(rules_mask_or_of_holding_goals, [M == 0b1101]) :-
+    relrl_gateway:gw_new_kb(KB),
+    assertz(KB:(yes)), assertz(KB:(no :- fail)),
+    relrl_rules:rules_mask(KB, [yes-4, no-2, yes-8], 1, M).
+
+%   One catch guards the loop; an error still names the goal that raised it.
+test(rules_mask_error_names_its_goal,
+     [throws(relrl_rule_error(boom(2), _, error(instantiation_error, _)))]) :-
+    relrl_gateway:gw_new_kb(KB),
+    assertz(KB:(ok)),
+    assertz(KB:(boom(_) :- atom_length(_, _))),
+    relrl_rules:rules_mask(KB, [ok-1, boom(2)-2, ok-4], 0, _).
+
+test(rules_mask_passes_a_named_error_on,
+     [throws(relrl_rule_error(inner, here, oops))]) :-
+    relrl_gateway:gw_new_kb(KB),
+    assertz(KB:(outer :- throw(relrl_rule_error(inner, here, oops)))),
+    relrl_rules:rules_mask(KB, [outer-1], 0, _).
+
+test(memory_state_round_trip, [true(Now-All == [see(b)]-[0-see(b), 1-see(a)])]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 1),
+    relrl_memory:wm_insert(KB, [see(a)]),
+    relrl_memory:wm_insert(KB, [see(b)]),
+    relrl_memory:wm_state(KB, State),
+    relrl_memory:wm_clear(KB),
+    relrl_memory:wm_set_state(KB, State),
+    findall(E, relrl_memory:wm_now(KB, E), Now),
+    relrl_memory:wm_elements(KB, All).
+
+test(ground_lookups_ages, [true(L == [yes, no, yes, no])]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 1),
+    relrl_memory:wm_insert(KB, [see(a)]),
+    relrl_memory:wm_insert(KB, [see(b), see(b)]),
+    findall(X, ( member(G, [wm_now(KB, see(b)), wm_now(KB, see(a)),
+                            wm_has(KB, see(a)), wm_has(KB, see(c))]),
+                 ( relrl_memory:G -> X = yes ; X = no ) ), L).
+
+%   relrl declares forbidden/1 in every knowledge base: without clauses there are no
+%   constraints; a dynamic forbidden/1 may get clauses during a run.
+test(constraints_detected_by_clauses, [true(A-B == false-true)]) :-
+    kb_with('tests/data/tiny.pl', KB1),
+    relrl_engine:engine_configure(KB1, etg, [], 0),
+    relrl_engine:engine_config(KB1, constraints, A),
+    relrl_gateway:gw_new_kb(KB2),
+    KB2:dynamic(forbidden/1),
+    assertz(KB2:response(r)),
+    relrl_engine:engine_configure(KB2, external, [], 0),
+    relrl_engine:engine_config(KB2, constraints, B).
+
+test(step_leaves_no_choice_point, [Det == true]) :-
+    kb_with('examples/domains/sis.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    call_cleanup(relrl_engine:engine_step(KB, [see(face), pose(face, frontal), at(centre)],
+                                          -1, learn, [], _),
+                 Det = true).
+
+:- end_tests(step_parts).
