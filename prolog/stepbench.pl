@@ -126,7 +126,8 @@ stepbench_replay(recording(Domain, Learner, Params, Seed, Warmup, Events), Optio
                  steps:Steps, passes:Passes, direct:DirectFig, gateway:GatewayFig,
                  loop_us_per_step:LoopUs},
     (   Profile == true
-    ->  profile_timed(Setup, Timed, Steps, Top, ProfileFig),
+    ->  ProfilePasses is max(4, min(200, ceiling(1.5 / max(D.cpu, 0.001)))),
+        profile_timed(Setup, Timed, Steps, ProfilePasses, Top, ProfileFig),
         Figures = Figures0.put(profile, ProfileFig)
     ;   Figures = Figures0
     ).
@@ -229,13 +230,13 @@ per_step(P, O, Steps, _{us_per_step:Us, cpu_us_per_step:CpuUs,
 
 %   ---- The profile -------------------------------------------------------------------------
 
-%   The profiler runs over the timed steps only (off during the warm-up) of 8 passes.
+%   The profiler runs over the timed steps only (off during the warm-up) of Passes passes
+%   (enough for about 1.5 s of samples).
 %   Per predicate: its share of the time with what it calls (cumulative) and alone (self),
 %   in percent, and how often it is entered per step (a recursive predicate's calls to
 %   itself are not counted).
-profile_timed(setup(KB, Learner, Params, Seed, Last), First-Events, Steps, Top,
+profile_timed(setup(KB, Learner, Params, Seed, Last), First-Events, Steps, Passes, Top,
               _{passes:Passes, samples:Samples, ticks:Ticks, predicates:Rows}) :-
-    Passes = 8,
     reset_profiler,
     forall(between(1, Passes, _),
            ( relrl_engine:engine_configure(KB, Learner, Params, Seed),

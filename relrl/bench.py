@@ -3,6 +3,9 @@
 * the cost of one gateway call with one binding;
 * steps per second of each learner driving the Social Interactive Simulator (a fixed,
   seeded synthetic environment), learning on, and the gateway calls per step;
+* the Prolog side of an ETG step alone: the same seeded run recorded and replayed in plain
+  swipl, every decision checked (relrl.stepbench), CPU microseconds and inferences per step,
+  called directly and through the gateway's time-limited call;
 * the simulator's own step rate;
 * ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
 * the perception pipeline's frames per second (perception.bench), optional.
@@ -73,6 +76,15 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     out["gateway_call_us"] = (before + after) / 2
     for figures in out["learners"].values():
         figures["step_in_gateway_calls"] = figures["us_per_step"] / out["gateway_call_us"]
+    from relrl.stepbench import bench_prolog_step
+
+    replayed = bench_prolog_step("etg", steps=steps)
+    out["etg_prolog_side"] = {
+        "steps": replayed["steps"], "passes": replayed["passes"],
+        "cpu_us_per_step": replayed["direct"]["cpu_us_per_step"],
+        "inferences_per_step": replayed["direct"]["inferences_per_step"],
+        "gateway_cpu_us_per_step": replayed["gateway"]["cpu_us_per_step"],
+        "in_gateway_calls": replayed["direct"]["cpu_us_per_step"] / out["gateway_call_us"]}
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
     from relrl.monitor.bench import bench_monitor
 

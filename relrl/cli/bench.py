@@ -6,7 +6,7 @@ import argparse
 import json
 
 HELP = "measure gateway call cost, learner steps/s, simulator and perception rates"
-EXAMPLE = "relrl bench --json bench.json"
+EXAMPLE = "relrl bench --json bench.json\n  relrl bench --prolog-step --profile   # the Prolog side of an ETG step alone"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -17,6 +17,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="skip the perception pipeline benchmark")
     parser.add_argument("--no-faces", action="store_true",
                         help="skip the face-recall figures (needs scikit-image)")
+    parser.add_argument("--prolog-step", action="store_true",
+                        help="only the Prolog side of a control step: record the bench's seeded "
+                             "run and replay it in plain swipl, every decision checked "
+                             "(microseconds and inferences per step)")
+    parser.add_argument("--learner", default="etg",
+                        help="with --prolog-step: the learner (default etg)")
+    parser.add_argument("--profile", action="store_true",
+                        help="with --prolog-step: SWI-Prolog's profiler over the replayed steps")
+    parser.add_argument("--top", type=int, default=25,
+                        help="with --profile: predicates listed (default 25)")
 
 
 def _print(d: dict, indent: str = "") -> None:
@@ -38,12 +48,41 @@ def run(args: argparse.Namespace) -> int:
 
     if args.steps < 100:
         raise ConfigError(f"--steps must be at least 100, not {args.steps}")
+    if not args.prolog_step and (args.profile or args.learner != "etg"):
+        raise ConfigError("--profile and --learner go with --prolog-step")
+    if args.top < 1:
+        raise ConfigError(f"--top must be at least 1, not {args.top}")
     path = check_out_file(args.json, "--json") if args.json else None  # before an hour's work
-    figures = bench_all(steps=args.steps, perception=not args.no_perception,
-                        faces=not args.no_faces)
-    _print(figures)
+    if args.prolog_step:
+        figures = _prolog_step(args)
+    else:
+        figures = bench_all(steps=args.steps, perception=not args.no_perception,
+                            faces=not args.no_faces)
+        _print(figures)
     if path is not None:
         write_json_atomic(path, figures)
         print(f"wrote {path}")
     json.dumps(figures)  # must be JSON-ready
     return 0
+
+
+def _prolog_step(args: argparse.Namespace) -> dict:
+    """``--prolog-step``: the figures of relrl.stepbench, printed (the profile as a table)."""
+    from relrl.learners import make_learner
+    from relrl.stepbench import bench_prolog_step
+
+    make_learner(args.learner)  # an unknown name is a ConfigError before any work
+    figures = bench_prolog_step(args.learner, steps=args.steps, profile=args.profile,
+                                top=args.top)
+    profile = figures.pop("profile", None)
+    _print(figures)
+    if profile is not None:
+        print(f"profile ({profile['passes']} passes over the timed steps, "
+              f"{profile['ticks']} ticks): cumulative %, self %, calls per step")
+        if not profile["predicates"]:
+            print("  no samples: the profiler needs longer runs (--steps 1000 or more)")
+        for row in profile["predicates"]:
+            print(f"  {row['cumulative']:6.1f} {row['self']:6.1f} {row['calls_per_step']:8.2f}"
+                  f"  {row['predicate']}")
+        figures["profile"] = profile
+    return figures

@@ -20,6 +20,9 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
         assert learner["cpu_us_per_step"] > 0
         assert learner["step_in_gateway_calls"] == \
             learner["us_per_step"] / figures["gateway_call_us"]
+    side = figures["etg_prolog_side"]
+    assert side["cpu_us_per_step"] > 0 and side["gateway_cpu_us_per_step"] > 0
+    assert side["inferences_per_step"] > 100
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "tg_steps_per_second>=3000" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
