@@ -6,7 +6,8 @@ import argparse
 import json
 
 HELP = "measure gateway call cost, learner steps/s, simulator and perception rates"
-EXAMPLE = "relrl bench --json bench.json\n  relrl bench --prolog-step --profile   # the Prolog side of an ETG step alone"
+EXAMPLE = ("relrl bench --json bench.json\n"
+           "  relrl bench --prolog-step --profile   # the Prolog side of an ETG step alone")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
