@@ -121,6 +121,17 @@ halt_message(Where, Message) :-
 
 :- initialization(at_halt(relrl_gateway:halt_hook)).
 
+%   Ctrl-C at the shell: kb.py's watcher thread raises SIGUSR1 in Prolog's thread
+%   (PL_thread_raise/2) while a user's query runs; the query stops with relrl_interrupted,
+%   reported as error(interrupted, _), at once instead of when its time limit strikes.
+:- initialization(on_signal(usr1, _, relrl_gateway:interrupt)).
+
+interrupt(_Signal) :-
+    (   nb_current(relrl_active, true)
+    ->  throw(relrl_interrupted)
+    ;   true                            % between gateway calls: nothing to stop
+    ).
+
 %   at_halt/1 hook: inside a gateway call, cancel the halt and remember where it came from.
 halt_hook :-
     (   nb_current(relrl_active, true)
@@ -227,6 +238,9 @@ time_up :-
 %   rule_error(Goal, Where, Formal), policy_error(File, Line, Text), or the error term
 %   itself) and Message is one line for a person.
 
+error_result(relrl_interrupted, error(interrupted, "interrupted")) :- !.
+error_result(relrl_rule_error(_, _, relrl_interrupted), Result) :- !,
+    error_result(relrl_interrupted, Result).
 error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
     where_text(Where0, Where),
     format(string(GoalText), "~q", [Goal]),

@@ -22,12 +22,14 @@ processes.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import os
 import re
+import signal
 import threading
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from ctypes import POINTER, byref, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
 from dataclasses import dataclass
 from pathlib import Path
@@ -177,6 +179,9 @@ class _Engine:
         self.recorded = fn("PL_recorded", c_int, c_void_p, T)
         self.erase = fn("PL_erase", None, c_void_p)
         self._records: dict[Any, int] = {}
+        self.thread_raise = fn("PL_thread_raise", c_int, c_int, c_int)
+        self.prolog_thread = fn("PL_thread_self", c_int)()
+        self.busy = False          # a goal of run() or of an open query is running
         self.mark_strings = fn("PL_mark_string_buffers", None, POINTER(c_size_t))
         self.release_strings = fn("PL_release_string_buffers_from_mark", None, c_size_t)
 
@@ -384,8 +389,12 @@ class _Engine:
             self.put(a0, goal, variables)
             self.put_float(a0 + 1, float(timeout or 0))
             self.put_variable(a0 + 2)
-            ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
-                                     self._gw_run, a0)
+            self.busy = True
+            try:
+                ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
+                                         self._gw_run, a0)
+            finally:
+                self.busy = False
             if not ok:
                 ex = self.exception(0)
                 if not ex:
@@ -501,6 +510,41 @@ class _Engine:
         self.mark_strings(byref(mark))
         return mark.value
 
+    @contextlib.contextmanager
+    def interruptible(self) -> Iterator[None]:
+        """Within the block, Ctrl-C (SIGINT) stops the Prolog goal running at that moment
+        (a user's query), as at swipl's toplevel, instead of when its time limit strikes.
+
+        Python only sees a signal between bytecodes, not while Prolog runs: the signal's
+        byte arrives on a wakeup pipe (:func:`signal.set_wakeup_fd`) that a thread
+        watches; while a goal runs, the thread raises SIGUSR1 in Prolog's thread
+        (``PL_thread_raise``, safe from any thread), whose handler in gateway.pl throws
+        inside the goal. The goal ends with an error the gateway reports, and Python's own
+        KeyboardInterrupt follows. Outside the main thread this does nothing.
+        """
+        if threading.current_thread() is not threading.main_thread() \
+                or threading.get_ident() != self.thread:
+            yield
+            return
+        r, w = os.pipe()
+        os.set_blocking(w, False)
+        old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+
+        def watch() -> None:
+            while data := os.read(r, 512):        # b"" once the write end is closed
+                if signal.SIGINT in data and self.busy:
+                    self.thread_raise(self.prolog_thread, signal.SIGUSR1)
+
+        watcher = threading.Thread(target=watch, name="relrl-interrupts", daemon=True)
+        watcher.start()
+        try:
+            yield
+        finally:
+            signal.set_wakeup_fd(old)
+            os.close(w)
+            watcher.join(5)
+            os.close(r)
+
     def _aborted(self) -> RelrlError:
         """The error for a goal that called abort/0 (asks gw_take_abort/1 where)."""
         out = self.run((":", "relrl_gateway", ("gw_take_abort", Var())), 0, (0,))
@@ -563,6 +607,8 @@ def _raise_result(result: Term, timeout: float) -> None:
             raise RuleError(message, "halt", None, error)
         if kind == "aborted":
             raise Aborted(None, None)
+        if kind == "interrupted":
+            raise KeyboardInterrupt
         raise PrologError(message, error)
     raise PrologError(f"unexpected gateway result {result!r}", result)
 
@@ -669,6 +715,11 @@ class KnowledgeBase:
         """The control step of this knowledge base's engine in one gateway call (see
         :class:`relrl.engine.Engine`, which decodes it); None when the step failed."""
         return self._engine.step(self.module, percepts, emitted, mode, want, self.timeout)
+
+    def interruptible(self) -> contextlib.AbstractContextManager[None]:
+        """A context in which Ctrl-C stops the running goal at once (see
+        :meth:`_Engine.interruptible`); for a user's queries at a terminal."""
+        return self._engine.interruptible()
 
     def hold(self, names: Iterable[str]) -> None:
         """Keep the atoms ``names`` (necessities, ...) so that the step reads them by

@@ -399,10 +399,11 @@ class Shell:
             self.execute(buffer)
 
     def _execute_at_terminal(self, text: str) -> None:
-        """Ctrl-C stops the query (once Prolog gives control back: at the latest when the
-        time limit strikes) and returns to the prompt, as at swipl's toplevel."""
+        """Ctrl-C stops the query at once and returns to the prompt, as at swipl's
+        toplevel."""
         try:
-            self.execute(text)
+            with self.kb.interruptible():
+                self.execute(text)
         except KeyboardInterrupt:
             self.print("\n% interrupted\n")
 
