@@ -76,19 +76,21 @@ def command(name: str, usage: str, help: str) -> Callable:
     return register
 
 
-def check_timeout(value: object) -> float:
-    """A query time limit in seconds: a positive, finite number.
+def check_timeout(value: object, flag: str | None = None) -> float:
+    """A time limit in seconds: a positive, finite number (``flag``: the command-line
+    flag that gave it, named in the error).
 
     Raises:
         ConfigError: anything else (0, a negative number, nan, inf, text): the limit of a
-            user's query cannot be switched off.
+            user's query (or of a run's rules) cannot be switched off.
     """
     try:
         seconds = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         seconds = math.nan
     if isinstance(value, bool) or not 0 < seconds < math.inf:
-        raise ConfigError(f"time limit {value!r}: use a positive number of seconds "
+        where = f"{flag}: " if flag else ""
+        raise ConfigError(f"{where}time limit {value!r}: use a positive number of seconds "
                           "(a query's time limit cannot be switched off)")
     return seconds
 
