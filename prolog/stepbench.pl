@@ -30,7 +30,7 @@ error. So the figures are of the same decisions the Python run made.
 Figures (per timed step; the warm-up steps are replayed untimed first): wall-clock and CPU
 microseconds and inferences, net of the replay loop's own cost (measured by the same loop
 with engine_step/6 left out), both with engine_step/6 called directly and through the
-gateway's time-limited call (gw_run/3, what Python calls). With profile(true), SWI-Prolog's
+gateway's time-limited call (gw_step/15, what Python calls). With profile(true), SWI-Prolog's
 profiler runs over the timed steps and the figures include each predicate's share of the
 time and its calls per step.
 
@@ -190,10 +190,10 @@ replay_step(direct, KB, s(Percepts, Emitted, Mode, Expected), I) :-
     relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
     same(I, Expected, Out).
 replay_step(gateway, KB, s(Percepts, Emitted, Mode, Expected), I) :-
-    relrl_gateway:gw_run(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
-                         60, Result),
+    relrl_gateway:gw_step(KB, Percepts, Emitted, Mode, [], 60, Result,
+                          Code, N, Ys, Reward, Reinforced, Mask, Action, Extras),
     (   Result == true
-    ->  same(I, Expected, Out)
+    ->  same(I, Expected, step(Code, N, Ys, Reward, Reinforced, Mask, Action, Extras))
     ;   throw(error(stepbench_step(I, Result), _))
     ).
 replay_step(overhead, _, s(_, _, _, r(C, N, Ys, R, Rf, M, A)), I) :-
