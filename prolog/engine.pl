@@ -297,14 +297,15 @@ engine_end_episode(KB) :-
 
 %!  engine_forget(+KB) is det.
 %
-%   Forget KB's engine (its configuration, last step and random stream).
+%   Forget KB's engine (its configuration, last step, random stream and compiled rules).
 
 engine_forget(KB) :-
     engine_key(KB, Key),
     (   nb_current(Key, _)
     ->  nb_delete(Key)
     ;   true
-    ).
+    ),
+    rules_forget(KB).
 
 %!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
 %

@@ -212,8 +212,8 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   extra test above the features' bits.
 
 %   What the hooks read every step, in a global variable per KB (its name made once):
-%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra as Goal-Bit pairs (their
-%   bits above the features'), and Numbers =
+%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra as a program of
+%   relrl_rules (their bits above the features'; `none` without extra tests), and Numbers =
 %   numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or `params` when
 %   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
 
@@ -237,13 +237,17 @@ relrl_engine:learner_init(etg, KB, Params) :-
     findall(G, declared(KB, etg_test(G)), Extra),
     length(Features, NF),
     extra_bits(Extra, NF, ExtraBits),
+    (   ExtraBits == []
+    ->  ExtraTests = none
+    ;   rules_program(KB, etg_tests, ExtraBits, ExtraTests)
+    ),
     (   maplist(param(Params), [alpha, gamma, epsilon, q_init, split_threshold],
                 [Alpha, Gamma, Epsilon, Qinit, Threshold])
     ->  Numbers = numbers(Alpha, Gamma, Epsilon, Qinit, Threshold)
     ;   Numbers = params
     ),
     config_key(KB, Key),
-    nb_setval(Key, etg(NF, ExtraBits, Numbers)),
+    nb_setval(Key, etg(NF, ExtraTests, Numbers)),
     append(Features, Extra, Tests),
     etg_init(KB, Tests).
 
@@ -254,10 +258,10 @@ extra_bits([G|Gs], I, [G-Bit|Bits]) :-
     extra_bits(Gs, I1, Bits).
 
 relrl_engine:learner_state(etg, KB, Code, D) :-
-    config(KB, etg(_, ExtraBits, _)),
-    (   ExtraBits == []
+    config(KB, etg(_, ExtraTests, _)),
+    (   ExtraTests == none
     ->  D = Code
-    ;   rules_mask(KB, ExtraBits, Code, D)
+    ;   program_mask(ExtraTests, Code, D)
     ).
 
 relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-

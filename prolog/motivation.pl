@@ -116,13 +116,13 @@ motivation_step(KB, Outputs, Active) :-
 %!  motivation_units(+KB, -Units:list) is det.
 %
 %   Units describes every necessity unit of KB as
-%   unit(N, Bias, Wr, Delta, Threshold, Initial, Inputs), Inputs = inputs(GoalBits, Weights)
-%   for the unit's inputs (necessity_inputs/3) in order: Goal-Bit pairs (bit j for the j-th
-%   input, as relrl_rules:rules_mask/4 takes them) and the weights. The engine computes it
-%   once per run and passes it to motivation_step/4.
+%   unit(N, Bias, Wr, Delta, Threshold, Initial, Inputs), Inputs = inputs(Program, Weights)
+%   for the unit's inputs (necessity_inputs/3) in order: a program of relrl_rules (bit j
+%   for the j-th input goal) and the weights. The engine computes it once per run and
+%   passes it to motivation_step/4.
 
 motivation_units(KB, Units) :-
-    findall(unit(N, B, Wr, Delta, T, Y0, inputs(GoalBits, Weights)),
+    findall(unit(N, B, Wr, Delta, T, Y0, inputs(Program, Weights)),
             ( kb_necessity(KB, N),
               unit_parameters(KB, N, Params),
               memberchk(bias=B, Params),
@@ -131,7 +131,8 @@ motivation_units(KB, Units) :-
               memberchk(threshold=T, Params),
               memberchk(initial=Y0, Params),
               necessity_inputs(KB, N, Inputs),
-              input_bits(Inputs, 1, GoalBits, Weights) ),
+              input_bits(Inputs, 1, GoalBits, Weights),
+              rules_program(KB, unit(N), GoalBits, Program) ),
             Units).
 
 input_bits([], _, [], []).
@@ -172,13 +173,13 @@ motivation_peek(KB, Units, Outputs, Active) :-
 
 %   Eq. 1 and 2 for every unit; Ir, the recurrent input, is the unit's previous output.
 unit_values([], _, _, [], []).
-unit_values([unit(N, B, Wr, Delta, _, Y0, inputs(GoalBits, Weights))|Us], KB, Previous,
+unit_values([unit(N, B, Wr, Delta, _, Y0, inputs(Program, Weights))|Us], KB, Previous,
             [N-Y|Os], [Y|Ys]) :-
     (   memberchk(N-Ir, Previous)
     ->  true
     ;   Ir = Y0
     ),
-    rules_mask(KB, GoalBits, 0, Holds),
+    program_mask(Program, 0, Holds),
     inputs_sum(Weights, Holds, 1, 0, Sum),
     U is Sum + Wr*Ir + B,
     Y is 1 / (1 + exp(-(U + Delta))),

@@ -105,13 +105,15 @@ active(fact(F), KB) :-
 %   the same code as features_code/3, for less work. The stimuli are read off working
 %   memory in one pass (memory elements indexed to the stimuli's bits: a stimulus holds
 %   when perceived, whatever rules say); each fact is still its goal, run by its rules
-%   through rule_holds/2 (errors and time limits propagate as there).
+%   (relrl_rules:rules_program/4: errors and time limits propagate as under rule_holds/2).
+%   Making a plan replaces KB's previous one.
 
-state_plan(KB, Features, plan(Masks, Facts)) :-
+state_plan(KB, Features, plan(Masks, Program)) :-
     must_be(atom, KB),
     must_be(list, Features),
     plan_(Features, 1, Masks0, Facts),
-    stimulus_masks(Masks0, Masks).
+    stimulus_masks(Masks0, Masks),
+    rules_program(KB, state_code, Facts, Program).
 
 plan_([], _, [], []).
 plan_([F|Fs], Bit, Masks, Facts) :-
@@ -145,21 +147,21 @@ merge_masks([S-B|Ps], Masks) :-
 %
 %   Code is the state code now, by a plan from state_plan/3.
 
-plan_code(KB, plan(Masks, Facts), Code) :-
+plan_code(KB, plan(Masks, Program), Code) :-
     (   Masks == []
     ->  Code0 = 0
     ;   wm_scan(KB, Masks, [], Code0, _)
     ),
-    rules_mask(KB, Facts, Code0, Code).
+    program_mask(Program, Code0, Code).
 
 %!  plan_code(+KB, +Plan, +Reinforcers:list, -Code, -Reinforced) is det.
 %
 %   plan_code/3, and Reinforced (true or false) as wm_scan/5 gives it for Reinforcers, from
 %   the same pass over working memory.
 
-plan_code(KB, plan(Masks, Facts), Reinforcers, Code, Reinforced) :-
+plan_code(KB, plan(Masks, Program), Reinforcers, Code, Reinforced) :-
     wm_scan(KB, Masks, Reinforcers, Code0, Reinforced),
-    rules_mask(KB, Facts, Code0, Code).
+    program_mask(Program, Code0, Code).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %

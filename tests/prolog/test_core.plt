@@ -332,6 +332,28 @@ test(rules_mask_passes_a_named_error_on,
     assertz(KB:(outer :- throw(relrl_rule_error(inner, here, oops)))),
     relrl_rules:rules_mask(KB, [outer-1], 0, _).
 
+%   A compiled program gives rules_mask/4's masks and errors.
+test(program_mask_as_rules_mask, [true(M1-M2 == 0b1101-0b1101)]) :-
+    relrl_gateway:gw_new_kb(KB),
+    assertz(KB:(yes)), assertz(KB:(no :- fail)),
+    GoalBits = [yes-4, no-2, yes-8],
+    relrl_rules:rules_mask(KB, GoalBits, 1, M1),
+    relrl_rules:rules_program(KB, t, GoalBits, P),
+    relrl_rules:program_mask(P, 1, M2).
+
+test(program_error_names_its_goal,
+     [throws(relrl_rule_error(boom(2), _, error(instantiation_error, _)))]) :-
+    relrl_gateway:gw_new_kb(KB),
+    assertz(KB:(ok)),
+    assertz(KB:(boom(_) :- atom_length(_, _))),
+    relrl_rules:rules_program(KB, t, [ok-1, boom(2)-2, ok-4], P),
+    relrl_rules:program_mask(P, 0, _).
+
+test(program_of_nothing, [M == 7]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_rules:rules_program(KB, t, [], P),
+    relrl_rules:program_mask(P, 7, M).
+
 test(memory_state_round_trip, [true(Now-All == [see(b)]-[0-see(b), 1-see(a)])]) :-
     relrl_gateway:gw_new_kb(KB),
     relrl_memory:wm_set_span(KB, 1),
