@@ -105,7 +105,7 @@ gateway can name the rule.
 %   so one KB never sees another's), holding engine(Run, Prev, Random):
 %     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
 %               Necessities, Plan) — fixed for a run, read without copying; Plan is the
-%               state code's plan (relrl_state:state_plan/3)
+%               state code's plan (relrl_state:state_plan/4)
 %     Prev    prev(State, Necessity) of the last step, or none
 %     Random  the KB's random state
 %   Prev and Random are replaced in place (nb_setarg/3) every step; eng(Prev, Random) is
@@ -222,8 +222,11 @@ engine_configure(KB, Learner, Params, Seed) :-
     findall(R, kb_response(KB, R), Responses),
     findall(S, kb_reinforcer(KB, S), Reinforcers),
     findall(N, kb_necessity(KB, N), Necessities),
-    motivation_units(KB, Units),
-    state_plan(KB, Features, Plan),
+    state_forget(KB),                                 % the last run's compiled rules
+    rules_forget(KB),
+    motivation_units(KB, Units0),
+    motivation_compiled(KB, Units0, Units),
+    state_plan(KB, Features, Reinforcers, Plan),
     (   has_constraints(KB)
     ->  Constraints = true
     ;   findall(I, nth0(I, Responses, _), AllIx),     % no constraint rules: all allowed,
@@ -305,6 +308,7 @@ engine_forget(KB) :-
     ->  nb_delete(Key)
     ;   true
     ),
+    state_forget(KB),
     rules_forget(KB).
 
 %!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
@@ -332,7 +336,7 @@ engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     nb_setarg(2, Engine, Next),
     nb_setarg(3, Engine, Random).
 
-step(KB, run(Learner, Params, _, Responses, Units, Reinforcers, Constraints, _, Plan),
+step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
      Prev, Percepts, EmittedIx, Mode, Want,
      step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
      prev(State, Active)) :-
@@ -341,7 +345,7 @@ step(KB, run(Learner, Params, _, Responses, Units, Reinforcers, Constraints, _, 
         wm_insert(KB, [emitted(Emitted)|Percepts])
     ;   wm_insert(KB, Percepts)
     ),
-    plan_code(KB, Plan, Reinforcers, Code, Reinforced),
+    plan_code(KB, Plan, Code, Reinforced),
     learner_view(Learner, KB, Code, State),
     motivation_values(KB, Units, _, Ys, Active),
     (   Reinforced == true

@@ -239,7 +239,7 @@ relrl_engine:learner_init(etg, KB, Params) :-
     extra_bits(Extra, NF, ExtraBits),
     (   ExtraBits == []
     ->  ExtraTests = none
-    ;   rules_program(KB, etg_tests, ExtraBits, ExtraTests)
+    ;   rules_program(KB, ExtraBits, ExtraTests)
     ),
     (   maplist(param(Params), [alpha, gamma, epsilon, q_init, split_threshold],
                 [Alpha, Gamma, Epsilon, Qinit, Threshold])

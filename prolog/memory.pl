@@ -5,7 +5,7 @@
             wm_has_chk/2,         % +KB, ?Element
             wm_now/2,             % +KB, ?Element
             wm_has_stimulus/2,    % +KB, +Stimulus
-            wm_scan/5,            % +KB, +StimulusMasks, +Reinforcers, -Mask, -Reinforced
+            wm_stamped/3,         % +KB, -Clock, -Pairs
             wm_elements/2,        % +KB, -Pairs
             wm_clear/1,           % +KB
             wm_span/2,            % +KB, -Span
@@ -222,50 +222,14 @@ sense_name(hear).
 sense_name(smell).
 sense_name(at).
 
-%!  wm_scan(+KB, +StimulusMasks:list, +Reinforcers:list, -Mask, -Reinforced) is det.
+%!  wm_stamped(+KB, -Clock, -Pairs:list) is det.
 %
-%   One pass over KB's memory for the control step. Mask is the bitwise or of the masks of
-%   the stimuli perceived (StimulusMasks lists Stimulus-Mask pairs of ground stimuli; a
-%   stimulus is perceived as in wm_has_stimulus/2). Reinforced is `true` when a stimulus
-%   of Reinforcers is sensed now (a Sense(S) percept of age 0, Sense one of see, hear,
-%   smell, at), else `false`.
+%   Clock is the number of insertions so far and Pairs the memory as Element-Stamp pairs,
+%   newest first (an element's age is Clock - Stamp): the whole memory in one read, for a
+%   pass over it (the state code's).
 
-wm_scan(KB, Masks, Reinforcers, Mask, Reinforced) :-
-    get(KB, wm(Clock, _, Pairs, _, _)),
-    scan(Pairs, Clock, Masks, Reinforcers, 0, Mask, false, Reinforced).
-
-scan([], _, _, _, Mask, Mask, R, R).
-scan([E-Stamp|Es], Clock, Masks, Rs, Mask0, Mask, R0, R) :-
-    (   compound(E),
-        scanned_stimulus(E, S, Sensed)
-    ->  (   memberchk(S-M, Masks)
-        ->  Mask1 is Mask0 \/ M
-        ;   Mask1 = Mask0
-        ),
-        (   R0 == false,
-            Sensed == true,
-            Stamp =:= Clock,
-            \+ \+ memberchk(S, Rs)
-        ->  R1 = true
-        ;   R1 = R0
-        )
-    ;   Mask1 = Mask0,
-        R1 = R0
-    ),
-    scan(Es, Clock, Masks, Rs, Mask1, Mask, R1, R).
-
-%   The stimulus an element perceives, and whether it is a sense percept Sense(S).
-scanned_stimulus(E, S, Sensed) :-
-    compound_name_arity(E, Name, Arity),
-    (   Arity =:= 1
-    ->  sense_name(Name),
-        arg(1, E, S),
-        Sensed = true
-    ;   Arity =:= 2,
-        Name == at,
-        arg(1, E, S),
-        Sensed = false
-    ).
+wm_stamped(KB, Clock, Pairs) :-
+    get(KB, wm(Clock, _, Pairs, _, _)).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
 %

@@ -1,7 +1,7 @@
 :- module(relrl_rules,
           [ rule_holds/2,         % +KB, +Goal
             rules_mask/4,         % +KB, +GoalBits, +Mask0, -Mask
-            rules_program/4,      % +KB, +Name, +GoalBits, -Program
+            rules_program/3,      % +KB, +GoalBits, -Program
             program_mask/3,       % +Program, +Mask0, -Mask
             rules_forget/1,       % +KB
             rule_solution/2,      % +KB, +Goal
@@ -63,24 +63,23 @@ rules_error(KB, GoalBits, running(I), E) :-
     ;   throw(E)
     ).
 
-%!  rules_program(+KB, +Name, +GoalBits:list, -Program) is det.
+%!  rules_program(+KB, +GoalBits:list, -Program) is det.
 %!  program_mask(+Program, +Mask0, -Mask) is det.
 %
 %   rules_mask/4 for a list of goals run many times (the state code's facts, a necessity
-%   unit's inputs): rules_program/4 compiles one clause that calls each goal of GoalBits
+%   unit's inputs): rules_program/3 compiles one clause that calls each goal of GoalBits
 %   directly (no call/1 of a goal term at run time, a fifth less time); program_mask/3 runs
-%   it, with rules_mask/4's results and errors. Name tells KB's programs apart (a new
-%   program replaces KB's program of the same name).
+%   it, with rules_mask/4's results and errors. A program lasts until rules_forget/1 (the
+%   engine forgets a KB's programs when it is configured again and when it is dropped).
 
-:- dynamic program_/6.              % Id, KB, Name, Running, Mask0, Mask (Id: unique)
+:- dynamic program_/5.              % Id, KB, Running, Mask0, Mask (Id: unique)
 
-rules_program(KB, Name, GoalBits, program(Id, KB, GoalBits)) :-
+rules_program(KB, GoalBits, program(Id, KB, GoalBits)) :-
     must_be(atom, KB),
     must_be(list, GoalBits),
-    retractall(program_(_, KB, Name, _, _, _)),
     flag(relrl_rules_program, Id, Id + 1),
     program_body(GoalBits, KB, Running, 1, Mask0, Mask, Body),
-    assertz((program_(Id, KB, Name, Running, Mask0, Mask) :- Body)).
+    assertz((program_(Id, KB, Running, Mask0, Mask) :- Body)).
 
 program_body([], _, _, _, Mask0, Mask, Mask = Mask0).
 program_body([Goal-Bit|Gs], KB, Running, I, Mask0, Mask,
@@ -97,7 +96,7 @@ program_body([Goal-Bit|Gs], KB, Running, I, Mask0, Mask,
 
 program_mask(program(Id, KB, GoalBits), Mask0, Mask) :-
     Running = running(0),
-    catch(program_(Id, _, _, Running, Mask0, Mask), E,
+    catch(program_(Id, _, Running, Mask0, Mask), E,
           rules_error(KB, GoalBits, Running, E)).
 
 %!  rules_forget(+KB) is det.
@@ -105,7 +104,7 @@ program_mask(program(Id, KB, GoalBits), Mask0, Mask) :-
 %   Forget KB's programs.
 
 rules_forget(KB) :-
-    retractall(program_(_, KB, _, _, _, _)).
+    retractall(program_(_, KB, _, _, _)).
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %

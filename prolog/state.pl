@@ -6,8 +6,10 @@
             state_code/2,         % +KB, -Code
             features_code/3,      % +KB, +Features, -Code
             state_plan/3,         % +KB, +Features, -Plan
+            state_plan/4,         % +KB, +Features, +Reinforcers, -Plan
             plan_code/3,          % +KB, +Plan, -Code
-            plan_code/5,          % +KB, +Plan, +Reinforcers, -Code, -Reinforced
+            plan_code/4,          % +KB, +Plan, -Code, -Reinforced
+            state_forget/1,       % +KB
             state_decode/3,       % +KB, +Code, -Terms
             state_encode/3        % +KB, +Terms, -Code
           ]).
@@ -100,20 +102,39 @@ active(fact(F), KB) :-
     rule_holds(KB, F).
 
 %!  state_plan(+KB, +Features:list, -Plan) is det.
+%!  state_plan(+KB, +Features:list, +Reinforcers:list, -Plan) is det.
 %
 %   Plan computes the code of Features (a list from state_features/2) with plan_code/3:
-%   the same code as features_code/3, for less work. The stimuli are read off working
-%   memory in one pass (memory elements indexed to the stimuli's bits: a stimulus holds
-%   when perceived, whatever rules say); each fact is still its goal, run by its rules
-%   (relrl_rules:rules_program/4: errors and time limits propagate as under rule_holds/2).
-%   Making a plan replaces KB's previous one.
+%   the same code as features_code/3, for less work, and whether a stimulus of Reinforcers
+%   is sensed now (plan_code/4). The stimuli are read off working memory in one pass: each
+%   memory element is looked up in a table of the percepts that perceive a stimulus (see(S),
+%   hear(S), smell(S), at(S), at(S, _) — what stimulus_perceived/2 accepts) and gives its
+%   stimulus's bits; a stimulus holds when perceived, whatever rules say. Each fact is
+%   still its goal, run by its rules (relrl_rules:rules_program/3: errors and time limits
+%   propagate as under rule_holds/2). A plan lasts until state_forget/1 and
+%   relrl_rules:rules_forget/1 (the engine's).
 
-state_plan(KB, Features, plan(Masks, Program)) :-
+:- dynamic
+    plan_kb_/2,             % Id, KB: KB's plan (one at a time)
+    plan_stimulus_/3,       % Id, Percept, Mask: Percept perceives the stimuli of Mask
+    plan_reinforcer_/2.     % Id, Percept: Percept senses a reinforcer
+
+state_plan(KB, Features, Plan) :-
+    state_plan(KB, Features, [], Plan).
+
+state_plan(KB, Features, Reinforcers, plan(Id, Program)) :-
     must_be(atom, KB),
     must_be(list, Features),
+    must_be(list, Reinforcers),
     plan_(Features, 1, Masks0, Facts),
     stimulus_masks(Masks0, Masks),
-    rules_program(KB, state_code, Facts, Program).
+    flag(relrl_state_plan, Id, Id + 1),
+    assertz(plan_kb_(Id, KB)),
+    forall(( member(S-Mask, Masks), perceives(S, Percept) ),
+           assertz(plan_stimulus_(Id, Percept, Mask))),
+    forall(( member(S, Reinforcers), sense(Sense), Percept =.. [Sense, S] ),
+           assertz(plan_reinforcer_(Id, Percept))),
+    rules_program(KB, Facts, Program).
 
 plan_([], _, [], []).
 plan_([F|Fs], Bit, Masks, Facts) :-
@@ -143,25 +164,49 @@ merge_masks([S-B|Ps], Masks) :-
         merge_masks(Ps, Masks1)
     ).
 
+%   The memory elements that perceive stimulus S.
+perceives(S, Percept) :-
+    sense(Sense),
+    Percept =.. [Sense, S].
+perceives(S, at(S, _)).
+
+%!  state_forget(+KB) is det.
+%
+%   Forget KB's plans' tables (their compiled facts go with relrl_rules:rules_forget/1).
+
+state_forget(KB) :-
+    forall(retract(plan_kb_(Id, KB)),
+           ( retractall(plan_stimulus_(Id, _, _)),
+             retractall(plan_reinforcer_(Id, _)) )).
+
 %!  plan_code(+KB, +Plan, -Code:integer) is det.
+%!  plan_code(+KB, +Plan, -Code:integer, -Reinforced) is det.
 %
-%   Code is the state code now, by a plan from state_plan/3.
+%   Code is the state code now, by a plan from state_plan/3,4; Reinforced is `true` when a
+%   stimulus of the plan's Reinforcers is sensed now (a Sense(S) percept of age 0, Sense
+%   one of see, hear, smell, at), else `false`: one pass over working memory for both.
 
-plan_code(KB, plan(Masks, Program), Code) :-
-    (   Masks == []
-    ->  Code0 = 0
-    ;   wm_scan(KB, Masks, [], Code0, _)
+plan_code(KB, Plan, Code) :-
+    plan_code(KB, Plan, Code, _).
+
+plan_code(KB, plan(Id, Program), Code, Reinforced) :-
+    wm_stamped(KB, Clock, Pairs),
+    scan(Pairs, Id, Clock, 0, Code0, false, Reinforced),
+    program_mask(Program, Code0, Code).
+
+scan([], _, _, Mask, Mask, R, R).
+scan([E-Stamp|Es], Id, Clock, Mask0, Mask, R0, R) :-
+    (   plan_stimulus_(Id, E, M)
+    ->  Mask1 is Mask0 \/ M
+    ;   Mask1 = Mask0
     ),
-    program_mask(Program, Code0, Code).
-
-%!  plan_code(+KB, +Plan, +Reinforcers:list, -Code, -Reinforced) is det.
-%
-%   plan_code/3, and Reinforced (true or false) as wm_scan/5 gives it for Reinforcers, from
-%   the same pass over working memory.
-
-plan_code(KB, plan(Masks, Program), Reinforcers, Code, Reinforced) :-
-    wm_scan(KB, Masks, Reinforcers, Code0, Reinforced),
-    program_mask(Program, Code0, Code).
+    (   R0 == false,
+        Stamp =:= Clock,
+        plan_reinforcer_(Id, E)
+    ->  R1 = true
+    ;   R1 = R0
+    ),
+    scan(Es, Id, Clock, Mask1, Mask, R1, R).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %

@@ -308,10 +308,11 @@ test(scan_masks_and_reinforcer, [true(R1-R2-M == true-false-5)]) :-
     relrl_gateway:gw_new_kb(KB),
     relrl_memory:wm_set_span(KB, 1),
     relrl_memory:wm_insert(KB, [hear(food), at(light, left)]),
-    relrl_state:state_plan(KB, [stimulus(light), stimulus(dark), stimulus(light)], Plan),
-    relrl_state:plan_code(KB, Plan, [food], M, R1),
+    relrl_state:state_plan(KB, [stimulus(light), stimulus(dark), stimulus(light)], [food],
+                           Plan),
+    relrl_state:plan_code(KB, Plan, M, R1),
     relrl_memory:wm_insert(KB, []),
-    relrl_state:plan_code(KB, Plan, [food], _, R2).
+    relrl_state:plan_code(KB, Plan, _, R2).
 
 test(rules_mask_or_of_holding_goals, [M == 0b1101]) :-
     relrl_gateway:gw_new_kb(KB),
@@ -338,7 +339,7 @@ test(program_mask_as_rules_mask, [true(M1-M2 == 0b1101-0b1101)]) :-
     assertz(KB:(yes)), assertz(KB:(no :- fail)),
     GoalBits = [yes-4, no-2, yes-8],
     relrl_rules:rules_mask(KB, GoalBits, 1, M1),
-    relrl_rules:rules_program(KB, t, GoalBits, P),
+    relrl_rules:rules_program(KB, GoalBits, P),
     relrl_rules:program_mask(P, 1, M2).
 
 test(program_error_names_its_goal,
@@ -346,13 +347,31 @@ test(program_error_names_its_goal,
     relrl_gateway:gw_new_kb(KB),
     assertz(KB:(ok)),
     assertz(KB:(boom(_) :- atom_length(_, _))),
-    relrl_rules:rules_program(KB, t, [ok-1, boom(2)-2, ok-4], P),
+    relrl_rules:rules_program(KB, [ok-1, boom(2)-2, ok-4], P),
     relrl_rules:program_mask(P, 0, _).
 
 test(program_of_nothing, [M == 7]) :-
     relrl_gateway:gw_new_kb(KB),
-    relrl_rules:rules_program(KB, t, [], P),
+    relrl_rules:rules_program(KB, [], P),
     relrl_rules:program_mask(P, 7, M).
+
+%   A run's compiled rules and tables are replaced when the engine is configured again,
+%   and go when it is forgotten.
+test(compiled_rules_do_not_pile_up, [true((N1 > 0, N2 == N1, N3 == 0))]) :-
+    kb_with('examples/domains/sis.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    compiled(KB, N1),
+    relrl_engine:engine_configure(KB, etg, P, 1),
+    compiled(KB, N2),
+    relrl_engine:engine_forget(KB),
+    compiled(KB, N3).
+
+compiled(KB, N) :-
+    aggregate_all(count, clause(relrl_rules:program_(_, KB, _, _, _), _), NP),
+    aggregate_all(count, ( relrl_state:plan_kb_(Id, KB),
+                           relrl_state:plan_stimulus_(Id, _, _) ), NS),
+    N is NP + NS.
 
 test(memory_state_round_trip, [true(Now-All == [see(b)]-[0-see(b), 1-see(a)])]) :-
     relrl_gateway:gw_new_kb(KB),
