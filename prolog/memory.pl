@@ -132,9 +132,18 @@ wm_insert(KB, New) :-
     ),
     Clock is Clock0 + 1,
     Oldest is Clock - Span,
-    stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
-    keep_old(Old, New, Oldest, KeptPairs, KeptElements),
-    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
+    duplicate_term(New, Fresh),
+    stamp(Fresh, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
+    keep_old(Old, Fresh, Oldest, KeptPairs, KeptElements),
+    key(KB, Key),
+    nb_linkval(Key, wm(Clock, Span, Pairs, Elements, Now)).
+
+%   The new memory is linked into the global variable, not copied as nb_setval/2 would
+%   (half an insertion's time). That is safe because nothing in it can be undone by
+%   backtracking: the new elements are a copy made here, the kept ones were stored by
+%   earlier insertions, and every list cell and pair is made by stamp/7 and keep_old/5
+%   below, which bind only variables younger than any choice point (if-then-else commits
+%   before it binds). nb_linkval/2 freezes the global stack, so the cells outlive the call.
 
 %   The new elements stamped, in front of PairsTail, and alone (Now), in front of Tail.
 stamp([], _, PairsTail, PairsTail, [], Tail, Tail).
@@ -148,12 +157,13 @@ stamp([E|Es], Clock, Pairs, PairsTail, Now, Elements, Tail) :-
     ).
 
 keep_old([], _, _, [], []).
-keep_old([E-S|Es], New, Oldest, Pairs, Elements) :-
+keep_old([P|Ps], New, Oldest, Pairs, Elements) :-
+    P = E-S,
     (   ( S < Oldest ; memberchk(E, New) )
-    ->  keep_old(Es, New, Oldest, Pairs, Elements)
-    ;   Pairs = [E-S|Pairs1],
+    ->  keep_old(Ps, New, Oldest, Pairs, Elements)
+    ;   Pairs = [P|Pairs1],
         Elements = [E|Elements1],
-        keep_old(Es, New, Oldest, Pairs1, Elements1)
+        keep_old(Ps, New, Oldest, Pairs1, Elements1)
     ).
 
 %!  wm_element(?KB, ?Element, ?Age) is nondet.

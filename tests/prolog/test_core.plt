@@ -373,6 +373,35 @@ compiled(KB, N) :-
                            relrl_state:plan_stimulus_(Id, _, _) ), NS),
     N is NP + NS.
 
+%   Memory is linked into its global variable (no second copy): what an insertion keeps
+%   must survive backtracking and garbage collection, even when the percepts were bound
+%   under a choice point (Z below is bound and unbound again by backtracking).
+test(memory_survives_backtracking,
+     [true(Pairs == [0-t(y), 1-t(x), 2-see(a)])]) :-
+    relrl_gateway:gw_new_kb(KB),
+    relrl_memory:wm_set_span(KB, 5),
+    relrl_memory:wm_insert(KB, [see(a)]),
+    relrl_memory:wm_insert(KB, [see(a)]),
+    relrl_memory:wm_insert(KB, [see(a), see(a)]),
+    (   true
+    ;   relrl_memory:wm_insert(KB, [see(a)])
+    ),
+    !,
+    T = t(Z),
+    (   member(V, [x, y]),
+        Z = V,
+        relrl_memory:wm_insert(KB, [T]),
+        fail
+    ;   true
+    ),
+    var(Z),
+    garbage_collect,
+    findall(N, ( between(1, 2000, I), N = f(I) ), _),
+    garbage_collect,
+    relrl_memory:wm_elements(KB, Pairs0),
+    msort(Pairs0, Pairs1),
+    Pairs1 = Pairs.
+
 test(memory_state_round_trip, [true(Now-All == [see(b)]-[0-see(b), 1-see(a)])]) :-
     relrl_gateway:gw_new_kb(KB),
     relrl_memory:wm_set_span(KB, 1),
