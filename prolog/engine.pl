@@ -34,6 +34,7 @@
 :- use_module(state).
 :- use_module(motivation).
 :- use_module(rules).
+:- use_module(gvar).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The control step, inside Prolog
@@ -112,14 +113,7 @@ gateway can name the rule.
 %   how the rest of this module sees the pair.
 
 engine_key(KB, Key) :-
-    (   engine_key_(KB, Key0)
-    ->  Key = Key0
-    ;   must_be(atom, KB),
-        atom_concat('$relrl_engine:', KB, Key),
-        assertz(engine_key_(KB, Key))
-    ).
-
-:- dynamic engine_key_/2.           % KB, the name of its global variable (made once)
+    gvar_key('$relrl_engine:', KB, Key).
 
 engine(KB, Engine) :-
     engine_key(KB, Key),

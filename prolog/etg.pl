@@ -13,6 +13,7 @@
 :- use_module(engine).
 :- use_module(declarations).
 :- use_module(rules).
+:- use_module(gvar).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Economic TG (ETG)
@@ -218,13 +219,7 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
 
 config_key(KB, Key) :-
-    (   config_key_(KB, Key0)
-    ->  Key = Key0
-    ;   atom_concat('$relrl_etg:', KB, Key),
-        assertz(config_key_(KB, Key))
-    ).
-
-:- dynamic config_key_/2.
+    gvar_key('$relrl_etg:', KB, Key).
 
 config(KB, Config) :-
     config_key(KB, Key),

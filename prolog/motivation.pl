@@ -16,6 +16,7 @@
 :- use_module(library(apply)).
 :- use_module(declarations).
 :- use_module(rules).
+:- use_module(gvar).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Consequence control: necessity units and the mediator
@@ -42,13 +43,7 @@ paper's weights are declared as satisfiers with their printed magnitudes.
 %   declaration order (no assert/retract in the robot's control step).
 
 outputs_key(KB, Key) :-
-    (   outputs_key_(KB, Key0)
-    ->  Key = Key0
-    ;   atom_concat('$relrl_units:', KB, Key),
-        assertz(outputs_key_(KB, Key))
-    ).
-
-:- dynamic outputs_key_/2.
+    gvar_key('$relrl_units:', KB, Key).
 
 get_outputs(KB, Outputs) :-
     outputs_key(KB, Key),

@@ -56,7 +56,7 @@ sensed(Sense, KB, What) :-
     ->  Percept =.. [Sense, What],
         wm_has(KB, Percept)
     ;   atomic(What)
-    ->  Percept =.. [Sense, What],
+    ->  compound_name_arguments(Percept, Sense, [What]),
         wm_has_chk(KB, Percept)
     ;   What =.. [_, Stimulus],
         atomic(Stimulus)

@@ -63,32 +63,10 @@ kb(KB) :-
 %
 %   Perception predicates over working memory; see relrl_perception:perceived/3.
 
-%   A stimulus (atomic) is looked up directly: what sensed/3 does for it, and what the
-%   control step asks many times.
-see(What) :-
-    context_module(KB),
-    (   atomic(What)
-    ->  wm_has_chk(KB, see(What))
-    ;   sensed(see, KB, What)
-    ).
-hear(What) :-
-    context_module(KB),
-    (   atomic(What)
-    ->  wm_has_chk(KB, hear(What))
-    ;   sensed(hear, KB, What)
-    ).
-smell(What) :-
-    context_module(KB),
-    (   atomic(What)
-    ->  wm_has_chk(KB, smell(What))
-    ;   sensed(smell, KB, What)
-    ).
-at(What) :-
-    context_module(KB),
-    (   atomic(What)
-    ->  wm_has_chk(KB, at(What))
-    ;   sensed(at, KB, What)
-    ).
+see(What)   :- context_module(KB), sensed(see, KB, What).
+hear(What)  :- context_module(KB), sensed(hear, KB, What).
+smell(What) :- context_module(KB), sensed(smell, KB, What).
+at(What)    :- context_module(KB), sensed(at, KB, What).
 
 %!  at(?Stimulus, ?Place) is nondet.
 %
