@@ -216,8 +216,8 @@ engine_configure(KB, Learner, Params, Seed) :-
     findall(R, kb_response(KB, R), Responses),
     findall(S, kb_reinforcer(KB, S), Reinforcers),
     findall(N, kb_necessity(KB, N), Necessities),
-    state_forget(KB),                                 % the last run's compiled rules
-    rules_forget(KB),
+    rules_mark(RulesMark),                            % what the last run compiled goes
+    state_mark(StateMark),                            % once this one is in place
     motivation_units(KB, Units0),
     motivation_compiled(KB, Units0, Units),
     state_plan(KB, Features, Reinforcers, Plan),
@@ -234,7 +234,9 @@ engine_configure(KB, Learner, Params, Seed) :-
                           none, Random)),
     wm_clear(KB),
     motivation_reset(KB),
-    with_random(KB, learner_init(Learner, KB, Params)).
+    with_random(KB, learner_init(Learner, KB, Params)),
+    rules_forget(KB, RulesMark),
+    state_forget(KB, StateMark).
 
 %   The domain has constraint rules: forbidden/1 has clauses, or may get them (dynamic).
 %   (relrl declares forbidden/1 in every knowledge base, so it always exists.)

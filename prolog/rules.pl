@@ -3,7 +3,9 @@
             rules_mask/4,         % +KB, +GoalBits, +Mask0, -Mask
             rules_program/3,      % +KB, +GoalBits, -Program
             program_mask/3,       % +Program, +Mask0, -Mask
+            rules_mark/1,         % -Mark
             rules_forget/1,       % +KB
+            rules_forget/2,       % +KB, +Mark
             rule_solution/2,      % +KB, +Goal
             rule_where/3          % +KB, +Goal, -Where
           ]).
@@ -99,12 +101,22 @@ program_mask(program(Id, KB, GoalBits), Mask0, Mask) :-
     catch(program_(Id, _, Running, Mask0, Mask), E,
           rules_error(KB, GoalBits, Running, E)).
 
+%!  rules_mark(-Mark) is det.
 %!  rules_forget(+KB) is det.
+%!  rules_forget(+KB, +Mark) is det.
 %
-%   Forget KB's programs.
+%   Forget KB's programs: all of them, or those made before rules_mark/1 gave Mark (the
+%   engine drops a run's programs once the next run is in place).
+
+rules_mark(Mark) :-
+    flag(relrl_rules_program, Mark, Mark).
 
 rules_forget(KB) :-
     retractall(program_(_, KB, _, _, _)).
+
+rules_forget(KB, Mark) :-
+    forall(( clause(program_(Id, KB, _, _, _), _, Ref), Id < Mark ),
+           erase(Ref)).
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %

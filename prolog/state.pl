@@ -9,7 +9,9 @@
             state_plan/4,         % +KB, +Features, +Reinforcers, -Plan
             plan_code/3,          % +KB, +Plan, -Code
             plan_code/4,          % +KB, +Plan, -Code, -Reinforced
+            state_mark/1,         % -Mark
             state_forget/1,       % +KB
+            state_forget/2,       % +KB, +Mark
             state_decode/3,       % +KB, +Code, -Terms
             state_encode/3        % +KB, +Terms, -Code
           ]).
@@ -170,13 +172,23 @@ perceives(S, Percept) :-
     Percept =.. [Sense, S].
 perceives(S, at(S, _)).
 
+%!  state_mark(-Mark) is det.
 %!  state_forget(+KB) is det.
+%!  state_forget(+KB, +Mark) is det.
 %
-%   Forget KB's plans' tables (their compiled facts go with relrl_rules:rules_forget/1).
+%   Forget the tables of KB's plans: all of them, or those made before state_mark/1 gave
+%   Mark. Their compiled facts go with relrl_rules:rules_forget/1,2.
+
+state_mark(Mark) :-
+    flag(relrl_state_plan, Mark, Mark).
 
 state_forget(KB) :-
-    forall(retract(plan_kb_(Id, KB)),
-           ( retractall(plan_stimulus_(Id, _, _)),
+    state_forget(KB, inf).
+
+state_forget(KB, Mark) :-
+    forall(( plan_kb_(Id, KB), Id < Mark ),
+           ( retractall(plan_kb_(Id, KB)),
+             retractall(plan_stimulus_(Id, _, _)),
              retractall(plan_reinforcer_(Id, _)) )).
 
 %!  plan_code(+KB, +Plan, -Code:integer) is det.
