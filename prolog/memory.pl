@@ -181,13 +181,11 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    (   key_(KB, Key)
-    ->  nb_getval(Key, wm(_, _, _, Elements, _)),
-        (   ground(Element)                 % one copy of an element at most
-        ->  memberchk(Element, Elements)
-        ;   member(Element, Elements)
-        )
-    ;   fail                            % no memory yet
+    key_(KB, Key),                      % none: no memory yet
+    nb_getval(Key, wm(_, _, _, Elements, _)),
+    (   ground(Element)                 % one copy of an element at most
+    ->  memberchk(Element, Elements)
+    ;   member(Element, Elements)
     ).
 
 %!  wm_has_chk(+KB, ?Element) is semidet.
