@@ -41,6 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
+from perception.cascade import Cascade, group
+
 __all__ = ["Face", "FaceParams", "FaceTracker", "detect_face"]
 
 _PROFILE_PAN = 70.0
@@ -92,19 +94,18 @@ class Face:
 
 _CASCADES: dict[str, object] = {}
 _FILES = {"frontal": "haarcascade_frontalface_alt2.xml", "profile": "haarcascade_profileface.xml"}
+_CASCADES_LOCK = threading.Lock()
 
 
 def _cascade(name: str):
-    """The OpenCV cascade ``name`` (loaded once per process)."""
-    import cv2
+    """The cascade ``name`` as a :class:`perception.cascade.Cascade` (loaded once per process;
+    one object serves every thread)."""
+    with _CASCADES_LOCK:
+        if name not in _CASCADES:
+            import cv2
 
-    if name not in _CASCADES:
-        path = Path(cv2.data.haarcascades) / _FILES[name]
-        c = cv2.CascadeClassifier(str(path))
-        if c.empty():  # pragma: no cover - the wheel ships the files
-            raise RuntimeError(f"cannot load the OpenCV cascade {path}")
-        _CASCADES[name] = c
-    return _CASCADES[name]
+            _CASCADES[name] = Cascade(Path(cv2.data.haarcascades) / _FILES[name])
+        return _CASCADES[name]
 
 
 def _search(grey: np.ndarray, kind: str, params: FaceParams, min_side: int,
@@ -114,8 +115,7 @@ def _search(grey: np.ndarray, kind: str, params: FaceParams, min_side: int,
 
     img = cv2.flip(grey, 1) if kind == "profile_mirrored" else grey
     cascade = _cascade("frontal" if kind == "frontal" else "profile")
-    hits = cascade.detectMultiScale(img, params.scale_factor, params.min_neighbors,
-                                    minSize=(min_side, min_side), maxSize=(max_side, max_side))
+    hits = cascade.detect(img, params.scale_factor, params.min_neighbors, min_side, max_side)
     return _largest(hits, kind, img.shape[1])
 
 
@@ -134,7 +134,6 @@ def _largest(hits, kind: str, width: int) -> tuple[int, int, int, int] | None:
 #: smallest sizes have the most windows and OpenCV halves its window step from twice the
 #: cascade's size (40 rows) up. Five bands keep two workers busy to the end of a search.
 _BAND_EDGES = (20, 23, 30, 46)
-_LOCAL = threading.local()
 
 
 def _bands(lo: int, hi: int) -> list[tuple[int, int]]:
@@ -145,22 +144,10 @@ def _bands(lo: int, hi: int) -> list[tuple[int, int]]:
 
 def _band_hits(img: np.ndarray, kind: str, params: FaceParams, lo: int,
                hi: int) -> list[list[int]]:
-    """Raw (ungrouped) hits of one cascade at sizes ``[lo, hi]``, run in a pool thread.
-
-    Every thread keeps its own classifiers, one per cascade and band: an OpenCV classifier
-    holds its scaled images while it searches, so two threads must not share one, and one that
-    always searches the same sizes keeps its prepared features.
-    """
-    import cv2
-
-    name = "frontal" if kind == "frontal" else "profile"
-    cache = _LOCAL.__dict__.setdefault("cascades", {})
-    if (name, lo, hi) not in cache:
-        cache[name, lo, hi] = cv2.CascadeClassifier(str(Path(cv2.data.haarcascades)
-                                                        / _FILES[name]))
-    hits = cache[name, lo, hi].detectMultiScale(img, params.scale_factor, 0,
-                                                 minSize=(lo, lo), maxSize=(hi, hi))
-    return [[int(v) for v in h] for h in hits]
+    """Raw (ungrouped, unclipped) hits of one cascade's full search at the sizes ``[lo, hi]``,
+    run in a pool thread (the compiled search releases the GIL)."""
+    return _cascade("frontal" if kind == "frontal" else "profile").raw(
+        img, params.scale_factor, params.min_size, min(img.shape[:2]), band=(lo, hi))
 
 
 def _search_pooled(grey: np.ndarray, params: FaceParams, pool: Executor):
@@ -181,8 +168,7 @@ def _search_pooled(grey: np.ndarray, params: FaceParams, pool: Executor):
         raw = [hit for task in tasks for hit in task.result()]  # in OpenCV's order: by size
         if not raw:
             continue
-        grouped, _ = cv2.groupRectangles(raw, params.min_neighbors, 0.2)
-        box = _largest(grouped, kind, grey.shape[1])
+        box = _largest(group(raw, params.min_neighbors, grey.shape), kind, grey.shape[1])
         if box is not None:
             for _, later in queued[k + 1:]:
                 for task in later:
