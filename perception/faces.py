@@ -4,6 +4,9 @@ Detection (a small real-time tracker rather than a brute-force search):
 
 * The frame is reduced to ``work_height`` rows (120 by default: a face must span at least
   ``min_size`` = 20 of them, a sixth of the frame) and searched at scale step ``scale_factor``.
+* Each search is OpenCV's ``detectMultiScale`` (same scales, windows, arithmetic, grouping: the
+  same faces) run by the compiled evaluator of :mod:`perception.cascade`, about 2.5 times
+  faster on one core.
 * The frontal cascade runs first. Only when it fails does the profile cascade run, first on the
   image (it finds faces whose nose points to the image's left) and then on the mirrored image
   (nose to the right).
@@ -11,9 +14,10 @@ Detection (a small real-time tracker rather than a brute-force search):
   around it, at sizes within ``[0.7, 1.4]`` of it, with the cascade that found it first. A full
   search is made when the window search fails.
 * Given a thread pool (``FaceTracker(pool=...)``, e.g. from ``Perceiver(threads=2)``), a full
-  search queues each cascade as tasks over bands of face sizes, frontal first, and groups each
-  cascade's raw hits as OpenCV's one call does: the same faces, in about half the wall time on
-  two free cores. A face found cancels the later cascades' tasks not yet started.
+  search queues each cascade as tasks over bands of face sizes of the same search, frontal
+  first, and groups each cascade's raw hits as the one call does: the same faces, in about
+  half the wall time on two free cores. A face found cancels the later cascades' tasks not yet
+  started.
 
 Pose (classes of :data:`perception.vocab.POSES`, in the image's frame):
 
@@ -130,9 +134,10 @@ def _largest(hits, kind: str, width: int) -> tuple[int, int, int, int] | None:
 
 
 #: the largest face side (working-image rows) of each band of a pooled search but the last:
-#: bands of about equal cost (20; 23; 26-30; 35-46; 53 up at scale step 1.15), since the
-#: smallest sizes have the most windows and OpenCV halves its window step from twice the
-#: cascade's size (40 rows) up. Five bands keep two workers busy to the end of a search.
+#: bands of similar cost (20; 23; 26-30; 35-46; 53 up at scale step 1.15: 16, 13, 20, 28 and
+#: 23 % of the compiled search on the bench photos), since the smallest sizes have the most
+#: windows and OpenCV halves its window step from twice the cascade's size (40 rows) up. Five
+#: bands keep two workers busy to the end of a search (1 to 4 bands measured no faster).
 _BAND_EDGES = (20, 23, 30, 46)
 
 
