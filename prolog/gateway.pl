@@ -1,5 +1,8 @@
 :- module(relrl_gateway,
           [ gw_run/3,             % :Goal, +TimeLimit, -Result
+            gw_step/15,           % +KB, +Percepts, +Emitted, +Mode, +Want, +TimeLimit,
+                                  % -Result, -Code, -Necessity, -Outputs, -Reward,
+                                  % -Reinforced, -Mask, -Action, -Extras
             gw_load/3,            % +File, +Module, -Problems
             gw_load/4,            % +File, +Module, +TimeLimit, -Problems
             gw_take_abort/1,      % -Where
@@ -26,6 +29,8 @@ Prolog error never escapes as an uncaught exception into the host and every quer
 bounded in time:
 
   - gw_run/3 runs a goal once under a time limit;
+  - gw_step/15 is gw_run/3 of the control step (relrl_engine:engine_step/6), its result
+    spread over output arguments that Python reads without decoding a term;
   - gw_load/4 consults a domain file into a knowledge-base module under a time limit and
     collects every error and warning with its file and line instead of printing them;
   - gw_query/5 parses a query typed by a user and collects its solutions as bindings.
@@ -54,6 +59,26 @@ process never see each other's clauses or working memory.
 gw_run(Goal, Limit, Result) :-
     active(catch(api_limited(Goal, Limit, Result0), E, error_result(E, Result0)), Result0,
            Result).
+
+%!  gw_step(+KB, +Percepts, +Emitted, +Mode, +Want, +TimeLimit, -Result,
+%!          -Code, -Necessity, -Outputs, -Reward, -Reinforced, -Mask, -Action,
+%!          -Extras) is det.
+%
+%   One control step: gw_run(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, Want,
+%   Out), TimeLimit, Result) — the same time limit, errors, halt and abort handling — with
+%   the fields of Out (step(Code, Necessity, Outputs, Reward, Reinforced, Mask, Action,
+%   Extras), see engine_step/6) as arguments of their own. Python reads each output with
+%   one foreign call instead of converting the whole result term: the step is the call
+%   the robot makes thousands of times a second. The outputs stay unbound unless Result
+%   is `true`.
+
+gw_step(KB, Percepts, Emitted, Mode, Want, Limit, Result,
+        Code, Necessity, Outputs, Reward, Reinforced, Mask, Action, Extras) :-
+    gw_run(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, Want, Out), Limit, Result),
+    (   Result == true
+    ->  Out = step(Code, Necessity, Outputs, Reward, Reinforced, Mask, Action, Extras)
+    ;   true
+    ).
 
 api_limited(Goal, Limit, Result) :-
     strip_module(Goal, M, G),
@@ -95,6 +120,17 @@ halt_message(Where, Message) :-
     ).
 
 :- initialization(at_halt(relrl_gateway:halt_hook)).
+
+%   Ctrl-C at the shell: kb.py's watcher thread raises SIGUSR1 in Prolog's thread
+%   (PL_thread_raise/2) while a user's query runs; the query stops with relrl_interrupted,
+%   reported as error(interrupted, _), at once instead of when its time limit strikes.
+:- initialization(on_signal(usr1, _, relrl_gateway:interrupt)).
+
+interrupt(_Signal) :-
+    (   nb_current(relrl_active, true)
+    ->  throw(relrl_interrupted)
+    ;   true                            % between gateway calls: nothing to stop
+    ).
 
 %   at_halt/1 hook: inside a gateway call, cancel the halt and remember where it came from.
 halt_hook :-
@@ -202,6 +238,9 @@ time_up :-
 %   rule_error(Goal, Where, Formal), policy_error(File, Line, Text), or the error term
 %   itself) and Message is one line for a person.
 
+error_result(relrl_interrupted, error(interrupted, "interrupted")) :- !.
+error_result(relrl_rule_error(_, _, relrl_interrupted), Result) :- !,
+    error_result(relrl_interrupted, Result).
 error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
     where_text(Where0, Where),
     format(string(GoalText), "~q", [Goal]),

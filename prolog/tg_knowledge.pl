@@ -122,13 +122,15 @@ graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], N
 %   each no-branch on the path, the negation of that test's query (a renamed copy: TILDE's
 %   semantics). action(T) becomes the head's action, necessity(T) its necessity; Q is
 %   rounded to three decimals. Inside a negation, what the clause already makes true is
-%   left out (an action the head fixes, a ground literal of the body), and a negated
-%   equality is written as X \= Y on the arguments that differ. Variables are named by
+%   left out: an action the head fixes, a ground literal of the body, and the part of the
+%   negated path query that shares no variable with the test's own literals (the body
+%   proves that part, so \+ (Path', Test) is \+ Test' there). A negated equality is
+%   written as X \= Y on the arguments that differ. Variables are named by
 %   type (P for a place, T for a toy), Action and Necessity in the head; a variable used
 %   once is written _.
 
 tg_leaf_clauses(KB, Clauses) :-
-    leaf_rules(KB, Rules),
+    leaf_rules(KB, short, Rules),
     maplist(named_rule, Rules, Clauses).
 
 named_rule(Rule-Names, Rule) :-
@@ -148,18 +150,21 @@ name_var(Counts, Name=V) :-
     ;   true
     ).
 
-%   Rule-Names for every leaf: the rule with its variables, and Name=Var for each.
-leaf_rules(KB, Rules) :-
+%   Rule-Names for every leaf: the rule with its variables, and Name=Var for each. Form
+%   `short` leaves out of each negation the path literals the body proves (as written in
+%   policy files since relrl 0.1); `full` negates the whole renamed path query, as policy
+%   files written before did: both read back.
+leaf_rules(KB, Form, Rules) :-
     tg_get_tree(KB, tree(Root, _, _, _)),
-    findall(R, leaf_clause(KB, Root, [], [], [], R), Rules).
+    findall(R, leaf_clause(KB, Form, Root, [], [], [], R), Rules).
 
-leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
+leaf_clause(KB, Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
     tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000.0,
     Head = q(Action, Necessity, Q),
     foldl(positive(Action, Necessity), Pos, Goals0, []),
     pairs_keys_values(Neg, NegTests, NegVars),
-    maplist(negative(Action, Necessity, Goals0), NegTests, NegGoals),
+    maplist(negative(Form, Action, Necessity, Goals0), NegTests, NegGoals),
     append(Goals0, NegGoals, Goals),
     append([Vars|NegVars], AllVars),
     name_variables(AllVars, Names0),
@@ -169,22 +174,30 @@ leaf_clause(KB, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
     ;   list_conj_(Goals, Body),
         Clause = (Head :- Body)
     ).
-leaf_clause(KB, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
+leaf_clause(KB, Form, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
     append(Pos, Lits, Pos1),
     append(Vars, New, Vars1),
-    (   leaf_clause(KB, Yes, Pos1, Neg, Vars1, Clause)
-    ;   copy_term(Pos1-Vars1, Test-TestVars),
-        append(Neg, [Test-TestVars], Neg1),
-        leaf_clause(KB, No, Pos, Neg1, Vars, Clause)
+    (   leaf_clause(KB, Form, Yes, Pos1, Neg, Vars1, Clause)
+    ;   copy_term(Pos-Lits-Vars1, PathCopy-TestCopy-TestVars),
+        append(Neg, [(PathCopy-TestCopy)-TestVars], Neg1),
+        leaf_clause(KB, Form, No, Pos, Neg1, Vars, Clause)
     ).
 
 positive(A, _, action(T), Gs, Gs) :- !, A = T.
 positive(_, N, necessity(T), Gs, Gs) :- !, N = T.
 positive(_, _, L, [L|Gs], Gs).
 
-%   The negation of a test's query (run after the positive goals Known).
-negative(A, N, Known, Lits, Goal) :-
-    maplist(body_literal(A, N), Lits, Goals0),
+%   The negation of a test's query, Path-Test renamed (run after the positive goals
+%   Known, which prove Path).
+negative(Form, A, N, Known, Path-Test, Goal) :-
+    maplist(body_literal(A, N), Path, PathGoals0),
+    maplist(body_literal(A, N), Test, TestGoals),
+    (   Form == short
+    ->  term_variables(A-N-Known, Outer),
+        linked(TestGoals, Outer, PathGoals0, PathGoals)
+    ;   PathGoals = PathGoals0
+    ),
+    append(PathGoals, TestGoals, Goals0),
     exclude(known_true(Known), Goals0, Goals),
     (   Goals == []
     ->  Goal = fail                        % the query holds whenever Known does
@@ -194,6 +207,37 @@ negative(A, N, Known, Lits, Goal) :-
     ;   list_conj_(Goals, Conj),
         Goal = (\+ Conj)
     ).
+
+%   linked(+Goals, +Outer, +Candidates, -Linked): the Candidates that share, directly or
+%   through other candidates, a variable not in Outer with Goals.
+linked(Goals, Outer, Candidates, Linked) :-
+    local_vars(Goals, Outer, Vs),
+    linked_(Candidates, Vs, Outer, Linked).
+
+linked_(Candidates, Vs, Outer, Linked) :-
+    partition(shares(Vs), Candidates, In, Out),
+    (   In == []
+    ->  Linked = []
+    ;   local_vars(In, Outer, Vs1),
+        append(Vs, Vs1, Vs2),
+        linked_(Out, Vs2, Outer, Linked0),
+        append(In, Linked0, Linked)
+    ).
+
+local_vars(Term, Outer, Vs) :-
+    term_variables(Term, Vs0),
+    exclude(in_vars(Outer), Vs0, Vs).
+
+shares(Vs, G) :-
+    term_variables(G, Gs),
+    member(V, Gs),
+    in_vars(Vs, V),
+    !.
+
+in_vars(Vs, V) :-
+    member(W, Vs),
+    W == V,
+    !.
 
 body_literal(A, _, action(T), A = T) :- !.
 body_literal(_, N, necessity(T), N = T) :- !.
@@ -344,7 +388,9 @@ typed_var(V-T) :-
 %   The q/3 rules of a policy are the tree written as rules: refuse a file whose rules
 %   say something else (an edited rule would otherwise be silently ignored).
 check_rules(KB, Terms) :-
-    leaf_rules(KB, Mine),
+    leaf_rules(KB, short, Short),
+    leaf_rules(KB, full, Full),
+    append(Short, Full, Mine),
     include(is_rule, Terms, Rules),
     forall(member(R, Rules),
            (   member(M-_, Mine), same_rule(R, M)

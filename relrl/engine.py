@@ -167,10 +167,12 @@ class Engine:
         self.learner = learner
         self.responses = one(self.kb, "responses", self.module)
         self.necessities = list(one(self.kb, "necessities", self.module))
+        self.kb.hold([*self.necessities, "none"])
 
     def step(self, percepts: Sequence[Term] | Cached, emitted: int = -1, mode: str = "learn",
              want: Iterable[str] = ()) -> StepResult:
-        """One control step: one gateway call.
+        """One control step: one gateway call (``relrl_gateway:gw_step/15``, the gateway's
+        form of ``engine_step/6`` whose result Python reads field by field).
 
         Args:
             percepts: this time unit's perception facts (a list, or a :class:`Cached` one).
@@ -181,17 +183,19 @@ class Engine:
         if not isinstance(percepts, Cached):
             percepts = Cached(percepts if isinstance(percepts, list) else list(percepts))
         want = list(want)
-        raw = call(self.kb, "step", self.module, percepts, emitted, mode, want, Var())[0]
-        (_, code, necessity, ys, reward, reinforced, mask, action, extras) = raw
+        raw = self.kb.step(percepts, emitted, mode, want)
+        if raw is None:
+            raise EngineError(f"{GOALS['step']}/6 failed in {self.module}")
+        code, necessity, ys, reward, reinforced, mask, action, extras = raw
         memory = memory_size = explanation = None
-        for _, key, value in extras:
+        for _, key, value in extras or ():
             if key == "memory":
                 memory = tuple((age, element) for (_, age, element) in value)
             elif key == "memory_size":
                 memory_size = value
             else:
                 explanation = value
-        return StepResult(code, necessity, tuple(ys), float(reward), reinforced == "true",
+        return StepResult(code, necessity, tuple(ys), float(reward), reinforced,
                           mask, action, memory, memory_size, explanation)
 
     def end_episode(self) -> None:

@@ -22,12 +22,14 @@ processes.
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import os
 import re
+import signal
 import threading
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from ctypes import POINTER, byref, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
 from dataclasses import dataclass
 from pathlib import Path
@@ -88,6 +90,9 @@ class Cached:
         self.key = key if key is not None else _hashable(value)
 
 
+_LIST_KEY = object()   # marks a list's key: no compound's key starts with it
+
+
 def _hashable(value: Term) -> Any:
     # Equal keys must mean equal terms: 1, 1.0 and True are equal in Python but not in
     # Prolog, and a list is not a compound. A string never equals a number or a tuple.
@@ -95,9 +100,12 @@ def _hashable(value: Term) -> Any:
     if kind is str:
         return value
     if kind is tuple:
-        return tuple(map(_hashable, value))
+        for item in value:
+            if type(item) is not str:
+                return tuple(map(_hashable, value))
+        return value          # atoms only (most percepts): the tuple is its own key
     if kind is list:
-        return ("[]", *map(_hashable, value))
+        return (_LIST_KEY, *map(_hashable, value))
     return (kind.__name__, value)
 
 
@@ -158,6 +166,8 @@ class _Engine:
         self.atom_nchars = fn("PL_atom_mbchars", c_int, T, POINTER(c_size_t),
                               POINTER(c_char_p), c_uint)
         self.get_arg = fn("PL_get_arg_sz", c_int, c_size_t, T, T)
+        self.get_atom = fn("PL_get_atom", c_int, T, POINTER(T))
+        self.get_nil = fn("PL_get_nil", c_int, T)
         self.get_list = fn("PL_get_list", c_int, T, T, T)
         self.predicate = fn("PL_predicate", c_void_p, c_char_p, c_int, c_char_p)
         self.open_frame = fn("PL_open_foreign_frame", T)
@@ -169,6 +179,9 @@ class _Engine:
         self.recorded = fn("PL_recorded", c_int, c_void_p, T)
         self.erase = fn("PL_erase", None, c_void_p)
         self._records: dict[Any, int] = {}
+        self.thread_raise = fn("PL_thread_raise", c_int, c_int, c_int)
+        self.prolog_thread = fn("PL_thread_self", c_int)()
+        self.busy = False          # a goal of run() or of an open query is running
         self.mark_strings = fn("PL_mark_string_buffers", None, POINTER(c_size_t))
         self.release_strings = fn("PL_release_string_buffers_from_mark", None, c_size_t)
 
@@ -177,6 +190,12 @@ class _Engine:
         self._gw_run = self.predicate(b"gw_run", 3, b"relrl_gateway")
         self.calls = 0
         self._bootstrap()
+        self._gw_step = self.predicate(b"gw_step", 15, b"relrl_gateway")
+        # Reused out-parameters of the step's reads (one thread uses the engine).
+        self._i64, self._f64, self._atom = c_int64(), c_double(), c_size_t()
+        self._held: dict[int, str] = {}
+        self._held_names: dict[str, int] = {}
+        self._true = self.hold("true")
 
     # -- Python -> Prolog ------------------------------------------------------------------
 
@@ -189,6 +208,17 @@ class _Engine:
             f = self.new_functor(atom, arity)
             self._functors[key] = f  # the functor keeps the atom alive
         return f
+
+    def hold(self, name: str) -> int:
+        """The handle of atom ``name``, referenced for the life of the process so that
+        reads can name it without converting text (see :meth:`step`)."""
+        atom = self._held_names.get(name)
+        if atom is None:
+            data = name.encode("utf-8")
+            atom = self.new_atom(_REP_UTF8, len(data), data)
+            self._held_names[name] = atom
+            self._held[atom] = name
+        return atom
 
     def put(self, t: int, value: Term, variables: dict[int, int]) -> None:
         """Write ``value`` into term reference ``t``."""
@@ -359,8 +389,12 @@ class _Engine:
             self.put(a0, goal, variables)
             self.put_float(a0 + 1, float(timeout or 0))
             self.put_variable(a0 + 2)
-            ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
-                                     self._gw_run, a0)
+            self.busy = True
+            try:
+                ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
+                                         self._gw_run, a0)
+            finally:
+                self.busy = False
             if not ok:
                 ex = self.exception(0)
                 if not ex:
@@ -391,6 +425,125 @@ class _Engine:
         finally:
             self.discard_frame(fid)
             self.release_strings(mark.value)
+
+    def step(self, module: str, percepts: Term, emitted: int, mode: str, want: list[str],
+             timeout: float) -> tuple | None:
+        """One control step through ``relrl_gateway:gw_step/15`` (the gateway's
+        ``engine_step/6`` under the same time limit and error handling as :meth:`run`).
+
+        The result's fields come back as arguments of their own and are read with one
+        foreign call each, not as a term converted node by node: the robot steps thousands
+        of times a second. Returns ``(code, necessity, outputs, reward, reinforced, mask,
+        action, extras)`` (``extras`` None when empty), or None when the step failed.
+        Raises QueryTimeout or PrologError as :meth:`run` does.
+        """
+        if threading.get_ident() != self.thread:
+            raise RelrlError("the Prolog engine belongs to the thread that started it; "
+                             "use processes, not threads, for parallel runs")
+        # No text is converted on the way (atoms are read by handle), so unlike run() the
+        # string stack needs marking only before a fallback conversion.
+        mark: list[int] = []
+
+        def slow(t: int) -> Term:       # any other term: converted, after marking
+            if not mark:
+                mark.append(self._mark())
+            return self.get(t)
+
+        fid = self.open_frame()
+        try:
+            self.calls += 1
+            a = self.new_term_refs(15)     # fresh variables
+            variables: dict[int, int] = {}
+            self.put(a, module, variables)
+            rec = self._records.get(percepts.key) if type(percepts) is Cached else None
+            if rec is not None:
+                self.recorded(rec, a + 1)
+            else:
+                self.put(a + 1, percepts, variables)
+            self.put_int64(a + 2, emitted)
+            self.put(a + 3, mode, variables)
+            if want:
+                self.put(a + 4, want, variables)
+            else:
+                self.put_nil(a + 4)
+            self.put_float(a + 5, float(timeout or 0))
+            if not self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
+                                       self._gw_step, a):
+                mark.append(self._mark())
+                ex = self.exception(0)
+                if not ex:
+                    self.clear_exception()
+                    raise self._aborted()
+                detail = self.get(ex)
+                self.clear_exception()
+                raise PrologError(f"gateway call failed: {detail!r}", detail)
+            atom, i64, f64 = self._atom, self._i64, self._f64
+            get_atom, get_int64, get_float = self.get_atom, self.get_int64, self.get_float
+            if not (get_atom(a + 6, atom) and atom.value == self._true):
+                result = slow(a + 6)
+                if result == "false":
+                    return None
+                _raise_result(result, timeout)
+            code = i64.value if get_int64(a + 7, i64) else slow(a + 7)  # else > 64 bits
+            if get_atom(a + 8, atom) and atom.value in self._held:
+                necessity = self._held[atom.value]
+            else:
+                necessity = slow(a + 8)
+            outputs = []
+            head, rest = self.new_term_ref(), a + 9
+            while self.get_list(rest, head, rest):
+                outputs.append(f64.value if get_float(head, f64) else slow(head))
+            reward = f64.value if get_float(a + 10, f64) else slow(a + 10)
+            reinforced = bool(get_atom(a + 11, atom) and atom.value == self._true)
+            mask = i64.value if get_int64(a + 12, i64) else slow(a + 12)  # > 63 responses
+            action = i64.value if get_int64(a + 13, i64) else slow(a + 13)
+            extras = None if not want or self.get_nil(a + 14) else slow(a + 14)
+            return code, necessity, outputs, reward, reinforced, mask, action, extras
+        finally:
+            self.discard_frame(fid)
+            if mark:
+                self.release_strings(mark[0])
+
+    def _mark(self) -> int:
+        """Mark the string stack (see :meth:`run`); release with ``release_strings``."""
+        mark = c_size_t()
+        self.mark_strings(byref(mark))
+        return mark.value
+
+    @contextlib.contextmanager
+    def interruptible(self) -> Iterator[None]:
+        """Within the block, Ctrl-C (SIGINT) stops the Prolog goal running at that moment
+        (a user's query), as at swipl's toplevel, instead of when its time limit strikes.
+
+        Python only sees a signal between bytecodes, not while Prolog runs: the signal's
+        byte arrives on a wakeup pipe (:func:`signal.set_wakeup_fd`) that a thread
+        watches; while a goal runs, the thread raises SIGUSR1 in Prolog's thread
+        (``PL_thread_raise``, safe from any thread), whose handler in gateway.pl throws
+        inside the goal. The goal ends with an error the gateway reports, and Python's own
+        KeyboardInterrupt follows. Outside the main thread this does nothing.
+        """
+        if threading.current_thread() is not threading.main_thread() \
+                or threading.get_ident() != self.thread:
+            yield
+            return
+        r, w = os.pipe()
+        os.set_blocking(w, False)
+        old = signal.set_wakeup_fd(w, warn_on_full_buffer=False)
+
+        def watch() -> None:
+            while data := os.read(r, 512):        # b"" once the write end is closed
+                if signal.SIGINT in data and self.busy:
+                    self.thread_raise(self.prolog_thread, signal.SIGUSR1)
+
+        watcher = threading.Thread(target=watch, name="relrl-interrupts", daemon=True)
+        watcher.start()
+        try:
+            yield
+        finally:
+            signal.set_wakeup_fd(old)
+            os.close(w)
+            watcher.join(5)
+            os.close(r)
 
     def _aborted(self) -> RelrlError:
         """The error for a goal that called abort/0 (asks gw_take_abort/1 where)."""
@@ -454,6 +607,8 @@ def _raise_result(result: Term, timeout: float) -> None:
             raise RuleError(message, "halt", None, error)
         if kind == "aborted":
             raise Aborted(None, None)
+        if kind == "interrupted":
+            raise KeyboardInterrupt
         raise PrologError(message, error)
     raise PrologError(f"unexpected gateway result {result!r}", result)
 
@@ -555,6 +710,22 @@ class KnowledgeBase:
         goal = (":", module or self.module, goal)
         outputs = [i for i, a in enumerate(arguments) if isinstance(a, Var)]
         return self._engine.run(goal, self.timeout if timeout is None else timeout, outputs)
+
+    def step(self, percepts: Term, emitted: int, mode: str, want: list[str]) -> tuple | None:
+        """The control step of this knowledge base's engine in one gateway call (see
+        :class:`relrl.engine.Engine`, which decodes it); None when the step failed."""
+        return self._engine.step(self.module, percepts, emitted, mode, want, self.timeout)
+
+    def interruptible(self) -> contextlib.AbstractContextManager[None]:
+        """A context in which Ctrl-C stops the running goal at once (see
+        :meth:`_Engine.interruptible`); for a user's queries at a terminal."""
+        return self._engine.interruptible()
+
+    def hold(self, names: Iterable[str]) -> None:
+        """Keep the atoms ``names`` (necessities, ...) so that the step reads them by
+        handle."""
+        for name in names:
+            self._engine.hold(name)
 
     def holds(self, goal: Term, *, timeout: float | None = None) -> bool:
         """True when ``goal`` (a term) succeeds in this knowledge base."""

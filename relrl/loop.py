@@ -77,7 +77,12 @@ class Agent:
         if r.explanation is not None:
             out.explanation = self.learner.decode_explanation(r.explanation)
         self.emitted = out.action
-        self._emitted = self._index_of(out.action)
+        if out.action is None:
+            self._emitted = -1
+        elif r.action_index >= 0 and out.action is responses[r.action_index]:
+            self._emitted = r.action_index      # the engine's own choice: its index
+        else:
+            self._emitted = self._index_of(out.action)
         self.steps += 1
         self.states.add(r.code)
         return out

@@ -98,7 +98,12 @@ class OpenQuery:
         engine.mark_strings(byref(mark))
         try:
             engine.calls += 1
-            if not self._next(self._qid):
+            engine.busy = True
+            try:
+                more = self._next(self._qid)
+            finally:
+                engine.busy = False
+            if not more:
                 ex = engine.exception(self._qid)
                 detail = engine.get(ex) if ex else None
                 self.close()

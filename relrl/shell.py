@@ -76,19 +76,21 @@ def command(name: str, usage: str, help: str) -> Callable:
     return register
 
 
-def check_timeout(value: object) -> float:
-    """A query time limit in seconds: a positive, finite number.
+def check_timeout(value: object, flag: str | None = None) -> float:
+    """A time limit in seconds: a positive, finite number (``flag``: the command-line
+    flag that gave it, named in the error).
 
     Raises:
         ConfigError: anything else (0, a negative number, nan, inf, text): the limit of a
-            user's query cannot be switched off.
+            user's query (or of a run's rules) cannot be switched off.
     """
     try:
         seconds = float(value)  # type: ignore[arg-type]
     except (TypeError, ValueError):
         seconds = math.nan
     if isinstance(value, bool) or not 0 < seconds < math.inf:
-        raise ConfigError(f"time limit {value!r}: use a positive number of seconds "
+        where = f"{flag}: " if flag else ""
+        raise ConfigError(f"{where}time limit {value!r}: use a positive number of seconds "
                           "(a query's time limit cannot be switched off)")
     return seconds
 
@@ -399,10 +401,11 @@ class Shell:
             self.execute(buffer)
 
     def _execute_at_terminal(self, text: str) -> None:
-        """Ctrl-C stops the query (once Prolog gives control back: at the latest when the
-        time limit strikes) and returns to the prompt, as at swipl's toplevel."""
+        """Ctrl-C stops the query at once and returns to the prompt, as at swipl's
+        toplevel."""
         try:
-            self.execute(text)
+            with self.kb.interruptible():
+                self.execute(text)
         except KeyboardInterrupt:
             self.print("\n% interrupted\n")
 

@@ -181,9 +181,9 @@ def _check_common(args: argparse.Namespace, config, learners_known) -> None:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     if args.address is not None and args.engine != "ray":
         raise ConfigError("--address applies to --engine ray only")
-    if not math.isfinite(args.timeout) or args.timeout <= 0:
-        raise ConfigError(f"--timeout must be a number of seconds > 0, not {args.timeout}")
-    config.timeout = args.timeout
+    from relrl.shell import check_timeout
+
+    config.timeout = check_timeout(args.timeout, "--timeout")
 
 
 def build_config(args: argparse.Namespace):

@@ -30,10 +30,7 @@ def run(args: argparse.Namespace) -> int:
     from relrl.kb import KnowledgeBase
     from relrl.shell import Shell, check_timeout
 
-    try:
-        timeout = check_timeout(args.timeout)
-    except ConfigError as exc:
-        raise ConfigError(f"--timeout: {exc}") from None
+    timeout = check_timeout(args.timeout, "--timeout")
     if args.max < 1:
         raise ConfigError(f"--max {args.max}: use a whole number >= 1")
     kb = KnowledgeBase(*args.domain)

@@ -270,8 +270,9 @@ def _check(args: argparse.Namespace) -> tuple[list[str], list[str], list[int]]:
         raise UserError("give at least one seed, learner and time unit")
     if args.every < 1 or args.workers < 1:
         raise UserError("--every and --workers must be at least 1")
-    if not (args.timeout > 0 and args.timeout < float("inf")):
-        raise UserError(f"--timeout must be a number of seconds > 0, not {args.timeout}")
+    from relrl.shell import check_timeout
+
+    check_timeout(args.timeout, "--timeout")
     load_episode(args.script)  # check it here, not in a worker
     return learners, units, seeds
 

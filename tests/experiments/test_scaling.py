@@ -119,8 +119,8 @@ def test_growth_is_the_log_log_slope() -> None:
      "--transfer places sets the placement weights"),
     (["--eval-runs", "0"], "--eval-runs must be at least 1"),
     (["--workers", "0"], "--workers must be at least 1"),
-    (["--timeout", "nan"], "--timeout must be a number of seconds > 0"),
-    (["--timeout", "0"], "--timeout must be a number of seconds > 0"),
+    (["--timeout", "nan"], "--timeout: time limit"),
+    (["--timeout", "0"], "--timeout: time limit"),
 ])
 def test_bad_sweep_options_one_line_exit_2(args: list[str], message: str, tmp_path: Path,
                                            capsys) -> None:

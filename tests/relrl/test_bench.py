@@ -19,7 +19,10 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
         assert 0.99 <= learner["gateway_calls_per_step"] <= 1.01
         assert learner["cpu_us_per_step"] > 0
         assert learner["step_in_gateway_calls"] == \
+            learner["agent_us_per_step"] / figures["gateway_call_us"]
+        assert learner["interaction_step_in_gateway_calls"] == \
             learner["us_per_step"] / figures["gateway_call_us"]
+        assert 0 < learner["agent_us_per_step"] < learner["us_per_step"]
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "tg_steps_per_second>=3000" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out

@@ -300,3 +300,26 @@ def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
         assert isinstance(deep, str) and "(...)" in deep
         (answer,), _ = kb.query("X = [1, 2, f(a)]")
         assert answer[0][1] == [1, 2, ("f", "a")]
+
+
+def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path) -> None:
+    """The step's fast read (gw_step/15) falls back to full conversion where a field does
+    not fit its one-call read: a state code or a response mask beyond 64 bits."""
+    n = 70
+    text = "".join(f"stimulus(s{i}).\nresponse(r{i}).\n" for i in range(n))
+    with KnowledgeBase(domain(tmp_path, text)) as kb:
+        engine = Engine(kb)
+        engine.configure("etg", {**make_learner("etg").params}, seed=0)
+        features = kb.features()
+        r = engine.step([("see", f"s{n - 1}")])
+        assert r.code == 2 ** features.index(("stimulus", f"s{n - 1}")) and r.code >= 2 ** 63
+        assert r.allowed_mask == 2 ** n - 1 and r.allowed_index == list(range(n))
+        assert engine.responses[r.action_index] in {f"r{i}" for i in range(n)}
+        assert r.necessity == "none" and r.outputs == () and not r.reinforced
+
+
+def test_step_failure_and_errors_through_the_fast_read(tmp_path: Path) -> None:
+    with KnowledgeBase(TINY) as kb:
+        engine = Engine(kb)
+        with pytest.raises(PrologError):        # not configured: an error, never a crash
+            engine.step([("see", "light")])

@@ -4,6 +4,7 @@ with no further learning, on places it never saw; save -> load -> same choices; 
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -243,3 +244,41 @@ def test_bad_parameter_on_the_command_line(capsys) -> None:
     assert main(["experiment", "sis", "--learners", "tg", "--param", "tg.half_life=-1",
                  "--quick", "--out", "/nonexistent/never-written"]) == 2
     assert "half_life must be >= 0" in capsys.readouterr().err
+
+
+def test_negations_leave_out_what_the_body_proves_and_old_policies_load(tmp_path: Path) -> None:
+    """A no-branch below a test that introduced a variable is written as the negation of
+    the test alone when it shares no variable with the path (the body proves the path);
+    a policy written with the whole path query in the negation, as before, still loads."""
+    from relrl.experiments.sis import DEFAULT_DOMAIN
+    from relrl.sim.caregiver import make_caregiver
+    from relrl.sim.sis import SharedAttentionEnv
+
+    with KnowledgeBase(DEFAULT_DOMAIN) as kb:
+        agent = Agent(kb, make_learner("tg"), seed=0)
+        env = SharedAttentionEnv(make_caregiver("paper"), max_steps=None, record_trace=False)
+        run(env, agent, 4000, seed=0)
+        path = agent.learner.save(tmp_path / "tg.pl")
+        text = path.read_text()
+        m = re.search(r"q\(look\(P\), _, [0-9.]+\) :-\n    gaze\(face, P\),\n"
+                      r"    gaze\(face, centre\),\n    \\\+ heard\(attention\)\.\n", text)
+        assert m, text                          # the short form: \+ heard(attention)
+        short = m.group(0)
+        full = short.replace("    \\+ heard(attention).\n",
+                             "    \\+ ( gaze(face, P1),\n         look(P)=look(P1),\n"
+                             "         heard(attention)\n       ).\n")
+        assert full != short
+        old = tmp_path / "old.pl"
+        old.write_text(text.replace(short, full))
+        fresh_env = SharedAttentionEnv(make_caregiver("paper"), max_steps=None,
+                                       record_trace=False)
+        before = [r.out.action for r in run(fresh_env, agent, 200, learning=False, seed=5)]
+        agent.learner.load(old)
+        after = [r.out.action for r in run(fresh_env, agent, 200, learning=False, seed=5)]
+        assert after == before
+        wrong = tmp_path / "wrong.pl"          # a negation of something else is refused
+        wrong.write_text(text.replace(short, full.replace("heard(attention)", "sees(toy)")))
+        from relrl.errors import PolicyError
+
+        with pytest.raises(PolicyError):
+            agent.learner.load(wrong)
