@@ -207,7 +207,7 @@ class Cascade:
         search = _kernels()
         h, w = grey.shape
         scales = _scales(w, h, self.window, scale_factor, min_size, max_size)
-        if search is None:  # pragma: no cover - numba is a dependency
+        if search is None:
             return self._opencv_hits(grey, scale_factor, 0, min_size, max_size, scales, band)
         if not scales:
             return []
@@ -264,13 +264,14 @@ class Cascade:
             min_neighbors: a group needs more than this many raw hits.
             min_size, max_size: window sides searched, in image pixels.
         """
-        if _kernels() is None:  # pragma: no cover - numba is a dependency
-            return self._opencv_hits(grey, scale_factor, min_neighbors, min_size, max_size)
+        if _kernels() is None:
+            return [tuple(hit) for hit in self._opencv_hits(grey, scale_factor, min_neighbors,
+                                                             min_size, max_size)]
         return group(self.raw(grey, scale_factor, min_size, max_size), min_neighbors,
                      grey.shape)
 
     def _opencv_hits(self, grey, scale_factor, min_neighbors, min_size, max_size,
-                     scales=None, band=None):  # pragma: no cover - numba is a dependency
+                     scales=None, band=None):
         """OpenCV's own search (a band as one call over its sizes: the same hits but for rows
         OpenCV's stripes leave out at the bottom)."""
         import cv2

@@ -120,3 +120,17 @@ def test_parse_reads_the_cascade_and_rejects_what_it_cannot_run(tmp_path):
                                 "<featureType>LBP</featureType>"))
     with pytest.raises(ValueError, match="not a boosted Haar cascade"):
         parse_cascade(lbp)
+
+
+def test_without_numba_the_same_calls_run_opencv(monkeypatch, images):
+    import perception.cascade as cascade_module
+
+    monkeypatch.setattr(cascade_module, "_kernels", lambda: None)
+    ours, theirs = Cascade(_DIR / _FILES[0]), cv2.CascadeClassifier(str(_DIR / _FILES[0]))
+    for img in images[:6]:
+        side = min(img.shape)
+        assert sorted(ours.detect(img, 1.15, 3, 20, side)) == _opencv(theirs, img, 1.15, 3, 20,
+                                                                       side)
+        assert sorted(map(tuple, ours.raw(img, 1.15, 20, side))) == _opencv(theirs, img, 1.15, 0,
+                                                                             20, side)
+        assert ours.raw(img, 1.15, 20, side, band=(41, 45)) == []  # no step of 1.15 there
