@@ -202,9 +202,13 @@ class Cascade:
 
         Returns:
             The raw hits by scale, then row, then column: OpenCV's set of raw hits.
+
+        Raises:
+            ValueError: for an image that is not 2-D uint8, or a scale step not above 1.
         """
         import cv2
 
+        _check(grey, scale_factor)
         search = _kernels()
         h, w = grey.shape
         scales = _scales(w, h, self.window, scale_factor, min_size, max_size)
@@ -265,6 +269,7 @@ class Cascade:
             min_neighbors: a group needs more than this many raw hits.
             min_size, max_size: window sides searched, in image pixels.
         """
+        _check(grey, scale_factor)
         if _kernels() is None:
             return [tuple(hit) for hit in self._opencv_hits(grey, scale_factor, min_neighbors,
                                                              min_size, max_size)]
@@ -292,6 +297,14 @@ class Cascade:
                                            minSize=(min_size, min_size),
                                            maxSize=(max_size, max_size))
         return [[int(v) for v in hit] for hit in hits]
+
+
+def _check(grey: np.ndarray, scale_factor: float) -> None:
+    if not isinstance(grey, np.ndarray) or grey.ndim != 2 or grey.dtype != np.uint8:
+        got = getattr(grey, "shape", type(grey).__name__), getattr(grey, "dtype", "")
+        raise ValueError(f"a cascade searches a 2-D uint8 image, got {got}")
+    if not scale_factor > 1:
+        raise ValueError(f"the scale step must be above 1, got {scale_factor!r}")
 
 
 def group(raw: list[list[int]], min_neighbors: int,

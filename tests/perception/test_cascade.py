@@ -134,3 +134,13 @@ def test_without_numba_the_same_calls_run_opencv(monkeypatch, images):
         assert sorted(map(tuple, ours.raw(img, 1.15, 20, side))) == _opencv(theirs, img, 1.15, 0,
                                                                              20, side)
         assert ours.raw(img, 1.15, 20, side, band=(41, 45)) == []  # no step of 1.15 there
+
+
+def test_bad_input_is_refused():
+    cascade = Cascade(_DIR / _FILES[0])
+    with pytest.raises(ValueError, match="2-D uint8"):
+        cascade.raw(np.zeros((40, 40, 3), np.uint8), 1.15, 20, 40)
+    with pytest.raises(ValueError, match="2-D uint8"):
+        cascade.detect(np.zeros((40, 40), np.float32), 1.15, 3, 20, 40)
+    with pytest.raises(ValueError, match="above 1"):
+        cascade.raw(np.zeros((40, 40), np.uint8), 1.0, 20, 40)
