@@ -3,14 +3,14 @@
 OpenCV's ``CascadeClassifier`` only says "face" or "no face" for a window. To build a synthetic
 face the real detector responds to (see :mod:`perception.texture`) we need a graded score: how
 many stages a window passes and by what margin. This module reads the cascade XML shipped in the
-wheel and evaluates windows the way OpenCV does (variance-normalised Haar features on an
-integral image, stage sums of stump leaves against stage thresholds). It is used offline, by the
-texture generator; the detector itself always uses OpenCV.
+wheel (with :func:`perception.cascade.parse_cascade`) and evaluates windows the way OpenCV does
+(variance-normalised Haar features on an integral image, stage sums of stump leaves against stage
+thresholds). It is used offline, by the texture generator; the detector itself uses the compiled
+search of :mod:`perception.cascade`, which gives OpenCV's detections.
 """
 
 from __future__ import annotations
 
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -35,27 +35,22 @@ class HaarCascade:
     """
 
     def __init__(self, path: str | Path) -> None:
-        root = ET.parse(str(path)).getroot()[0]
-        self.width = int(root.findtext("width"))
-        self.height = int(root.findtext("height"))
-        feats = []
-        for f in root.find("features"):
-            rects = [[float(v) for v in r.text.split()] for r in f.find("rects")]
-            rects += [[0.0, 0.0, 0.0, 0.0, 0.0]] * (3 - len(rects))
-            feats.append(rects)
-        table = np.array(feats)
+        from perception.cascade import parse_cascade
+
+        m = parse_cascade(path)
+        if m.weak[:, 0].max() != 1:
+            raise ValueError(f"{path}: only stump cascades are supported")
+        self.width, self.height = m.width, m.height
+        table = np.concatenate([m.rects.astype(np.float64), m.weights[:, :, None]], axis=2)
         self.stages: list[_Stage] = []
-        for s in root.find("stages"):
-            idx, ths, leaves = [], [], []
-            for weak in s.find("weakClassifiers"):
-                nodes = weak.findtext("internalNodes").split()
-                if len(nodes) != 4:
-                    raise ValueError(f"{path}: only stump cascades are supported")
-                idx.append(int(nodes[2]))
-                ths.append(float(nodes[3]))
-                leaves.append([float(v) for v in weak.findtext("leafValues").split()])
-            self.stages.append(_Stage(float(s.findtext("stageThreshold")), table[idx],
-                                      np.array(ths), np.array(leaves)))
+        for threshold, first, count in zip(m.stage_threshold, m.stage_first, m.stage_count,
+                                           strict=True):
+            weak = m.weak[first:first + count]
+            nodes = weak[:, 1]
+            self.stages.append(_Stage(float(threshold), table[m.nodes[nodes, 2]],
+                                      m.node_threshold[nodes],
+                                      np.stack([m.leaves[weak[:, 2]], m.leaves[weak[:, 2] + 1]],
+                                               axis=1)))
 
     def evaluate(self, grey: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Score windows of the cascade's size at the given top-left corners.

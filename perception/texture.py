@@ -80,6 +80,7 @@ def score_with_opencv(patch: np.ndarray, frames) -> np.ndarray:
     import cv2
 
     from perception import render as rmod
+    from perception.cascade import group
     from perception.faces import FaceParams, _cascade
 
     p = FaceParams()
@@ -93,9 +94,8 @@ def score_with_opencv(patch: np.ndarray, frames) -> np.ndarray:
                           interpolation=cv2.INTER_AREA)
         if view.face_pose.startswith("right"):
             grey = cv2.flip(grey, 1)
-        raw = cascade.detectMultiScale(grey, p.scale_factor, 0, minSize=(p.min_size,) * 2)
-        hits = [list(map(int, r)) for r in raw]
-        grouped, _ = cv2.groupRectangles(hits, p.min_neighbors, 0.2) if hits else ((), 0)
+        hits = cascade.raw(grey, p.scale_factor, p.min_size, min(grey.shape))
+        grouped = group(hits, p.min_neighbors, grey.shape)
         out.append(min(len(hits), 10) / 10.0 + 2.0 * (len(grouped) > 0))
     rmod._TEXTURE.clear()
     return np.array(out)

@@ -14,8 +14,9 @@ def test_photo_figures_wall_cpu_and_stages():
             assert out[key.format(size)] > 0, key
     stages = out["ms_photos_320x240_cold"]
     assert set(stages) == {"faces", "saliency", "colour"} and min(stages.values()) > 0
-    assert out["faces_found"] >= 90 and out["false_detections"] == 0
-    assert out["pose_frames"] == 192 and out["poses_right"] >= 185
+    # the quality figures the speed work keeps (98 / 100 lfw faces, 0 false, 191 / 192 poses)
+    assert out["faces_found"] >= 98 and out["false_detections"] == 0
+    assert out["pose_frames"] == 192 and out["poses_right"] >= 191
 
 
 def _burn(seconds: float) -> float:

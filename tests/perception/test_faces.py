@@ -29,8 +29,10 @@ def test_no_face_in_a_blank_or_noisy_frame():
 
 
 def test_lfw_recall_and_no_false_detection():
+    # the figures of the full search today (98 / 100 faces, 0 on 100 non-faces): a faster
+    # search must not find fewer faces or any non-face
     figures = lfw_figures()
-    assert figures["faces_found"] >= 90
+    assert figures["faces_found"] >= 98
     assert figures["false_detections"] == 0
 
 
