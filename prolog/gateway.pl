@@ -47,7 +47,7 @@ A knowledge base is a module of its own (gw_new_kb/1), so two knowledge bases in
 process never see each other's clauses or working memory.
 */
 
-:- meta_predicate gw_run(0, +, -).
+:- meta_predicate gw_run(0, +, -), guarded(0, +, -), api_call(0), once_result(0, -).
 
 %!  gw_run(:Goal, +TimeLimit, -Result) is det.
 %
@@ -57,8 +57,7 @@ process never see each other's clauses or working memory.
 %   A TimeLimit of 0 means no limit.
 
 gw_run(Goal, Limit, Result) :-
-    active(catch(api_limited(Goal, Limit, Result0), E, error_result(E, Result0)), Result0,
-           Result).
+    guarded(api_call(Goal), Limit, Result).
 
 %!  gw_step(+KB, +Percepts, +Emitted, +Mode, +Want, +TimeLimit, -Result,
 %!          -Code, -Necessity, -Outputs, -Reward, -Reinforced, -Mask, -Action,
@@ -74,13 +73,14 @@ gw_run(Goal, Limit, Result) :-
 
 gw_step(KB, Percepts, Emitted, Mode, Want, Limit, Result,
         Code, Necessity, Outputs, Reward, Reinforced, Mask, Action, Extras) :-
-    gw_run(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, Want, Out), Limit, Result),
+    guarded(relrl_engine:engine_step(KB, Percepts, Emitted, Mode, Want, Out), Limit, Result),
     (   Result == true
     ->  Out = step(Code, Necessity, Outputs, Reward, Reinforced, Mask, Action, Extras)
     ;   true
     ).
 
-api_limited(Goal, Limit, Result) :-
+%   A goal of a knowledge-base module or of python_api/1; anything else is refused.
+api_call(Goal) :-
     strip_module(Goal, M, G),
     (   callable(G),
         functor(G, Name, Arity),
@@ -88,13 +88,59 @@ api_limited(Goal, Limit, Result) :-
         ->  true
         ;   python_api(M:Name/Arity)
         )
-    ->  limited(Goal, Limit, Result)
+    ->  call(Goal)
     ;   functor(G, Name, Arity),
         permission_error(call, private_predicate, M:Name/Arity)
     ).
 
-%   Run Goal as a gateway call: halt/0,1 is cancelled while it runs (see halt_hook/0) and
-%   turns Result0 into an error result.
+%   Run Goal once as a gateway call, under the time limit Limit (0: none): Result is true,
+%   false or error(E, Message). While it runs, halt/0,1 is cancelled (see halt_hook/0;
+%   Result then says so) and Ctrl-C may stop it (interrupt/1). One setup_call_cleanup/3
+%   sets and restores the flags and the deadline (see limited/3) for both.
+guarded(Goal, Limit, Result) :-
+    (   nb_current(relrl_active, Was)
+    ->  true
+    ;   Was = false
+    ),
+    nb_getval(relrl_deadline, Outer),
+    (   Limit > 0
+    ->  get_time(Now),
+        Deadline0 is Now + Limit,
+        (   Outer \== none,
+            Outer < Deadline0
+        ->  Deadline = Outer
+        ;   Deadline = Deadline0
+        )
+    ;   Deadline = Outer
+    ),
+    setup_call_cleanup(
+        enter_call(Deadline),
+        catch(once_result(Goal, Result0), E,
+              ( nb_setval(relrl_deadline, Outer),     % the error's report is not timed
+                error_result(E, Result0) )),
+        leave_call(Was, Outer)),
+    nb_getval(relrl_halt, Halt),
+    (   Halt == none
+    ->  Result = Result0
+    ;   nb_setval(relrl_halt, none),
+        halt_message(Halt, Message),
+        Result = error(halt_called(Halt), Message)
+    ).
+
+enter_call(Deadline) :-
+    nb_setval(relrl_active, true),
+    nb_setval(relrl_halt, none),
+    (   Deadline == none
+    ->  true
+    ;   set_deadline(Deadline)
+    ).
+
+leave_call(Was, Outer) :-
+    nb_setval(relrl_active, Was),
+    nb_setval(relrl_deadline, Outer).
+
+%   Run Goal (which catches its own errors) with halt/0,1 cancelled: Result is Result0,
+%   or error(halt_called(Where), Message) when Goal called halt (gw_load/4).
 active(Goal, Result0, Result) :-
     (   nb_current(relrl_active, Was)
     ->  true
@@ -110,6 +156,12 @@ active(Goal, Result0, Result) :-
     ;   nb_setval(relrl_halt, none),
         halt_message(Halt, Message),
         Result = error(halt_called(Halt), Message)
+    ).
+
+once_result(Goal, Result) :-
+    (   call(Goal)
+    ->  Result = true
+    ;   Result = false
     ).
 
 halt_message(Where, Message) :-
@@ -197,25 +249,66 @@ python_api(relrl_gateway:gw_findall/3).
 python_api(relrl_gateway:gw_parse/3).
 python_api(relrl_gateway:gw_take_abort/1).
 
+%   Run Goal once under a time limit of Limit seconds (0: none of its own; a limit of an
+%   enclosing call still holds).
+%
+%   The limit is a deadline in a global variable, and one alarm (the watchdog) is armed
+%   only when no earlier alarm is pending: when it fires, time_up/0 throws if the running
+%   call's deadline has passed, and otherwise sets itself for that deadline. A robot
+%   stepping thousands of times a second under a 10 s limit so arms the alarm about once
+%   in 10 s instead of twice per call: arming and disarming an alarm wakes the alarm
+%   library's scheduler thread, which cost a control step 10-60 µs here, more than the
+%   rest of the gateway (call_with_time_limit/2, which also creates an alarm per call,
+%   costs more still). The limit holds to within the alarm's precision, as before.
+
 limited(Goal, Limit, Result) :-
     (   Limit > 0
-    ->  watchdog(Alarm),
+    ->  get_time(Now),
+        Deadline0 is Now + Limit,
+        nb_getval(relrl_deadline, Outer),
+        (   Outer \== none,
+            Outer < Deadline0
+        ->  Deadline = Outer
+        ;   Deadline = Deadline0
+        ),
         setup_call_cleanup(
-            install_alarm(Alarm, Limit),
+            set_deadline(Deadline),
             (   call(Goal)
             ->  Result = true
             ;   Result = false
             ),
-            uninstall_alarm(Alarm))
+            nb_setval(relrl_deadline, Outer))
     ;   (   call(Goal)
         ->  Result = true
         ;   Result = false
         )
     ).
 
-%   One alarm, made once and re-armed for every call: much cheaper than creating and
-%   removing an alarm per call (call_with_time_limit/2) when the robot steps thousands of
-%   times a second.
+:- initialization(( nb_setval(relrl_deadline, none), nb_setval(relrl_armed, none) )).
+
+%   The running call must end by Deadline: arm the watchdog unless it fires sooner.
+set_deadline(Deadline) :-
+    nb_setval(relrl_deadline, Deadline),
+    nb_getval(relrl_armed, At),
+    (   At \== none,
+        At =< Deadline
+    ->  true
+    ;   arm(Deadline)
+    ).
+
+%   Set the watchdog to fire at Deadline (signals held off: time_up/0 arms it too).
+arm(Deadline) :-
+    sig_atomic(arm_(Deadline)).
+
+arm_(Deadline) :-
+    watchdog(Alarm),
+    uninstall_alarm(Alarm),
+    get_time(Now),
+    In is max(Deadline - Now, 0.0001),
+    install_alarm(Alarm, In),
+    nb_setval(relrl_armed, Deadline).
+
+%   The one alarm, made once.
 watchdog(Alarm) :-
     (   nb_current(relrl_watchdog, Alarm0)
     ->  Alarm = Alarm0
@@ -224,12 +317,21 @@ watchdog(Alarm) :-
         nb_setval(relrl_watchdog, Alarm)
     ).
 
-%   The alarm: remember where a file being loaded was (a directive that never ends), then
-%   throw as call_with_time_limit/2 does.
+%   The alarm fired. If the running call's deadline has passed: remember where a file
+%   being loaded was (a directive that never ends), then throw as call_with_time_limit/2
+%   does. If a call runs with a later deadline, wait for that; if none runs, stay unarmed.
 time_up :-
-    load_location(Where),
-    nb_setval(relrl_timeout_where, Where),
-    throw(time_limit_exceeded).
+    nb_setval(relrl_armed, none),
+    nb_getval(relrl_deadline, Deadline),
+    (   Deadline == none
+    ->  true
+    ;   get_time(Now),
+        Now >= Deadline - 0.0005
+    ->  load_location(Where),
+        nb_setval(relrl_timeout_where, Where),
+        throw(time_limit_exceeded)
+    ;   arm(Deadline)
+    ).
 
 %!  error_result(+Exception, -Result) is det.
 %
@@ -578,31 +680,30 @@ gw_answer(Module, Text, Limit, Mode, Answer) :-
     ).
 
 answers(Goal, Bindings, Limit, Answer) :-
-    watchdog(Alarm),
-    (   catch(answer(Goal, Bindings, Alarm, Limit, Answer0), E0,
-              ( pause(Alarm, _), toplevel_error(E0, E), error_result(E, Answer0) ))
+    (   catch(answer(Goal, Bindings, Limit, Answer0), E0,
+              ( pause(_), toplevel_error(E0, E), error_result(E, Answer0) ))
     *-> Answer = Answer0
-    ;   pause(Alarm, Halt),
+    ;   pause(Halt),
         Halt \== none,
         halt_message(Halt, Message),
         Answer = error(halt_called(Halt), Message)
     ).
 
-answer(Goal, Bindings, Alarm, Limit, Answer) :-
-    resume(Alarm, Limit),
+answer(Goal, Bindings, Limit, Answer) :-
+    resume(Limit),
     call_cleanup(Goal, Det = true),
     (   var(Det)
     ->  Det = false
     ;   true
     ),
-    deliver(Bindings, Det, Alarm, Limit, Answer).
+    deliver(Bindings, Det, Limit, Answer).
 
 %   Write the answer (again, after gw_answer_again/1); on backtracking for the next
 %   answer, restart the clock and fail into the goal (the cuts stay in this clause).
-deliver(Bindings, Det, Alarm, Limit, Answer) :-
+deliver(Bindings, Det, Limit, Answer) :-
     repeat,
     answer_text(Bindings, Text),
-    pause(Alarm, Halt),
+    pause(Halt),
     (   Halt \== none
     ->  !,
         halt_message(Halt, Message),
@@ -610,10 +711,10 @@ deliver(Bindings, Det, Alarm, Limit, Answer) :-
     ;   Answer = answer(Text, Det)
     ;   nb_getval(relrl_answer_again, Again),
         Again \== none
-    ->  resume(Alarm, Limit),
+    ->  resume(Limit),
         fail
     ;   !,
-        resume(Alarm, Limit),
+        resume(Limit),
         fail
     ).
 
@@ -627,13 +728,15 @@ toplevel_error(E, E).
 
 %   The clock runs and halt/0,1 is cancelled (see halt_hook/0) while an answer is sought;
 %   between answers the clock stops and what the goal wrote is flushed.
-resume(Alarm, Limit) :-
+resume(Limit) :-
     nb_setval(relrl_active, true),
     nb_setval(relrl_halt, none),
-    install_alarm(Alarm, Limit).
+    get_time(Now),
+    Deadline is Now + Limit,
+    set_deadline(Deadline).
 
-pause(Alarm, Halt) :-
-    uninstall_alarm(Alarm),
+pause(Halt) :-
+    nb_setval(relrl_deadline, none),
     flush_output(user_output),          % the goal's output comes before the answer
     nb_setval(relrl_active, false),
     nb_getval(relrl_halt, Halt),

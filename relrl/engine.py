@@ -180,23 +180,30 @@ class Engine:
             mode: one of :data:`MODES`.
             want: any of :data:`WANTS`, reported in the same call.
         """
-        if not isinstance(percepts, Cached):
+        return StepResult(*self.step_fields(percepts, emitted, mode, want))
+
+    def step_fields(self, percepts: Sequence[Term] | Cached, emitted: int = -1,
+                    mode: str = "learn", want: Iterable[str] = ()) -> tuple:
+        """:meth:`step`'s fields as a plain tuple, in :class:`StepResult`'s order (for
+        the control loop, which builds its own record of the step)."""
+        if type(percepts) is not Cached:
             percepts = Cached(percepts if isinstance(percepts, list) else list(percepts))
-        want = list(want)
+        want = list(want) if want else []
         raw = self.kb.step(percepts, emitted, mode, want)
         if raw is None:
             raise EngineError(f"{GOALS['step']}/6 failed in {self.module}")
         code, necessity, ys, reward, reinforced, mask, action, extras = raw
         memory = memory_size = explanation = None
-        for _, key, value in extras or ():
-            if key == "memory":
-                memory = tuple((age, element) for (_, age, element) in value)
-            elif key == "memory_size":
-                memory_size = value
-            else:
-                explanation = value
-        return StepResult(code, necessity, tuple(ys), float(reward), reinforced,
-                          mask, action, memory, memory_size, explanation)
+        if extras:
+            for _, key, value in extras:
+                if key == "memory":
+                    memory = tuple((age, element) for (_, age, element) in value)
+                elif key == "memory_size":
+                    memory_size = value
+                else:
+                    explanation = value
+        return (code, necessity, tuple(ys), float(reward), reinforced, mask, action,
+                memory, memory_size, explanation)
 
     def end_episode(self) -> None:
         """End an interaction: forget the last step, working memory and the units' state."""

@@ -194,6 +194,7 @@ class _Engine:
         # Reused out-parameters of the step's reads (one thread uses the engine).
         self._i64, self._f64, self._atom = c_int64(), c_double(), c_size_t()
         self._held: dict[int, str] = {}
+        self._step_mark: int | None = None
         self._held_names: dict[str, int] = {}
         self._true = self.hold("true")
 
@@ -440,69 +441,85 @@ class _Engine:
         if threading.get_ident() != self.thread:
             raise RelrlError("the Prolog engine belongs to the thread that started it; "
                              "use processes, not threads, for parallel runs")
-        # No text is converted on the way (atoms are read by handle), so unlike run() the
-        # string stack needs marking only before a fallback conversion.
-        mark: list[int] = []
-
-        def slow(t: int) -> Term:       # any other term: converted, after marking
-            if not mark:
-                mark.append(self._mark())
-            return self.get(t)
-
+        atoms, put_atom = self._atoms, self.put_atom
         fid = self.open_frame()
         try:
             self.calls += 1
             a = self.new_term_refs(15)     # fresh variables
-            variables: dict[int, int] = {}
-            self.put(a, module, variables)
+            if module in atoms:
+                put_atom(a, atoms[module])
+            else:
+                self.put(a, module, {})
             rec = self._records.get(percepts.key) if type(percepts) is Cached else None
             if rec is not None:
                 self.recorded(rec, a + 1)
             else:
-                self.put(a + 1, percepts, variables)
+                self.put(a + 1, percepts, {})
             self.put_int64(a + 2, emitted)
-            self.put(a + 3, mode, variables)
+            if mode in atoms:
+                put_atom(a + 3, atoms[mode])
+            else:
+                self.put(a + 3, mode, {})
             if want:
-                self.put(a + 4, want, variables)
+                self.put(a + 4, want, {})
             else:
                 self.put_nil(a + 4)
-            self.put_float(a + 5, float(timeout or 0))
+            self.put_float(a + 5, timeout)
             if not self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
                                        self._gw_step, a):
-                mark.append(self._mark())
-                ex = self.exception(0)
-                if not ex:
-                    self.clear_exception()
-                    raise self._aborted()
-                detail = self.get(ex)
-                self.clear_exception()
-                raise PrologError(f"gateway call failed: {detail!r}", detail)
+                return self._step_failed(timeout, None)
             atom, i64, f64 = self._atom, self._i64, self._f64
             get_atom, get_int64, get_float = self.get_atom, self.get_int64, self.get_float
+            held = self._held
+            # No text is converted on this path (atoms are read by handle): any field that
+            # does not fit its one-call read goes to _step_field, which marks the string
+            # stack first (see run()).
             if not (get_atom(a + 6, atom) and atom.value == self._true):
-                result = slow(a + 6)
-                if result == "false":
-                    return None
-                _raise_result(result, timeout)
-            code = i64.value if get_int64(a + 7, i64) else slow(a + 7)  # else > 64 bits
-            if get_atom(a + 8, atom) and atom.value in self._held:
-                necessity = self._held[atom.value]
-            else:
-                necessity = slow(a + 8)
+                return self._step_failed(timeout, a + 6)
+            code = i64.value if get_int64(a + 7, i64) else self._step_field(a + 7)
+            necessity = held.get(atom.value) if get_atom(a + 8, atom) else None
+            if necessity is None:
+                necessity = self._step_field(a + 8)
             outputs = []
             head, rest = self.new_term_ref(), a + 9
             while self.get_list(rest, head, rest):
-                outputs.append(f64.value if get_float(head, f64) else slow(head))
-            reward = f64.value if get_float(a + 10, f64) else slow(a + 10)
-            reinforced = bool(get_atom(a + 11, atom) and atom.value == self._true)
-            mask = i64.value if get_int64(a + 12, i64) else slow(a + 12)  # > 63 responses
-            action = i64.value if get_int64(a + 13, i64) else slow(a + 13)
-            extras = None if not want or self.get_nil(a + 14) else slow(a + 14)
-            return code, necessity, outputs, reward, reinforced, mask, action, extras
+                outputs.append(f64.value if get_float(head, f64) else self._step_field(head))
+            reward = f64.value if get_float(a + 10, f64) else self._step_field(a + 10)
+            reinforced = get_atom(a + 11, atom) and atom.value == self._true
+            mask = i64.value if get_int64(a + 12, i64) else self._step_field(a + 12)
+            action = i64.value if get_int64(a + 13, i64) else self._step_field(a + 13)
+            extras = self._step_field(a + 14) if want and not self.get_nil(a + 14) else None
+            return code, necessity, outputs, reward, bool(reinforced), mask, action, extras
         finally:
             self.discard_frame(fid)
-            if mark:
-                self.release_strings(mark[0])
+            if self._step_mark is not None:
+                self.release_strings(self._step_mark)
+                self._step_mark = None
+
+    def _step_field(self, t: int) -> Term:
+        """A field of a step's result read by conversion (after marking the string
+        stack once; :meth:`step` releases it)."""
+        if self._step_mark is None:
+            self._step_mark = self._mark()
+        return self.get(t)
+
+    def _step_failed(self, timeout: float, result: int | None) -> None:
+        """The step's call raised (``result`` None) or gave ``false``/an error term at
+        ``result``: None for false, else the exception."""
+        if result is not None:
+            value = self._step_field(result)
+            if value == "false":
+                return None
+            _raise_result(value, timeout)
+        if self._step_mark is None:
+            self._step_mark = self._mark()
+        ex = self.exception(0)
+        if not ex:
+            self.clear_exception()
+            raise self._aborted()
+        detail = self.get(ex)
+        self.clear_exception()
+        raise PrologError(f"gateway call failed: {detail!r}", detail)
 
     def _mark(self) -> int:
         """Mark the string stack (see :meth:`run`); release with ``release_strings``."""
@@ -714,7 +731,8 @@ class KnowledgeBase:
     def step(self, percepts: Term, emitted: int, mode: str, want: list[str]) -> tuple | None:
         """The control step of this knowledge base's engine in one gateway call (see
         :class:`relrl.engine.Engine`, which decodes it); None when the step failed."""
-        return self._engine.step(self.module, percepts, emitted, mode, want, self.timeout)
+        return self._engine.step(self.module, percepts, emitted, mode, want,
+                                 float(self.timeout or 0))
 
     def interruptible(self) -> contextlib.AbstractContextManager[None]:
         """A context in which Ctrl-C stops the running goal at once (see

@@ -45,6 +45,7 @@ class Agent:
         self.necessities: list[str] = self.engine.necessities
         self._emitted = -1
         self.emitted: Term | None = None
+        self._allowed: dict[int, tuple[tuple[int, ...], tuple[Term, ...]]] = {}
         self.steps = 0
         self.states: set[int] = set()
 
@@ -66,25 +67,26 @@ class Agent:
         if explore is None:
             explore = learning
         mode = "learn" if learning else ("explore" if explore else "greedy")
-        r = self.engine.step(percepts, self._emitted, mode, want)
+        (code, necessity, ys, reward, reinforced, mask, action_index, memory, memory_size,
+         explanation) = self.engine.step_fields(percepts, self._emitted, mode, want)
         responses = self.responses
-        allowed = r.allowed_index
-        out = StepOut(r.code, r.necessity, dict(zip(self.necessities, r.outputs, strict=True)),
-                      r.reward, [responses[i] for i in allowed],
-                      responses[r.action_index] if r.action_index >= 0 else None, allowed,
-                      reinforced=r.reinforced, memory=r.memory, memory_size=r.memory_size)
+        allowed_index, allowed = self._allowed.get(mask) or self._allow(mask)
+        action = responses[action_index] if action_index >= 0 else None
+        out = StepOut(code, necessity, dict(zip(self.necessities, ys, strict=True)), reward,
+                      list(allowed), action, list(allowed_index), reinforced=reinforced,
+                      memory=memory, memory_size=memory_size)
         out.action = self.learner.act(out, learning, explore)
-        if r.explanation is not None:
-            out.explanation = self.learner.decode_explanation(r.explanation)
+        if explanation is not None:
+            out.explanation = self.learner.decode_explanation(explanation)
         self.emitted = out.action
         if out.action is None:
             self._emitted = -1
-        elif r.action_index >= 0 and out.action is responses[r.action_index]:
-            self._emitted = r.action_index      # the engine's own choice: its index
+        elif action_index >= 0 and out.action is action:
+            self._emitted = action_index      # the engine's own choice: its index
         else:
             self._emitted = self._index_of(out.action)
         self.steps += 1
-        self.states.add(r.code)
+        self.states.add(code)
         return out
 
     @contextlib.contextmanager
@@ -122,6 +124,20 @@ class Agent:
 
         self.engine.reseed(int(seed))
         self.learner.rng = np.random.default_rng(int(seed))
+
+    def _allow(self, mask: int) -> tuple[tuple[int, ...], tuple[Term, ...]]:
+        """The allowed responses' indices and terms for an allowed-mask (remembered: a
+        domain has few masks)."""
+        index = []
+        i = 0
+        while mask >> i:
+            if mask >> i & 1:
+                index.append(i)
+            i += 1
+        pair = (tuple(index), tuple(self.responses[i] for i in index))
+        if len(self._allowed) < 4096:
+            self._allowed[mask] = pair
+        return pair
 
     def _index_of(self, action: Term | None) -> int:
         if action is None:

@@ -44,16 +44,23 @@ class _RecordingEngine:
     def __getattr__(self, name: str) -> Any:
         return getattr(self._engine, name)
 
-    def step(self, percepts: Any, emitted: int = -1, mode: str = "learn",
-             want: Iterable[str] = ()) -> Any:
+    def step_fields(self, percepts: Any, emitted: int = -1, mode: str = "learn",
+                    want: Iterable[str] = ()) -> tuple:
         want = list(want)
-        r = self._engine.step(percepts, emitted, mode, want)
+        fields = self._engine.step_fields(percepts, emitted, mode, want)
+        code, necessity, outputs, reward, reinforced, mask, action = fields[:7]
         value = getattr(percepts, "value", percepts)   # a Cached percept list
-        expected = ("r", r.code, r.necessity, list(r.outputs), r.reward,
-                    "true" if r.reinforced else "false", r.allowed_mask, r.action_index)
+        expected = ("r", code, necessity, list(outputs), reward,
+                    "true" if reinforced else "false", mask, action)
         self._sink.append(f"s({format_term(list(value))},{emitted},{mode},"
                           f"{format_term(expected)}).")
-        return r
+        return fields
+
+    def step(self, percepts: Any, emitted: int = -1, mode: str = "learn",
+             want: Iterable[str] = ()) -> Any:
+        from relrl.engine import StepResult
+
+        return StepResult(*self.step_fields(percepts, emitted, mode, want))
 
     def end_episode(self) -> None:
         self._engine.end_episode()

@@ -167,3 +167,27 @@ def test_partial_list_keeps_its_tail(fruits: KnowledgeBase) -> None:
     (value,) = fruits.call("=", Var(), ("[|]", 1, ("[|]", 2, Var("T"))))
     assert value[0] == "[|]" and value[1] == 1
     assert value[2][0] == "[|]" and value[2][1] == 2 and isinstance(value[2][2], Var)
+
+
+def test_time_limit_holds_across_many_short_calls() -> None:
+    """The watchdog is armed lazily (once per limit, not per call): calls that end in time
+    never see it fire, however long they run together, and a runaway call after them is
+    still stopped at its own limit."""
+    import time
+
+    with KnowledgeBase(SIS, timeout=0.2) as kb:
+        start = time.monotonic()
+        calls = 0
+        while time.monotonic() - start < 1.0:    # five limits' worth of short calls
+            assert kb.holds(("between", 1, 200, 200))
+            calls += 1
+        assert calls > 100
+        t = time.monotonic()
+        with pytest.raises(QueryTimeout):
+            kb.holds((",", ("repeat",), ("fail",)))
+        assert 0.15 < time.monotonic() - t < 1.5
+        with pytest.raises(QueryTimeout):          # an inner, shorter limit holds too
+            kb.holds((",", ("repeat",), ("fail",)), timeout=0.05)
+        assert kb.holds(("true",))                 # and nothing fires afterwards
+        time.sleep(0.3)
+        assert kb.holds(("between", 1, 1000, 1000))
