@@ -88,7 +88,10 @@ random_element(List, X) :-
 scores([], _, _, _, [], Best, Best).
 scores([A|As], Entries, N, Q0, [Q-A|Ss], Best0, Best) :-
     entry_q(Entries, A, N, Q0, Q),
-    Best1 is max(Best0, Q),
+    (   Q < Best0                       % max/2 would give Best0 itself
+    ->  Best1 = Best0
+    ;   Best1 is max(Best0, Q)
+    ),
     scores(As, Entries, N, Q0, Ss, Best1, Best).
 
 ties([], _, []).
@@ -136,28 +139,43 @@ update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold) :-
     insert_example(KB, D0, A0, N0, Target, Alpha, Qinit, Threshold).
 
 max_q(Entries, N, Allowed, Qinit, Max) :-
-    max_q_(Entries, N, Allowed, none, 0, Max1, K),
-    (   K =:= 0
+    max_allowed(Entries, N, Allowed, none, Max1),
+    (   Max1 == none                    % no entry for N of an allowed action
     ->  Max = Qinit
-    ;   Allowed \== [], length(Allowed, L), K < L
+    ;   Max1 > Qinit                    % max(Max1, Qinit) would be Max1 itself
+    ->  Max = Max1
+    ;   count_allowed(Entries, N, Allowed, 0, K),
+        Allowed \== [], length(Allowed, L), K < L
     ->  Max is max(Max1, Qinit)     % some allowed action is still untried
     ;   Max = Max1
     ).
 
-%   The largest Q among the entries for N of allowed actions, and how many there are.
-max_q_([], _, _, Max, K, Max, K).
-max_q_([e(A, Q, N1)|Es], N, Allowed, Max0, K0, Max, K) :-
+%   The largest Q among the entries for N of allowed actions (none if there is none). An
+%   entry whose Q is below the largest so far cannot change it (max/2 would give the
+%   largest so far itself), so neither its action's look-up nor the arithmetic is done:
+%   in a leaf kept in decreasing Q that is every entry after the first allowed one.
+max_allowed([], _, _, Max, Max).
+max_allowed([e(A, Q, N1)|Es], N, Allowed, Max0, Max) :-
     (   N1 == N,
+        ( Max0 == none -> true ; \+ Q < Max0 ),
         allowed_or_any(Allowed, A)
-    ->  K1 is K0 + 1,
-        (   Max0 == none
+    ->  (   Max0 == none
         ->  Max1 = Q
         ;   Max1 is max(Max0, Q)
         )
-    ;   K1 = K0,
-        Max1 = Max0
+    ;   Max1 = Max0
     ),
-    max_q_(Es, N, Allowed, Max1, K1, Max, K).
+    max_allowed(Es, N, Allowed, Max1, Max).
+
+%   How many entries for N are of allowed actions.
+count_allowed([], _, _, K, K).
+count_allowed([e(A, _, N1)|Es], N, Allowed, K0, K) :-
+    (   N1 == N,
+        allowed_or_any(Allowed, A)
+    ->  K1 is K0 + 1
+    ;   K1 = K0
+    ),
+    count_allowed(Es, N, Allowed, K1, K).
 
 allowed_or_any([], _) :- !.
 allowed_or_any(Allowed, A) :- memberchk(A, Allowed).

@@ -442,4 +442,74 @@ test(step_leaves_no_choice_point, [Det == true]) :-
                                           -1, learn, [], _),
                  Det = true).
 
+%   ETG's max over the next leaf gives what the plain definition gives (max/2 over every
+%   entry for N of an allowed action; q_init when one is untried), entries in any order,
+%   with integer and float values, ties, and every subset of allowed actions.
+plain_max_q(Entries, N, Allowed, Qinit, Max) :-
+    findall(Q, ( member(e(A, Q, N1), Entries), N1 == N,
+                 ( Allowed == [] -> true ; memberchk(A, Allowed) ) ), Qs),
+    length(Qs, K),
+    (   K =:= 0
+    ->  Max = Qinit
+    ;   Qs = [Q1|Qs1],
+        foldl(max_of, Qs1, Q1, Max1),
+        (   Allowed \== [], length(Allowed, L), K < L
+        ->  Max is max(Max1, Qinit)
+        ;   Max = Max1
+        )
+    ).
+
+max_of(Q, M0, M) :-
+    M is max(M0, Q).
+
+put_entry(E, L0, L) :-
+    relrl_qtree:qtree_put_entry(L0, E, L).
+
+random_entries(Es) :-
+    findall(e(A, Q, N),
+            ( member(A, [a, b, c, d]), member(N, [n, m]), random(X), X < 0.6,
+              random_member(Q, [0, 1, 2.5, 2.5, 30, 30.0, -1.0, 31.25, 29.5, 40]) ),
+            Es0),
+    random_permutation(Es0, Es).
+
+test(etg_max_q_is_plain_max, [true(Bad == [])]) :-
+    set_random(seed(11)),
+    findall(Es-N-Allowed-Got-Want,
+            ( between(1, 2000, _),
+              random_entries(Es),
+              random_member(N, [n, m]),
+              random_member(Allowed, [[], [a], [a, b], [b, c, d], [a, b, c, d],
+                                      [a, b, c, d, e]]),
+              random_member(Qinit, [30, 30.0, 0]),
+              relrl_etg:max_q(Es, N, Allowed, Qinit, Got),
+              plain_max_q(Es, N, Allowed, Qinit, Want),
+              Got \== Want ),
+            Bad).
+
+%   Sorted leaves too (as the tree keeps them): the first allowed entry is the max.
+test(etg_max_q_sorted_leaves, [true(Bad == [])]) :-
+    set_random(seed(12)),
+    findall(Es-Got-Want,
+            ( between(1, 1000, _),
+              random_entries(Es0),
+              foldl(put_entry, Es0, [], Es),
+              random_member(Allowed, [[], [a, b], [a, b, c, d]]),
+              relrl_etg:max_q(Es, n, Allowed, 30, Got),
+              plain_max_q(Es, n, Allowed, 30, Want),
+              Got \== Want ),
+            Bad).
+
+%   A ground leaf is linked into the tree, not copied: it survives backtracking to before
+%   it was made and garbage collection.
+test(qtree_linked_leaf_survives, [true(Entries == [e(a, 2.5, n), e(b, 1.0, n)])]) :-
+    relrl_qtree:qtree_new(tlink, [t0]),
+    (   X is 1.5 + 1.0, Y is 0.5 * 2,
+        relrl_qtree:qtree_set_leaf(tlink, 0, 1, [e(a, X, n), e(b, Y, n)]),
+        fail
+    ;   true
+    ),
+    findall(Z, ( between(1, 20000, I), Z = f(I, I) ), _),
+    garbage_collect,
+    relrl_qtree:qtree_leaf(tlink, 0, _, Entries).
+
 :- end_tests(step_parts).
