@@ -185,11 +185,16 @@ interrupt(_Signal) :-
     ).
 
 %   at_halt/1 hook: inside a gateway call, cancel the halt and remember where it came from.
+%   Otherwise the process ends: the watchdog, which stays armed between calls (limited/3),
+%   is disarmed first, so that no alarm is pending while the alarm library shuts down.
 halt_hook :-
     (   nb_current(relrl_active, true)
     ->  load_location(Where),
         nb_setval(relrl_halt, Where),
         cancel_halt(relrl_gateway)
+    ;   nb_current(relrl_watchdog, Alarm)
+    ->  nb_setval(relrl_armed, none),
+        uninstall_alarm(Alarm)
     ;   true
     ).
 

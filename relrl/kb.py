@@ -133,10 +133,16 @@ class _Engine:
         self.thread = threading.get_ident()
         lib = core._lib
         self.lib = lib
+        # The foreign calls that only build or read terms take microseconds: they keep the
+        # GIL (a PyDLL view of the same library). Only calls that run Prolog goals
+        # (call_predicate, an open query's next solution) let other Python threads run —
+        # the monitor's server, perception, the Ctrl-C watcher. A control step used to hand
+        # the GIL over some twenty times, and a busy server thread took it each time.
+        quick = ctypes.PyDLL(lib._name, handle=lib._handle)
         T = c_size_t  # term_t, atom_t, functor_t, fid_t are uintptr_t
 
-        def fn(name: str, restype: Any, *argtypes: Any) -> Any:
-            f = getattr(lib, name)
+        def fn(name: str, restype: Any, *argtypes: Any, runs_prolog: bool = False) -> Any:
+            f = getattr(lib if runs_prolog else quick, name)
             f.restype = restype
             f.argtypes = list(argtypes)
             return f
@@ -172,7 +178,8 @@ class _Engine:
         self.predicate = fn("PL_predicate", c_void_p, c_char_p, c_int, c_char_p)
         self.open_frame = fn("PL_open_foreign_frame", T)
         self.discard_frame = fn("PL_discard_foreign_frame", None, T)
-        self.call_predicate = fn("PL_call_predicate", c_int, c_void_p, c_int, c_void_p, T)
+        self.call_predicate = fn("PL_call_predicate", c_int, c_void_p, c_int, c_void_p, T,
+                                 runs_prolog=True)
         self.exception = fn("PL_exception", T, T)
         self.clear_exception = fn("PL_clear_exception", None)
         self.record = fn("PL_record", c_void_p, T)
