@@ -119,13 +119,7 @@ guarded(Goal, Limit, Result) :-
               ( nb_setval(relrl_deadline, Outer),     % the error's report is not timed
                 error_result(E, Result0) )),
         leave_call(Was, Outer)),
-    nb_getval(relrl_halt, Halt),
-    (   Halt == none
-    ->  Result = Result0
-    ;   nb_setval(relrl_halt, none),
-        halt_message(Halt, Message),
-        Result = error(halt_called(Halt), Message)
-    ).
+    halt_result(Result0, Result).
 
 enter_call(Deadline) :-
     nb_setval(relrl_active, true),
@@ -150,6 +144,10 @@ active(Goal, Result0, Result) :-
         ( nb_setval(relrl_active, true), nb_setval(relrl_halt, none) ),
         Goal,
         nb_setval(relrl_active, Was)),
+    halt_result(Result0, Result).
+
+%   Result0, or the error for a halt/0,1 that was cancelled while the call ran.
+halt_result(Result0, Result) :-
     nb_getval(relrl_halt, Halt),
     (   Halt == none
     ->  Result = Result0

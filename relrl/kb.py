@@ -33,7 +33,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from ctypes import POINTER, byref, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from relrl.errors import (
     PolicyError,
@@ -404,14 +404,7 @@ class _Engine:
             finally:
                 self.busy = False
             if not ok:
-                ex = self.exception(0)
-                if not ex:
-                    # abort/0 unwinds past every catch/3: gw_run/3 noted where it came from.
-                    self.clear_exception()
-                    raise self._aborted()
-                detail = self.get(ex)
-                self.clear_exception()
-                raise PrologError(f"gateway call failed: {detail!r}", detail)
+                self._raise_exception()
             result = self.get(a0 + 2)
             if result == "false":
                 return None
@@ -520,8 +513,14 @@ class _Engine:
             _raise_result(value, timeout)
         if self._step_mark is None:
             self._step_mark = self._mark()
+        self._raise_exception()
+
+    def _raise_exception(self) -> NoReturn:
+        """The error for a gateway call that raised past its own catch (the string stack
+        already marked)."""
         ex = self.exception(0)
         if not ex:
+            # abort/0 unwinds past every catch/3: gw_run/3 noted where it came from.
             self.clear_exception()
             raise self._aborted()
         detail = self.get(ex)
