@@ -47,7 +47,8 @@ A knowledge base is a module of its own (gw_new_kb/1), so two knowledge bases in
 process never see each other's clauses or working memory.
 */
 
-:- meta_predicate gw_run(0, +, -), guarded(0, +, -), api_call(0), once_result(0, -).
+:- meta_predicate gw_run(0, +, -), guarded(0, +, -), api_call(0), once_result(0, -),
+    limited(0, +, -).
 
 %!  gw_run(:Goal, +TimeLimit, -Result) is det.
 %
@@ -102,17 +103,7 @@ guarded(Goal, Limit, Result) :-
     ->  true
     ;   Was = false
     ),
-    nb_getval(relrl_deadline, Outer),
-    (   Limit > 0
-    ->  get_time(Now),
-        Deadline0 is Now + Limit,
-        (   Outer \== none,
-            Outer < Deadline0
-        ->  Deadline = Outer
-        ;   Deadline = Deadline0
-        )
-    ;   Deadline = Outer
-    ),
+    call_deadline(Limit, Outer, Deadline),
     setup_call_cleanup(
         enter_call(Deadline),
         catch(once_result(Goal, Result0), E,
@@ -124,10 +115,7 @@ guarded(Goal, Limit, Result) :-
 enter_call(Deadline) :-
     nb_setval(relrl_active, true),
     nb_setval(relrl_halt, none),
-    (   Deadline == none
-    ->  true
-    ;   set_deadline(Deadline)
-    ).
+    enter_deadline(Deadline).
 
 leave_call(Was, Outer) :-
     nb_setval(relrl_active, Was),
@@ -265,26 +253,32 @@ python_api(relrl_gateway:gw_take_abort/1).
 %   costs more still). The limit holds to within the alarm's precision, as before.
 
 limited(Goal, Limit, Result) :-
+    call_deadline(Limit, Outer, Deadline),
+    setup_call_cleanup(
+        enter_deadline(Deadline),
+        once_result(Goal, Result),
+        nb_setval(relrl_deadline, Outer)).
+
+%   call_deadline(+Limit, -Outer, -Deadline): Outer is the deadline of the enclosing call
+%   (or none); Deadline the one a call limited to Limit seconds (0: none of its own) runs
+%   under — the earlier of the two.
+call_deadline(Limit, Outer, Deadline) :-
+    nb_getval(relrl_deadline, Outer),
     (   Limit > 0
     ->  get_time(Now),
         Deadline0 is Now + Limit,
-        nb_getval(relrl_deadline, Outer),
         (   Outer \== none,
             Outer < Deadline0
         ->  Deadline = Outer
         ;   Deadline = Deadline0
-        ),
-        setup_call_cleanup(
-            set_deadline(Deadline),
-            (   call(Goal)
-            ->  Result = true
-            ;   Result = false
-            ),
-            nb_setval(relrl_deadline, Outer))
-    ;   (   call(Goal)
-        ->  Result = true
-        ;   Result = false
         )
+    ;   Deadline = Outer
+    ).
+
+enter_deadline(Deadline) :-
+    (   Deadline == none
+    ->  true
+    ;   set_deadline(Deadline)
     ).
 
 :- initialization(( nb_setval(relrl_deadline, none), nb_setval(relrl_armed, none) )).

@@ -34,7 +34,7 @@ from relrl.errors import RelrlError
 from relrl.kb import Cached, KnowledgeBase
 from relrl.terms import Term, Var
 
-__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult"]
+__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult", "mask_indices"]
 
 #: Every goal of relrl's Prolog that Python calls: short name -> "module:predicate".
 GOALS: dict[str, str] = {
@@ -113,13 +113,18 @@ class StepResult:
     @property
     def allowed_index(self) -> list[int]:
         """Indices of the allowed responses, in declaration order."""
-        mask, out, i = self.allowed_mask, [], 0
-        while mask:
-            if mask & 1:
-                out.append(i)
-            mask >>= 1
-            i += 1
-        return out
+        return mask_indices(self.allowed_mask)
+
+
+def mask_indices(mask: int) -> list[int]:
+    """The indices of the bits set in an allowed-responses mask, in increasing order."""
+    out, i = [], 0
+    while mask:
+        if mask & 1:
+            out.append(i)
+        mask >>= 1
+        i += 1
+    return out
 
 
 def call(kb: KnowledgeBase, goal: str, *arguments: Term, timeout: float | None = None) -> list:

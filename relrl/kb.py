@@ -499,9 +499,13 @@ class _Engine:
     def _step_field(self, t: int) -> Term:
         """A field of a step's result read by conversion (after marking the string
         stack once; :meth:`step` releases it)."""
+        self._mark_step()
+        return self.get(t)
+
+    def _mark_step(self) -> None:
+        """Mark the string stack once in a step (released when the step ends)."""
         if self._step_mark is None:
             self._step_mark = self._mark()
-        return self.get(t)
 
     def _step_failed(self, timeout: float, result: int | None) -> None:
         """The step's call raised (``result`` None) or gave ``false``/an error term at
@@ -511,8 +515,7 @@ class _Engine:
             if value == "false":
                 return None
             _raise_result(value, timeout)
-        if self._step_mark is None:
-            self._step_mark = self._mark()
+        self._mark_step()
         self._raise_exception()
 
     def _raise_exception(self) -> NoReturn:

@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from relrl.engine import Engine
+from relrl.engine import Engine, mask_indices
 from relrl.errors import UserError
 from relrl.interfaces import Actuator, Environment
 from relrl.kb import KnowledgeBase
@@ -128,12 +128,7 @@ class Agent:
     def _allow(self, mask: int) -> tuple[tuple[int, ...], tuple[Term, ...]]:
         """The allowed responses' indices and terms for an allowed-mask (remembered: a
         domain has few masks)."""
-        index = []
-        i = 0
-        while mask >> i:
-            if mask >> i & 1:
-                index.append(i)
-            i += 1
+        index = mask_indices(mask)
         pair = (tuple(index), tuple(self.responses[i] for i in index))
         if len(self._allowed) < 4096:
             self._allowed[mask] = pair
