@@ -14,6 +14,7 @@
             engine_resume/2,          % +KB, +Slot
             engine_reseed/2,          % +KB, +Seed
             engine_forget/1,          % +KB
+            engine_park/0,
             engine_param/3,           % +KB, ?Name, ?Value
             engine_params/2,          % +KB, -Params
             engine_config/3,          % +KB, ?Key, ?Value
@@ -71,9 +72,15 @@ touches its own file and one line of learners.pl.
 
 ## Random numbers
 
-Each knowledge base owns its random stream: the engine swaps it in around every call that
-may draw numbers and keeps it with the knowledge base, so two agents in one process give the
-same trajectories as each alone. Learners just use library(random).
+Each knowledge base owns its random stream, so two agents in one process give the same
+trajectories as each alone. Learners just use library(random): SWI-Prolog has one random
+generator (per thread), and the engine keeps in it the stream of the knowledge base that
+stepped last, swapping only when another knowledge base steps (a robot stepping one agent
+never saves or restores the generator's 2.5 KB state). Anything else that may draw numbers
+first puts that stream away with engine_park/0: the engine's other predicates that touch
+the generator do, and so does relrl's gateway before every call that is not a step (a
+user's query, loading a file, keep and resume, ...). A Prolog program that calls
+engine_step/6 itself and draws numbers of its own between steps calls engine_park/0 first.
 
 ## Errors
 
@@ -108,9 +115,10 @@ gateway can name the rule.
 %               Necessities, Plan) — fixed for a run, read without copying; Plan is the
 %               state code's plan (relrl_state:state_plan/4)
 %     Prev    prev(State, Necessity) of the last step, or none
-%     Random  the KB's random state
-%   Prev and Random are replaced in place (nb_setarg/3) every step; eng(Prev, Random) is
-%   how the rest of this module sees the pair.
+%     Random  the KB's random state, while the generator does not hold it (see
+%             random_owner/1: while it does, the generator's state is the KB's)
+%   Prev is replaced in place (nb_setarg/3) every step; eng(Prev, Random) is how the rest
+%   of this module sees the pair (eng/2 gives the stream as it is now).
 
 engine_key(KB, Key) :-
     gvar_key('$relrl_engine:', KB, Key).
@@ -126,12 +134,61 @@ run(KB, Run) :-
     engine(KB, engine(Run, _, _)).
 
 eng(KB, eng(Prev, Random)) :-
-    engine(KB, engine(_, Prev, Random)).
+    engine(KB, engine(_, Prev, Random0)),
+    (   random_owner(KB)
+    ->  random_property(state(Random))
+    ;   Random = Random0
+    ).
 
 set_eng(KB, eng(Prev, Random)) :-
     engine(KB, Engine),
     nb_setarg(2, Engine, Prev),
-    nb_setarg(3, Engine, Random).
+    set_stream(KB, Engine, Random).
+
+%   KB's stream is now Random (the generator loads it when KB next needs it).
+set_stream(KB, Engine, Random) :-
+    nb_setarg(3, Engine, Random),
+    (   random_owner(KB)
+    ->  nb_setval(relrl_random_owner, none)
+    ;   true
+    ).
+
+%   The generator holds Owner's stream (the KB that stepped last), or that of none.
+random_owner(Owner) :-
+    nb_current(relrl_random_owner, Owner).
+
+:- initialization(nb_setval(relrl_random_owner, none)).
+
+%!  engine_park is det.
+%
+%   Put the stream the random generator holds (the knowledge base's that stepped last)
+%   away with its knowledge base, so that numbers drawn before the next step of any
+%   knowledge base draw from no knowledge base's stream. relrl's gateway calls it before
+%   every call that is not a control step; engine_step/6 and the engine's other predicates
+%   call it when they need the generator.
+
+engine_park :-
+    (   random_owner(Owner),
+        Owner \== none
+    ->  (   engine_key(Owner, Key),
+            nb_current(Key, Engine)
+        ->  random_property(state(Random)),
+            nb_setarg(3, Engine, Random)
+        ;   true
+        ),
+        nb_setval(relrl_random_owner, none)
+    ;   true
+    ).
+
+%   Load KB's stream into the generator (Engine is KB's engine term).
+claim_random(KB, Engine) :-
+    (   random_owner(KB)
+    ->  true
+    ;   engine_park,
+        arg(3, Engine, Random),
+        set_random(state(Random)),
+        nb_setval(relrl_random_owner, KB)
+    ).
 
 %!  engine_learner(+KB, -Learner) is det.
 %
@@ -251,6 +308,7 @@ has_constraints(KB) :-
     ).
 
 fresh_random(Seed, Random) :-
+    engine_park,
     (   integer(Seed)
     ->  set_random(seed(Seed))
     ;   Seed == none
@@ -259,14 +317,11 @@ fresh_random(Seed, Random) :-
     ),
     random_property(state(Random)).
 
-%   Run Goal with KB's random stream in place; keep the stream KB leaves behind.
+%   Run Goal with KB's random stream in the generator (it stays there, see claim_random/2).
 with_random(KB, Goal) :-
-    eng(KB, eng(_, Random0)),
-    set_random(state(Random0)),
-    call(Goal),
-    random_property(state(Random)),
-    eng(KB, eng(Prev, _)),
-    set_eng(KB, eng(Prev, Random)).
+    engine(KB, Engine),
+    claim_random(KB, Engine),
+    call(Goal).
 
 %!  engine_reseed(+KB, +Seed:integer) is det.
 %
@@ -274,9 +329,9 @@ with_random(KB, Goal) :-
 
 engine_reseed(KB, Seed) :-
     must_be(integer, Seed),
-    eng(KB, eng(Prev, _)),
+    engine(KB, Engine),
     fresh_random(Seed, Random),
-    set_eng(KB, eng(Prev, Random)).
+    set_stream(KB, Engine, Random).
 
 %!  engine_end_episode(+KB) is det.
 %
@@ -284,9 +339,9 @@ engine_reseed(KB, Seed) :-
 %   the necessity units start afresh.
 
 engine_end_episode(KB) :-
-    run(KB, run(Learner, _, _, _, _, _, _, _, _)),
-    eng(KB, eng(_, Random)),
-    set_eng(KB, eng(none, Random)),
+    engine(KB, Engine),
+    arg(1, Engine, run(Learner, _, _, _, _, _, _, _, _)),
+    nb_setarg(2, Engine, none),
     wm_clear(KB),
     motivation_reset(KB),
     (   learner_end_episode(Learner, KB)
@@ -302,6 +357,10 @@ engine_forget(KB) :-
     engine_key(KB, Key),
     (   nb_current(Key, _)
     ->  nb_delete(Key)
+    ;   true
+    ),
+    (   random_owner(KB)
+    ->  nb_setval(relrl_random_owner, none)
     ;   true
     ),
     state_forget(KB),
@@ -325,12 +384,10 @@ engine_forget(KB) :-
 
 engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     engine(KB, Engine),
-    Engine = engine(Run, Prev, Random0),
-    set_random(state(Random0)),
+    Engine = engine(Run, Prev, _),
+    claim_random(KB, Engine),
     step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
-    random_property(state(Random)),
-    nb_setarg(2, Engine, Next),
-    nb_setarg(3, Engine, Random).
+    nb_setarg(2, Engine, Next).
 
 step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
      Prev, Percepts, EmittedIx, Mode, Want,
@@ -439,7 +496,7 @@ engine_explain(KB, When, Explanation) :-
     must_be(oneof([last, now]), When),
     run(KB, run(Learner, _, _, _, Units, _, _, _, Plan)),
     (   When == last,
-        eng(KB, eng(prev(State, N), _))
+        engine(KB, engine(_, prev(State, N), _))
     ->  true
     ;   plan_code(KB, Plan, Code),
         learner_view(Learner, KB, Code, State),

@@ -20,6 +20,7 @@
 :- use_module(relrl).
 :- use_module(declarations).
 :- use_module(policy).
+:- use_module(engine, [engine_park/0]).
 
 /** <module> The Prolog side of relrl's Python gateway
 
@@ -44,7 +45,9 @@ gateway call is cancelled and reported as an error naming the file and line when
 from a directive; abort/0 is reported (gw_take_abort/1) instead of unwinding silently.
 
 A knowledge base is a module of its own (gw_new_kb/1), so two knowledge bases in one
-process never see each other's clauses or working memory.
+process never see each other's clauses or working memory. Every call but a step first puts
+the random stream of the knowledge base that stepped last away (engine_park/0): a user's
+query or a loaded file that draws random numbers draws from none of the agents' streams.
 */
 
 :- meta_predicate gw_run(0, +, -), guarded(0, +, -), api_call(0), once_result(0, -),
@@ -80,8 +83,10 @@ gw_step(KB, Percepts, Emitted, Mode, Want, Limit, Result,
     ;   true
     ).
 
-%   A goal of a knowledge-base module or of python_api/1; anything else is refused.
+%   A goal of a knowledge-base module or of python_api/1; anything else is refused. The
+%   last stepping agent's random stream is put away first (see relrl_engine:engine_park/0).
 api_call(Goal) :-
+    engine_park,
     strip_module(Goal, M, G),
     (   callable(G),
         functor(G, Name, Arity),
@@ -464,6 +469,7 @@ gw_load(File, Module, Problems) :-
 gw_load(File, Module, Limit, Problems) :-
     must_be(atom, Module),
     must_be(number, Limit),
+    engine_park,                        % a directive may draw random numbers
     (   exists_file(File)
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),
@@ -726,6 +732,7 @@ toplevel_error(E, E).
 %   The clock runs and halt/0,1 is cancelled (see halt_hook/0) while an answer is sought;
 %   between answers the clock stops and what the goal wrote is flushed.
 resume(Limit) :-
+    engine_park,                        % a step may have run between two answers
     nb_setval(relrl_active, true),
     nb_setval(relrl_halt, none),
     get_time(Now),

@@ -255,6 +255,66 @@ test(random_streams_per_kb, [As1 == As2]) :-
                  relrl_engine:engine_step(B, S, -1, learn, [], step(_, _, _, _, _, _, X, _)) ),
             As2).
 
+%   Between two steps the generator holds the stream of the knowledge base that stepped
+%   last; engine_park/0 puts it away, so numbers drawn afterwards are no agent's.
+test(parked_stream_is_not_drawn_from, [As1 == As2]) :-
+    Steps = [[see(light)], [see(dark)], [see(light), smell(food)], [see(dark)],
+             [see(light)], [see(dark)], [see(light)], [see(dark), smell(food)]],
+    P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,
+         reward_positive=10.0, reward_negative= -1.0],
+    kb_with('tests/data/tiny.pl', A),
+    relrl_engine:engine_configure(A, etg, P, 7),
+    findall(X, ( member(S, Steps),
+                 relrl_engine:engine_step(A, S, -1, learn, [], step(_, _, _, _, _, _, X, _)) ),
+            As1),
+    kb_with('tests/data/tiny.pl', B),
+    relrl_engine:engine_configure(B, etg, P, 7),
+    findall(X, ( member(S, Steps),
+                 relrl_engine:engine_step(B, S, -1, learn, [], step(_, _, _, _, _, _, X, _)),
+                 relrl_engine:engine_park,
+                 random(_), random(_) ),
+            As2).
+
+%   The stream a snapshot keeps is the one the knowledge base draws from now, whether the
+%   generator holds it (the knowledge base stepped last) or not.
+test(snapshot_takes_the_live_stream, [Same == true]) :-
+    P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,
+         reward_positive=10.0, reward_negative= -1.0],
+    kb_with('tests/data/tiny.pl', KB),
+    relrl_engine:engine_configure(KB, etg, P, 5),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_snapshot(KB, snapshot(_, _, eng(_, R1), _)),
+    relrl_engine:engine_park,
+    relrl_engine:engine_snapshot(KB, snapshot(_, _, eng(_, R2), _)),
+    same(R1, R2, Same).          % (not the states themselves: 2.5 KB each in a message)
+
+%   Ending an episode leaves the stream where the last step left it; reseeding replaces it,
+%   whether or not the generator holds it.
+test(end_episode_keeps_and_reseed_replaces_the_stream, [Same == true-true]) :-
+    P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,
+         reward_positive=10.0, reward_negative= -1.0],
+    kb_with('tests/data/tiny.pl', KB),
+    relrl_engine:engine_configure(KB, etg, P, 5),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_step(KB, [see(dark)], 0, learn, [], _),
+    relrl_engine:engine_snapshot(KB, snapshot(_, _, eng(_, R1), _)),
+    relrl_engine:engine_end_episode(KB),
+    relrl_engine:engine_snapshot(KB, snapshot(_, _, eng(_, R2), _)),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_reseed(KB, 7),
+    relrl_engine:engine_snapshot(KB, snapshot(_, _, eng(_, R3), _)),
+    set_random(seed(7)),
+    random_property(state(R7)),
+    same(R1, R2, Kept),
+    same(R3, R7, Replaced),
+    Same = Kept-Replaced.
+
+same(X, Y, Same) :-
+    (   X == Y
+    ->  Same = true
+    ;   Same = false
+    ).
+
 test(snapshot_restores_memory_and_stream, [X1 == X2]) :-
     kb_with('tests/data/tiny.pl', KB),
     P = [alpha=0.2, gamma=0.9, epsilon=1.0, q_init=0.0, split_threshold=0.1,

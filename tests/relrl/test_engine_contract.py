@@ -4,6 +4,7 @@ policies read as data."""
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -146,6 +147,48 @@ def _trajectory(learner: str, with_other: bool, steps: int = 300) -> list:
 @pytest.mark.parametrize("learner", ["etg", "contingency", "qlearning"])
 def test_two_agents_in_one_process_are_isolated(learner: str) -> None:
     assert _trajectory(learner, with_other=False) == _trajectory(learner, with_other=True)
+
+
+def _learning_with(between: Callable[[KnowledgeBase, int], None] | None,
+                   steps: int = 200) -> list:
+    """An ETG agent's actions on SIS, ``between(kb, i)`` called after each step."""
+    with KnowledgeBase(SIS) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=4)
+        env = SharedAttentionEnv(make_caregiver("paper"), max_steps=None, record_trace=False)
+        me = Interaction(env, agent)
+        me.reset(seed=4)
+        actions = []
+        for i in range(steps):
+            actions += [r.out.action for r in me.run(1)]
+            if between is not None:
+                between(kb, i)
+        return actions
+
+
+def test_user_queries_between_steps_leave_the_trajectory() -> None:
+    """Numbers a user's query draws (a query, a call, the shell's open query, even with
+    another agent's step between two of its answers) come from no agent's stream."""
+    drawn: list = []
+    with KnowledgeBase(SIS) as kb2:
+        other = Interaction(SharedAttentionEnv(make_caregiver("paper"), max_steps=None,
+                                               record_trace=False),
+                            Agent(kb2, make_learner("etg"), seed=5))
+        other.reset(seed=5)
+
+        def queries(kb: KnowledgeBase, i: int) -> None:
+            if i % 3 == 0:
+                drawn.append(kb.query("X is random_float, Y is random(1000)")[0][0][0][1])
+            elif i % 3 == 1:
+                drawn.append(kb.call("random_between", 1, 1000, Var())[0])
+            else:
+                with kb.open_query("between(1, 2, _), X is random(1000)") as q:
+                    drawn.append(q.next().text)
+                    other.run(1)
+                    drawn.append(q.next().text)
+
+        alone = _learning_with(None)
+        assert _learning_with(queries) == alone
+    assert len(set(drawn)) > len(drawn) // 2        # the queries did draw numbers
 
 
 def test_preserved_leaves_learning_as_it_was() -> None:
