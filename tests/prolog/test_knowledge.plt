@@ -117,3 +117,46 @@ test(example_domains_valid, [P1-P2 == []-[]]) :-
     relrl_check:check_domain(B, P2).
 
 :- end_tests(check).
+
+% ---------------------------------------------------------------------------------------
+%   What a gateway call leaves behind: the caller's flags and deadline (none between calls),
+%   whatever way the call ended.
+caller_state(Active-Deadline) :-
+    (   nb_current(relrl_active, Active0)
+    ->  Active = Active0
+    ;   Active = false                  % before the first call
+    ),
+    nb_getval(relrl_deadline, Deadline).
+
+:- begin_tests(gateway_call).
+
+ends(true, 0, true).
+ends(fail, 0, false).
+ends(throw(oops), 0, error(oops, _)).
+ends((repeat, fail), 0.05, error(time_limit_exceeded, _)).
+ends(halt, 0, error(halt_called(goal), _)).
+ends(relrl_gateway:interrupt(usr1), 0, error(interrupted, _)).
+
+test(each_end_restores_the_caller, [Ends == [ok, ok, ok, ok, ok, ok]]) :-
+    caller_state(Before),
+    findall(Ok, ( ends(Goal, Limit, Expected),
+                  relrl_gateway:guarded(Goal, Limit, Result),
+                  caller_state(After),
+                  (   subsumes_term(Expected, Result), After == Before
+                  ->  Ok = ok
+                  ;   Ok = Goal-Result-After
+                  ) ),
+            Ends).
+
+%   An inner call's time limit ends the inner call only; the outer call's deadline holds
+%   again after it.
+test(nested_limits, [Inner-Outer-Active == time_limit_exceeded-true-true]) :-
+    caller_state(Before),
+    relrl_gateway:guarded(( relrl_gateway:guarded((repeat, fail), 0.05, error(Inner, _)),
+                            user:caller_state(Active-Deadline),
+                            number(Deadline) ),
+                          5, Outer),
+    caller_state(After),
+    assertion(After == Before).
+
+:- end_tests(gateway_call).

@@ -108,6 +108,26 @@ def test_abort_while_loading_is_a_load_error(tmp_path: Path) -> None:
         assert kb.holds("true")
 
 
+def test_abort_in_a_goal_or_a_step_leaves_no_deadline_behind(tmp_path: Path) -> None:
+    """abort/0 unwinds past the gateway's catch/3: the call's flags and deadline are put
+    back all the same, so later calls run under their own limits."""
+    import time
+
+    path = domain(tmp_path, BASE + "fact(stop(face)).\nstop(face) :- percept(hear(stop)), "
+                                   "abort.\nslow :- sleep(0.1).\n")
+    with KnowledgeBase(path, timeout=0.2) as kb:
+        agent = Agent(kb, make_learner("etg"), seed=0)
+        with pytest.raises(RuleError, match="abort/0 called"):
+            kb.holds("abort")
+        time.sleep(0.25)
+        assert kb.holds("slow")          # the aborted call's deadline would stop it at once
+        with pytest.raises(RuleError, match="abort/0 called"):
+            agent.step([("see", "face"), ("hear", "stop")])
+        time.sleep(0.25)
+        assert kb.holds("slow")
+        assert agent.step([("see", "face")]).action is not None
+
+
 def test_deep_and_cyclic_terms(tmp_path: Path) -> None:
     path = domain(tmp_path, BASE + "cyc(X) :- X = f(X).\n"
                                    "deep(0, z) :- !.\ndeep(N, f(T)) :- M is N-1, deep(M, T).\n")
