@@ -58,7 +58,9 @@ key(KB, Key) :-
 :- dynamic key_/2.                  % KB, the name of its global variable (made once)
 
 %   The variable exists from the moment its name is made (key/2), so reading it is one
-%   nb_getval/2: the perception predicates read memory many times a step.
+%   nb_getval/2: the perception predicates read memory many times a step. Readers take the
+%   term and then unify it with the wm/5 they want (State = wm(...)): a wm/5 pattern given
+%   to nb_getval/2 or get/2 would first be built on the global stack, every read.
 get(KB, State) :-
     (   key_(KB, Key)
     ->  nb_getval(Key, State)
@@ -76,7 +78,8 @@ put(KB, State) :-
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    get(KB, wm(_, Span0, _, _, _)),
+    get(KB, State),
+    State = wm(_, Span0, _, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
     ;   Span = Span0
@@ -99,7 +102,8 @@ domain_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    get(KB, wm(Clock, _, Pairs, Elements, Now)),
+    get(KB, State),
+    State = wm(Clock, _, Pairs, Elements, Now),
     put(KB, wm(Clock, Span, Pairs, Elements, Now)).
 
 %!  wm_clock(+KB, -Clock) is det.
@@ -107,7 +111,8 @@ wm_set_span(KB, Span) :-
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    get(KB, wm(Clock, _, _, _, _)).
+    get(KB, State),
+    State = wm(Clock, _, _, _, _).
 
 %!  wm_insert(+KB, +Elements:list) is det.
 %
@@ -125,7 +130,8 @@ wm_insert(KB, New) :-
     ->  instantiation_error(E)
     ;   true
     ),
-    get(KB, wm(Clock0, Span0, Old, _, _)),
+    get(KB, State),
+    State = wm(Clock0, Span0, Old, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
     ;   Span = Span0
@@ -171,7 +177,8 @@ keep_old([P|Ps], New, Oldest, Pairs, Elements) :-
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    get(KB, wm(Clock, _, Pairs, _, _)),
+    get(KB, State),
+    State = wm(Clock, _, Pairs, _, _),
     member(Element-Stamp, Pairs),
     Age is Clock - Stamp.
 
@@ -182,7 +189,8 @@ wm_element(KB, Element, Age) :-
 
 wm_has(KB, Element) :-
     key_(KB, Key),                      % none: no memory yet
-    nb_getval(Key, wm(_, _, _, Elements, _)),
+    nb_getval(Key, State),
+    State = wm(_, _, _, Elements, _),
     (   ground(Element)                 % one copy of an element at most
     ->  memberchk(Element, Elements)
     ;   member(Element, Elements)
@@ -194,7 +202,8 @@ wm_has(KB, Element) :-
 
 wm_has_chk(KB, Element) :-
     key_(KB, Key),
-    nb_getval(Key, wm(_, _, _, Elements, _)),
+    nb_getval(Key, State),
+    State = wm(_, _, _, Elements, _),
     memberchk(Element, Elements).
 
 %!  wm_now(+KB, ?Element) is nondet.
@@ -202,7 +211,8 @@ wm_has_chk(KB, Element) :-
 %   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
 
 wm_now(KB, Element) :-
-    get(KB, wm(_, _, _, _, Now)),
+    get(KB, State),
+    State = wm(_, _, _, _, Now),
     (   ground(Element)                 % one copy of an element at most
     ->  memberchk(Element, Now)
     ;   member(Element, Now)
@@ -214,7 +224,8 @@ wm_now(KB, Element) :-
 %   (at(S, Place)) in KB's memory.
 
 wm_has_stimulus(KB, S) :-
-    get(KB, wm(_, _, _, Elements, _)),
+    get(KB, State),
+    State = wm(_, _, _, Elements, _),
     member(E, Elements),
     compound(E),
     (   compound_name_arguments(E, Sense, [S1])
@@ -237,7 +248,8 @@ sense_name(at).
 %   pass over it (the state code's).
 
 wm_stamped(KB, Clock, Pairs) :-
-    get(KB, wm(Clock, _, Pairs, _, _)).
+    get(KB, State),
+    State = wm(Clock, _, Pairs, _, _).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
 %
@@ -257,7 +269,8 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    get(KB, wm(_, Span, _, _, _)),
+    get(KB, State),
+    State = wm(_, Span, _, _, _),
     put(KB, wm(0, Span, [], [], [])).
 
 %!  wm_size(+KB, -Size:nonneg) is det.
@@ -265,7 +278,8 @@ wm_clear(KB) :-
 %   Size is the number of elements in KB's memory.
 
 wm_size(KB, Size) :-
-    get(KB, wm(_, _, Pairs, _, _)),
+    get(KB, State),
+    State = wm(_, _, Pairs, _, _),
     length(Pairs, Size).
 
 %!  wm_state(+KB, -State) is det.
@@ -278,7 +292,8 @@ wm_size(KB, Size) :-
 %   @error domain_error(working_memory_state, State) if State is not such a term.
 
 wm_state(KB, wm(Clock, Span, Pairs)) :-
-    get(KB, wm(Clock, Span, Pairs, _, _)).
+    get(KB, State),
+    State = wm(Clock, Span, Pairs, _, _).
 
 wm_set_state(KB, State) :-
     must_be(atom, KB),
