@@ -12,6 +12,7 @@
             state_mark/1,         % -Mark
             state_forget/1,       % +KB
             state_forget/2,       % +KB, +Mark
+            state_touch/0,
             state_decode/3,       % +KB, +Code, -Terms
             state_encode/3        % +KB, +Terms, -Code
           ]).
@@ -111,20 +112,32 @@ active(fact(F), KB) :-
 %   is sensed now (plan_code/4). The stimuli are read off working memory in one pass: each
 %   memory element is looked up in a table of the percepts that perceive a stimulus (see(S),
 %   hear(S), smell(S), at(S), at(S, _) — what stimulus_perceived/2 accepts) and gives its
-%   stimulus's bits; a stimulus holds when perceived, whatever rules say. Each fact is
-%   still its goal, run by its rules (relrl_rules:rules_program/3: errors and time limits
-%   propagate as under rule_holds/2). A plan lasts until state_forget/1 and
-%   relrl_rules:rules_forget/1 (the engine's).
+%   stimulus's bits; a stimulus holds when perceived, whatever rules say.
+%
+%   A fact is its goal, run by its rules (relrl_rules:rules_program/3: errors and time
+%   limits propagate as under rule_holds/2) — except a *memory fact*, whose goal only looks
+%   a ground percept up in working memory (memory_fact/4; head_at(left) :-
+%   memory(at(left), 0)): the same pass reads it off memory, as a stimulus. A memory fact
+%   holds exactly when its goal would succeed, and its goal can raise no error, so the
+%   code is the same. Once anything but a step may have redefined, traced or spied a
+%   memory fact's predicate (state_touch/0), the next plan_code/4 checks the memory facts
+%   again; if one is no longer, every fact runs as its goal (until the next check).
+%
+%   A plan lasts until state_forget/1 and relrl_rules:rules_forget/1 (the engine's).
 
 :- dynamic
     plan_kb_/2,             % Id, KB: KB's plan (one at a time)
     plan_stimulus_/3,       % Id, Percept, Mask: Percept perceives the stimuli of Mask
+    plan_fact_/4,           % Id, Percept, Any, Now: Percept (ground, one entry each)
+                            % makes the memory facts of Any true, and those of Now too
+                            % when it is of age 0
+    plan_memory_fact_/4,    % Id, Goal, Percept, When (any or now): the memory facts
     plan_reinforcer_/2.     % Id, Percept: Percept senses a reinforcer
 
 state_plan(KB, Features, Plan) :-
     state_plan(KB, Features, [], Plan).
 
-state_plan(KB, Features, Reinforcers, plan(Id, Program)) :-
+state_plan(KB, Features, Reinforcers, plan(Id, Program, Goals, checked(Touch, true))) :-
     must_be(atom, KB),
     must_be(list, Features),
     must_be(list, Reinforcers),
@@ -136,7 +149,113 @@ state_plan(KB, Features, Reinforcers, plan(Id, Program)) :-
            assertz(plan_stimulus_(Id, Percept, Mask))),
     forall(( member(S, Reinforcers), sense(Sense), Percept =.. [Sense, S] ),
            assertz(plan_reinforcer_(Id, Percept))),
-    rules_program(KB, Facts, Program).
+    partition(memory_fact_bit(KB, Id), Facts, MemoryFacts, OtherFacts),
+    fact_masks(Id, MemoryFacts),
+    touched(Touch),
+    rules_program(KB, OtherFacts, Program),
+    rules_program(KB, Facts, Goals).
+
+%   Goal-Bit is a memory fact (noted for plan Id).
+memory_fact_bit(KB, Id, Goal-_) :-
+    memory_fact(KB, Goal, Percept, When),
+    assertz(plan_memory_fact_(Id, Goal, Percept, When)).
+
+%   The table plan_fact_/4: per percept, the bits of the memory facts it makes true (at
+%   any age, or at age 0).
+fact_masks(Id, MemoryFacts) :-
+    findall(Percept-Masks,
+            ( member(Goal-Bit, MemoryFacts),
+              plan_memory_fact_(Id, Goal, Percept, When),
+              (   When == any
+              ->  Masks = m(Bit, 0)
+              ;   Masks = m(0, Bit)
+              ) ),
+            Facts),
+    msort(Facts, Sorted),
+    merge_percepts(Sorted, Percepts),
+    forall(member(P-m(Any, Now), Percepts),
+           assertz(plan_fact_(Id, P, Any, Now))).
+
+merge_percepts([], []).
+merge_percepts([P-m(A, N)|Ps], Percepts) :-
+    (   Ps = [P1-m(A1, N1)|Ps1], P1 == P
+    ->  A2 is A \/ A1,
+        N2 is N \/ N1,
+        merge_percepts([P-m(A2, N2)|Ps1], Percepts)
+    ;   Percepts = [P-m(A, N)|Percepts1],
+        merge_percepts(Ps, Percepts1)
+    ).
+
+%!  memory_fact(+KB, +Goal, -Percept, -When) is semidet.
+%
+%   Goal, a fact of KB, only looks Percept (ground) up in working memory, at any age
+%   (When = any) or at age 0 (When = now): its predicate is KB's own, static, neither
+%   multifile nor traced nor spied, and has one clause, whose body for Goal is one call of
+%   relrl's percept/1 (any age), memory/2 with age 0 (now), at/2 (any age), or see/1,
+%   hear/1, smell/1 or at/1 of an atomic stimulus (any age), on a ground term. Goal then
+%   succeeds exactly when Percept is in memory (of age 0 for `now`), and raises no error.
+
+memory_fact(KB, Goal, Percept, When) :-
+    callable(Goal),
+    current_prolog_flag(protect_static_code, false),
+    Head = KB:Goal,
+    predicate_property(Head, number_of_clauses(1)),
+    \+ predicate_property(Head, imported_from(_)),
+    \+ predicate_property(Head, dynamic),
+    \+ predicate_property(Head, multifile),
+    \+ predicate_property(Head, wrapped(_)),
+    \+ predicate_property(Head, spying),
+    clause(Head, Body),
+    reads_memory(Body, Percept, When),
+    ground(Percept),
+    functor(Body, Name, Arity),
+    functor(Callee, Name, Arity),
+    predicate_property(KB:Callee, imported_from(relrl)).
+
+reads_memory(percept(P), P, any).
+reads_memory(memory(P, Age), P, now) :-
+    Age == 0.
+reads_memory(at(S, Place), at(S, Place), any).
+reads_memory(Body, Body, any) :-
+    compound(Body),
+    compound_name_arguments(Body, Sense, [S]),
+    sense(Sense),
+    atomic(S).
+
+%!  state_touch is det.
+%
+%   Anything may have changed the domain's rules since the last step (a user's query, a
+%   file loaded, a trace point set): each plan checks its memory facts again at its next
+%   use (see state_plan/4). relrl's gateway calls it (through relrl_engine:engine_park/0)
+%   before every call that is not a step.
+
+state_touch :-
+    touched(T0),
+    T is T0 + 1,
+    nb_setval(relrl_state_touch, T).
+
+touched(T) :-
+    (   nb_current(relrl_state_touch, T0)
+    ->  T = T0
+    ;   T = 0
+    ).
+
+%   Plan Id's memory facts are memory facts still: checked(Touch, Hold) says so (Hold)
+%   until state_touch/0 moves on from Touch; then they are checked again.
+memory_facts_hold(KB, Id, Checked) :-
+    touched(T),
+    (   arg(1, Checked, T)
+    ->  arg(2, Checked, true)
+    ;   (   \+ ( plan_memory_fact_(Id, Goal, Percept, When),
+                 \+ ( memory_fact(KB, Goal, Percept1, When1),
+                      Percept1 == Percept, When1 == When ) )
+        ->  Hold = true
+        ;   Hold = false
+        ),
+        nb_setarg(1, Checked, T),
+        nb_setarg(2, Checked, Hold),
+        Hold == true
+    ).
 
 plan_([], _, [], []).
 plan_([F|Fs], Bit, Masks, Facts) :-
@@ -189,6 +308,8 @@ state_forget(KB, Mark) :-
     forall(( plan_kb_(Id, KB), Id < Mark ),
            ( retractall(plan_kb_(Id, KB)),
              retractall(plan_stimulus_(Id, _, _)),
+             retractall(plan_fact_(Id, _, _, _)),
+             retractall(plan_memory_fact_(Id, _, _, _)),
              retractall(plan_reinforcer_(Id, _)) )).
 
 %!  plan_code(+KB, +Plan, -Code:integer) is det.
@@ -201,16 +322,30 @@ state_forget(KB, Mark) :-
 plan_code(KB, Plan, Code) :-
     plan_code(KB, Plan, Code, _).
 
-plan_code(KB, plan(Id, Program), Code, Reinforced) :-
+plan_code(KB, plan(Id, Program, Goals, Checked), Code, Reinforced) :-
     wm_stamped(KB, Clock, Pairs),
-    scan(Pairs, Id, Clock, 0, Code0, false, Reinforced),
-    program_mask(Program, Code0, Code).
+    (   memory_facts_hold(KB, Id, Checked)
+    ->  scan(Pairs, Id, Clock, true, 0, Code0, false, Reinforced),
+        program_mask(Program, Code0, Code)
+    ;   scan(Pairs, Id, Clock, false, 0, Code0, false, Reinforced),
+        program_mask(Goals, Code0, Code)
+    ).
 
-scan([], _, _, Mask, Mask, R, R).
-scan([E-Stamp|Es], Id, Clock, Mask0, Mask, R0, R) :-
+%   The pass over memory: the bits of the stimuli each element perceives and (Facts ==
+%   true) of the memory facts it makes true, and whether a reinforcer is sensed now (R).
+scan([], _, _, _, Mask, Mask, R, R).
+scan([E-Stamp|Es], Id, Clock, Facts, Mask0, Mask, R0, R) :-
     (   plan_stimulus_(Id, E, M)
     ->  Mask1 is Mask0 \/ M
     ;   Mask1 = Mask0
+    ),
+    (   Facts == true,
+        plan_fact_(Id, E, Any, Now)
+    ->  (   Stamp =:= Clock
+        ->  Mask2 is Mask1 \/ Any \/ Now
+        ;   Mask2 is Mask1 \/ Any
+        )
+    ;   Mask2 = Mask1
     ),
     (   R0 == false,
         Stamp =:= Clock,
@@ -218,7 +353,7 @@ scan([E-Stamp|Es], Id, Clock, Mask0, Mask, R0, R) :-
     ->  R1 = true
     ;   R1 = R0
     ),
-    scan(Es, Id, Clock, Mask1, Mask, R1, R).
+    scan(Es, Id, Clock, Facts, Mask2, Mask, R1, R).
 
 %!  state_decode(+KB, +Code, -Terms:list) is det.
 %

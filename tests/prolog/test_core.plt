@@ -363,6 +363,84 @@ test(plan_code_is_features_code, [true(Pairs1 == Pairs2)]) :-
     pairs_keys(Pairs, Pairs1),
     pairs_values(Pairs, Pairs2).
 
+%   Facts whose goal only looks a ground percept up in memory are read off memory by the
+%   plan's pass (memory facts); the others run as goals. The code is the same either way.
+test(memory_facts_of_sis, [Names == [gaze_frontal, gaze_left, gaze_left_down, gaze_down,
+                                      gaze_right_down, gaze_right, head_at, head_at,
+                                      head_at, head_at, head_at, head_at, toy_at, toy_at,
+                                      toy_at, toy_at, toy_at]]) :-
+    kb_with('examples/domains/sis.pl', KB),
+    findall(Name, ( relrl_declarations:kb_fact(KB, F),
+                    relrl_state:memory_fact(KB, F, _, _),
+                    functor(F, Name, _) ),
+            Names).
+
+test(memory_facts_and_goals,
+     [Found == [plain-see(s)-any, young-hear(s)-now, seen-see(s)-any,
+                placed(s)-at(s, left)-any, placed(t)-at(t, left)-any]]) :-
+    kb_with('tests/data/memory_facts.pl', KB),
+    findall(F-P-W, ( relrl_declarations:kb_fact(KB, F),
+                     relrl_state:memory_fact(KB, F, P, W) ),
+            Found).
+
+memory_facts_percept(P) :-
+    member(P, [see(s), see(t), hear(s), hear(t), at(s, left), at(t, left), at(s, right),
+               a, b, pose(s, x)]).
+
+test(memory_facts_code_is_features_code, [true(Pairs1 == Pairs2)]) :-
+    kb_with('tests/data/memory_facts.pl', KB),
+    relrl_state:state_features(KB, Features),
+    relrl_state:state_plan(KB, Features, Plan),
+    set_random(seed(6)),
+    findall(C1-C2,
+            ( between(1, 300, _),
+              findall(P, ( memory_facts_percept(P), random(X), X < 0.3 ), Elements),
+              relrl_memory:wm_insert(KB, Elements),
+              relrl_state:features_code(KB, Features, C1),
+              relrl_state:plan_code(KB, Plan, C2) ),
+            Pairs),
+    pairs_keys(Pairs, Pairs1),
+    pairs_values(Pairs, Pairs2).
+
+%   A memory fact redefined after the plan was made (by a file loaded into the knowledge
+%   base) is run as its new goal at the next step.
+test(redefined_memory_fact_runs_its_new_goal, [Plain0-Plain1 == true-false]) :-
+    kb_with('tests/data/memory_facts.pl', KB),
+    relrl_state:state_features(KB, Features),
+    relrl_state:state_plan(KB, Features, Plan),
+    once(relrl_state:feature_code(KB, fact(plain), X)),
+    relrl_memory:wm_insert(KB, [see(s)]),
+    relrl_state:plan_code(KB, Plan, C0),
+    tmp_file_stream(text, File, S),
+    format(S, "plain :- percept(see(t)).~n", []),
+    close(S),
+    relrl_gateway:gw_load(File, KB, _),
+    delete_file(File),
+    relrl_state:plan_code(KB, Plan, C1),
+    bit(C0, X, Plain0),
+    bit(C1, X, Plain1).
+
+bit(Code, X, Set) :-
+    (   Code /\ (1 << X) =\= 0
+    ->  Set = true
+    ;   Set = false
+    ).
+
+%   A memory fact traced (wrapped, as relrl shell's trace does) after the plan was made
+%   runs as its goal again, so the trace sees it.
+test(traced_memory_fact_runs_as_its_goal, [Calls == 1]) :-
+    kb_with('tests/data/memory_facts.pl', KB),
+    relrl_state:state_features(KB, Features),
+    relrl_state:state_plan(KB, Features, Plan),
+    relrl_memory:wm_insert(KB, [see(s)]),
+    relrl_state:plan_code(KB, Plan, _),
+    flag(relrl_test_calls, _, 0),
+    wrap_predicate(KB:plain, relrl_test, W, ( flag(relrl_test_calls, N, N + 1), W )),
+    relrl_state:state_touch,
+    relrl_state:plan_code(KB, Plan, _),
+    unwrap_predicate(KB:plain, relrl_test),
+    flag(relrl_test_calls, Calls, 0).
+
 %   A stimulus declared twice owns both bits; the reinforcement check reads age 0 only.
 test(scan_masks_and_reinforcer, [true(R1-R2-M == true-false-5)]) :-
     relrl_gateway:gw_new_kb(KB),
@@ -430,7 +508,10 @@ test(compiled_rules_do_not_pile_up, [true((N1 > 0, N2 == N1, N3 == 0))]) :-
 compiled(KB, N) :-
     aggregate_all(count, clause(relrl_rules:program_(_, KB, _, _, _), _), NP),
     aggregate_all(count, ( relrl_state:plan_kb_(Id, KB),
-                           relrl_state:plan_stimulus_(Id, _, _) ), NS),
+                           (   relrl_state:plan_stimulus_(Id, _, _)
+                           ;   relrl_state:plan_fact_(Id, _, _, _)
+                           ;   relrl_state:plan_memory_fact_(Id, _, _, _)
+                           ) ), NS),
     N is NP + NS.
 
 %   Memory is linked into its global variable (no second copy): what an insertion keeps
