@@ -161,20 +161,13 @@ random_owner(Owner) :-
 
 %!  engine_park is det.
 %
-%   Make way for something else than a step, between steps: put the stream the random
-%   generator holds (the knowledge base's that stepped last) away with its knowledge base,
-%   so that numbers drawn before the next step draw from no knowledge base's stream, and
-%   let the next step check again which facts it may read straight off working memory
-%   (relrl_state:state_touch/0: a rule may be redefined, traced or spied meanwhile).
-%   relrl's gateway calls it before every call that is not a control step.
+%   Put the stream the random generator holds (the knowledge base's that stepped last)
+%   away with its knowledge base, so that numbers drawn before the next step of any
+%   knowledge base draw from no knowledge base's stream. relrl's gateway calls it before
+%   every call that is not a control step; the engine's own predicates that need the
+%   generator do too.
 
 engine_park :-
-    park_random,
-    state_touch.
-
-%   Put the generator's stream away with its knowledge base (the engine's own predicates
-%   that need the generator do this first).
-park_random :-
     (   random_owner(Owner),
         Owner \== none
     ->  (   engine_key(Owner, Key),
@@ -191,7 +184,7 @@ park_random :-
 claim_random(KB, Engine) :-
     (   random_owner(KB)
     ->  true
-    ;   park_random,
+    ;   engine_park,
         arg(3, Engine, Random),
         set_random(state(Random)),
         nb_setval(relrl_random_owner, KB)
@@ -315,7 +308,7 @@ has_constraints(KB) :-
     ).
 
 fresh_random(Seed, Random) :-
-    park_random,
+    engine_park,
     (   integer(Seed)
     ->  set_random(seed(Seed))
     ;   Seed == none

@@ -21,6 +21,7 @@
 :- use_module(declarations).
 :- use_module(policy).
 :- use_module(engine, [engine_park/0]).
+:- use_module(state, [state_touch/0]).
 
 /** <module> The Prolog side of relrl's Python gateway
 
@@ -48,6 +49,9 @@ A knowledge base is a module of its own (gw_new_kb/1), so two knowledge bases in
 process never see each other's clauses or working memory. Every call but a step first puts
 the random stream of the knowledge base that stepped last away (engine_park/0): a user's
 query or a loaded file that draws random numbers draws from none of the agents' streams.
+A call that may change the domain's rules (a goal of a knowledge base, a user's query,
+loading a file) also makes the next step check which facts it may read straight off
+working memory (relrl_state:state_touch/0).
 */
 
 :- meta_predicate gw_run(0, +, -), guarded(0, +, -), guarded_call(0, +, +, +, -),
@@ -84,14 +88,16 @@ gw_step(KB, Percepts, Emitted, Mode, Want, Limit, Result,
     ).
 
 %   A goal of a knowledge-base module or of python_api/1; anything else is refused. The
-%   last stepping agent's random stream is put away first (see relrl_engine:engine_park/0).
+%   last stepping agent's random stream is put away first (see relrl_engine:engine_park/0);
+%   a goal of a knowledge base (the user's own: it may redefine or trace a rule) touches
+%   the state plans (relrl_state:state_touch/0).
 api_call(Goal) :-
     engine_park,
     strip_module(Goal, M, G),
     (   callable(G),
         functor(G, Name, Arity),
         (   kb_module_(M)
-        ->  true
+        ->  state_touch
         ;   python_api(M:Name/Arity)
         )
     ->  call(Goal)
@@ -482,6 +488,7 @@ gw_load(File, Module, Limit, Problems) :-
     must_be(atom, Module),
     must_be(number, Limit),
     engine_park,                        % a directive may draw random numbers
+    state_touch,                        % or redefine a rule
     (   exists_file(File)
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),
@@ -581,6 +588,7 @@ strip_location(Msg0, Msg) :-
 %   error(Error, Message) for a syntax error, an exception or a time-out.
 
 gw_query(Module, Text, Limit, Max, Result) :-
+    state_touch,                        % a query may redefine or trace a rule
     catch(query_(Module, Text, Limit, Max, Result), E, error_result(E, Result)).
 
 query_(Module, Text, Limit, Max, solutions(Solutions, More)) :-
@@ -745,6 +753,7 @@ toplevel_error(E, E).
 %   between answers the clock stops and what the goal wrote is flushed.
 resume(Limit) :-
     engine_park,                        % a step may have run between two answers
+    state_touch,                        % a query may redefine or trace a rule
     nb_setval(relrl_active, true),
     nb_setval(relrl_halt, none),
     get_time(Now),
