@@ -31,3 +31,19 @@ def default_signals() -> None:
         signal.signal(sig, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
 
+
+
+@pytest.fixture(params=["kernel", "ctypes"])
+def crossing(request: pytest.FixtureRequest):
+    """Run a test twice: with the control step's crossing compiled (relrl._step_kernel)
+    and through ctypes alone (as without numba). Yields the name of the crossing."""
+    from relrl.kb import _get_engine
+
+    engine = _get_engine()
+    kernel = engine._kernel if engine._kernel is not None else engine._load_kernel()
+    assert kernel, "numba is a dependency: the compiled step must load"
+    engine._kernel = kernel if request.param == "kernel" else False
+    try:
+        yield request.param
+    finally:
+        engine._kernel = kernel
