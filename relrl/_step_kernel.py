@@ -24,9 +24,11 @@ whether the extras are not ``[]``.
 
 ``fo`` (float64): in — the time limit; out — the reward, then the necessity units' outputs.
 
-The frame is left open: the caller reads what the kernel could not (an error, a result
-other than ``true``, a field that is not a small integer, atom or float, more outputs than
-``fo`` holds, the extras) from the argument references, then discards it.
+When every field was read and the extras are ``[]``, the kernel discards the frame (``io``'s
+frame is then 0). Otherwise the frame is left open: the caller reads what the kernel could
+not (an error, a result other than ``true``, a field that is not a small integer, atom or
+float, more outputs than ``fo`` holds, the extras) from the argument references, then
+discards it.
 """
 
 from __future__ import annotations
@@ -54,6 +56,7 @@ SLOW = -3        # a field must be converted by the caller
 _T = types.uintp                       # term_t, atom_t, fid_t, record_t, predicate_t
 _I = types.intc
 _open_frame = types.ExternalFunction("PL_open_foreign_frame", _T())
+_discard_frame = types.ExternalFunction("PL_discard_foreign_frame", types.void(_T))
 _new_term_refs = types.ExternalFunction("PL_new_term_refs", _T(types.size_t))
 _new_term_ref = types.ExternalFunction("PL_new_term_ref", _T())
 _put_atom = types.ExternalFunction("PL_put_atom", _I(_T, _T))
@@ -112,4 +115,7 @@ def step(io, fo):  # pragma: no cover - compiled (its Python twin is KnowledgeBa
         return SLOW
     io[OUTPUTS] = n
     io[EXTRAS] = 1 - _get_nil(a + 14)
+    if io[EXTRAS] == 0:       # nothing left to read: the frame goes now
+        _discard_frame(fid)
+        io[FRAME] = 0
     return 0

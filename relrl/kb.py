@@ -105,6 +105,17 @@ def _hashable(value: Term) -> Any:
                 return tuple(map(_hashable, value))
         return value          # atoms only (most percepts): the tuple is its own key
     if kind is list:
+        for item in value:             # a percept list: tuples of atoms, keyed as they are
+            if type(item) is not tuple:
+                break
+            for arg in item:
+                if type(arg) is not str:
+                    break
+            else:
+                continue
+            break
+        else:
+            return (_LIST_KEY, *value)
         return (_LIST_KEY, *map(_hashable, value))
     return (kind.__name__, value)
 
@@ -520,7 +531,8 @@ class _Engine:
                             v[k.ACTION], extras)
             return self._step_read(v[k.ARGS], status != k.RAISED, want, timeout)
         finally:
-            self.discard_frame(v[k.FRAME])
+            if v[k.FRAME]:
+                self.discard_frame(v[k.FRAME])
             if self._step_mark is not None:
                 self.release_strings(self._step_mark)
                 self._step_mark = None

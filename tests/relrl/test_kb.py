@@ -191,3 +191,20 @@ def test_time_limit_holds_across_many_short_calls() -> None:
         assert kb.holds(("true",))                 # and nothing fires afterwards
         time.sleep(0.3)
         assert kb.holds(("between", 1, 1000, 1000))
+
+
+def test_cached_keys_are_equal_only_for_equal_terms() -> None:
+    """A recorded term is found by its key: terms that Python calls equal but Prolog does
+    not (1, 1.0, True; a list and a compound) must have different keys."""
+    from relrl.kb import Cached
+
+    def key(value: object) -> object:
+        return Cached(value).key
+
+    percepts = [("see", "face"), ("at", "face", "left")]
+    assert key(percepts) == key([("see", "face"), ("at", "face", "left")])
+    assert key(percepts) != key(tuple(percepts)) != key([("see", "face")])
+    assert len({key([("f", 1)]), key([("f", 1.0)]), key([("f", True)]),
+                key([("f", "1")])}) == 4
+    assert len({key([1]), key([1.0]), key([True]), key(["1"]), key([[1]]), key([(1,)]),
+                key([("f", [1])]), key([("f", (1,))])}) == 8
