@@ -69,6 +69,29 @@ _CVT_WRITEQ = 0xC0
 _BUF_DISCARDABLE = 0x0
 _PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
 
+# relrl._read_kernel's codes (that module imports numba: it is loaded on first use).
+_R_ATOM, _R_INT, _R_FLOAT, _R_STRING, _R_NIL, _R_LIST, _R_TERM, _R_OTHER = range(8)
+_R_ROOT = -1
+_FULL, _DEEP, _LONG = -1, -2, -3
+
+
+def _too_deep() -> PrologError:
+    return PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) cannot be "
+                       "passed to Python", "term_too_deep")
+
+
+def _too_long() -> PrologError:
+    return PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) cannot be passed "
+                       "to Python", "list_too_long")
+
+
+def _grown(array: Any) -> Any:
+    """``array`` twice as long (first axis), zeroed: a compiled reader's room."""
+    import numpy as np
+
+    return np.zeros((2 * array.shape[0], *array.shape[1:]), array.dtype)
+
+
 _KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
 _MAX_RECORDS = 4096
 _MAX_ATOMS = 4096
@@ -215,6 +238,7 @@ class _Engine:
         self._held: dict[int, str] = {}
         self._step_mark: int | None = None
         self._kernel: Any = None          # the compiled step: None untried, False none
+        self._flatten: Any = None         # the compiled reader: the same
         self._held_names: dict[str, int] = {}
         self._true = self.hold("true")
 
@@ -349,15 +373,107 @@ class _Engine:
             name = ctypes.string_at(s, n.value).decode("utf-8")
         return name
 
-    def get(self, t: int, depth: int = 0) -> Term:
+    def get(self, t: int) -> Term:
         """Read the term at reference ``t`` as a Python value.
 
+        A compound or a list is read in one compiled call (:mod:`relrl._read_kernel`)
+        when numba is there, else node by node, as an atom or a number always is.
+
         Raises:
-            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic).
+            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
+                holds a list longer than :data:`MAX_LIST` (or cyclic).
         """
+        kind = self.term_type(t)
+        if kind != _PL_TERM and kind != _PL_LIST_PAIR:
+            return self._get_nodes(t)
+        flatten = self._flatten if self._flatten is not None else self._load_flatten()
+        if not flatten:
+            return self._get_nodes(t)
+        ops, nums, text, stack = self._read_arrays
+        while True:
+            n = flatten(t, ops, nums, text, stack, MAX_DEPTH, MAX_LIST)
+            if n != _FULL:
+                break
+            ops, nums, text, stack = self._read_arrays = tuple(
+                _grown(a) for a in self._read_arrays)
+        if n == _DEEP:
+            raise _too_deep()
+        if n == _LONG:
+            raise _too_long()
+        return self._decode(ops[:n].tolist(), nums, text)
+
+    def _decode(self, ops: list[int], nums: Any, text: Any) -> Term:
+        """The value of a stream written by :func:`relrl._read_kernel.flatten`."""
+        names: dict[int, str] = self._held.copy()
+        stack: list[list[Any]] = [[[], 1, _R_ROOT]]
+        i = 0
+        while True:
+            op = ops[i]
+            if op == _R_ATOM:
+                handle = ops[i + 1]
+                value = names.get(handle)
+                if value is None:
+                    value = names[handle] = self._atom_name(handle)
+                i += 2
+            elif op == _R_TERM:
+                handle, arity = ops[i + 1], ops[i + 2]
+                name = names.get(handle)
+                if name is None:
+                    name = names[handle] = self._atom_name(handle)
+                i += 3
+                if arity:
+                    stack.append([[name], arity, _R_TERM])
+                    continue
+                value = (name,)
+            elif op == _R_INT:
+                value = ops[i + 1]
+                i += 2
+            elif op == _R_FLOAT:
+                value = float(nums[ops[i + 1]])
+                i += 2
+            elif op == _R_STRING:
+                start = ops[i + 1]
+                value = text[start:start + ops[i + 2]].tobytes().decode("utf-8")
+                i += 3
+            elif op == _R_NIL:
+                value = []
+                i += 1
+            elif op == _R_LIST:
+                stack.append([[], ops[i + 1] + 1, _R_LIST])      # the elements, the tail
+                i += 2
+                continue
+            else:
+                value = self._get_nodes(ops[i + 1])
+                i += 2
+            while True:                       # the value completes its container(s)
+                top = stack[-1]
+                top[0].append(value)
+                top[1] -= 1
+                if top[1]:
+                    break
+                stack.pop()
+                items = top[0]
+                if top[2] == _R_TERM:
+                    value = tuple(items)
+                elif top[2] == _R_LIST:
+                    value = items
+                    tail = items.pop()
+                    if not (type(tail) is list and not tail):
+                        value = tail          # [a, b|T]: the '[|]' compounds it is made of
+                        for item in reversed(items):
+                            value = ("[|]", item, value)
+                else:
+                    return value
+
+    def _load_flatten(self) -> Any:
+        """The compiled reader, or False (see :meth:`_load_kernel`)."""
+        self._load_kernel()
+        return self._flatten
+
+    def _get_nodes(self, t: int, depth: int = 0) -> Term:
+        """:meth:`get` node by node (a foreign call or more per node)."""
         if depth > MAX_DEPTH:
-            raise PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
-                              "cannot be passed to Python", "term_too_deep")
+            raise _too_deep()
         kind = self.term_type(t)
         if kind == _PL_ATOM:
             return self._text(t, _CVT_ATOM)
@@ -381,14 +497,13 @@ class _Engine:
             self.put_term(rest, t)
             n = 0
             while self.get_list(rest, head, rest):
-                items.append(self.get(head, depth + 1))
+                items.append(self._get_nodes(head, depth + 1))
                 n += 1
                 if n > MAX_LIST:
-                    raise PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) "
-                                      "cannot be passed to Python", "list_too_long")
+                    raise _too_long()
             if self.term_type(rest) != _PL_NIL:
                 # A partial list [a, b|T]: as the '[|]' compounds it is made of.
-                value: Term = self.get(rest, depth + 1)
+                value: Term = self._get_nodes(rest, depth + 1)
                 for item in reversed(items):
                     value = ("[|]", item, value)
                 return value
@@ -401,14 +516,14 @@ class _Engine:
             values = [self._atom_name(name.value)]
             for i in range(1, arity.value + 1):
                 self.get_arg(i, t, arg)
-                values.append(self.get(arg, depth + 1))
+                values.append(self._get_nodes(arg, depth + 1))
             return tuple(values)
         if kind == _PL_VARIABLE:
             return Var(self._text(t, _CVT_VARIABLE))
         if kind == _PL_RATIONAL:
             from fractions import Fraction
 
-            return Fraction(self._text(t, _CVT_WRITEQ))
+            return Fraction(self._text(t, _CVT_WRITEQ).replace("r", "/"))   # 1r3
         return self._text(t, _CVT_WRITEQ)
 
     # -- running goals ---------------------------------------------------------------------
@@ -539,18 +654,23 @@ class _Engine:
 
     def _load_kernel(self) -> Any:
         """The compiled step (:mod:`relrl._step_kernel`), or False without numba or with
-        ``RELRL_STEP_KERNEL=0`` in the environment (the ctypes calls do the same)."""
-        self._kernel = False
-        if os.environ.get("RELRL_STEP_KERNEL", "1") == "0":
+        ``RELRL_KERNELS=0`` in the environment (the ctypes calls do the same); loads the
+        compiled reader (:mod:`relrl._read_kernel`) beside it."""
+        self._kernel = self._flatten = False
+        if os.environ.get("RELRL_KERNELS", "1") == "0":
             return False
         try:
             import llvmlite.binding
             import numpy as np
 
             llvmlite.binding.load_library_permanently(self.lib._name)
+            from relrl import _read_kernel as r
             from relrl import _step_kernel as k
         except ImportError:      # pragma: no cover - numba is a dependency
             return False
+        self._flatten = r.flatten
+        self._read_arrays = (np.zeros(4096, np.int64), np.zeros(512, np.float64),
+                             np.zeros(16384, np.uint8), np.zeros((256, 4), np.int64))
         self._k = k
         self._io = np.zeros(k.IO_SIZE, np.int64)
         self._fo = np.zeros(k.FIRST_OUTPUT + 64, np.float64)

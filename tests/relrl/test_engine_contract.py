@@ -107,7 +107,7 @@ def test_abort_while_loading_is_a_load_error(tmp_path: Path) -> None:
         assert kb.holds("true")
 
 
-def test_deep_and_cyclic_terms(tmp_path: Path) -> None:
+def test_deep_and_cyclic_terms(tmp_path: Path, crossing: str) -> None:
     path = domain(tmp_path, BASE + "cyc(X) :- X = f(X).\n"
                                    "deep(0, z) :- !.\ndeep(N, f(T)) :- M is N-1, deep(M, T).\n")
     with KnowledgeBase(path) as kb:
@@ -290,7 +290,7 @@ def test_arithmetic_errors_load_the_same_before_and_after_a_save(tmp_path: Path)
         kb.close()
 
 
-def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
+def test_query_answers_that_are_cyclic_or_deep_come_as_text(crossing: str) -> None:
     with KnowledgeBase(TINY) as kb:
         (answer,), _ = kb.query("X = f(X)")
         name, value, printed = answer[0]
