@@ -238,7 +238,7 @@ class _Engine:
         self._held: dict[int, str] = {}
         self._step_mark: int | None = None
         self._kernel: Any = None          # the compiled step: None untried, False none
-        self._flatten: Any = None         # the compiled reader: the same
+        self._flatten: Any = None         # the compiled reader (loaded with the step's)
         self._held_names: dict[str, int] = {}
         self._true = self.hold("true")
 
@@ -377,17 +377,19 @@ class _Engine:
         """Read the term at reference ``t`` as a Python value.
 
         A compound or a list is read in one compiled call (:mod:`relrl._read_kernel`)
-        when numba is there, else node by node, as an atom or a number always is.
+        once the compiled calls are loaded — with the first control step: a process that
+        never steps (``relrl check``, a shell) does not pay numba's half second of
+        loading —, else node by node, as an atom or a number always is.
 
         Raises:
             PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
                 holds a list longer than :data:`MAX_LIST` (or cyclic).
         """
+        flatten = self._flatten
+        if not flatten:
+            return self._get_nodes(t)
         kind = self.term_type(t)
         if kind != _PL_TERM and kind != _PL_LIST_PAIR:
-            return self._get_nodes(t)
-        flatten = self._flatten if self._flatten is not None else self._load_flatten()
-        if not flatten:
             return self._get_nodes(t)
         ops, nums, text, stack = self._read_arrays
         while True:
@@ -464,11 +466,6 @@ class _Engine:
                             value = ("[|]", item, value)
                 else:
                     return value
-
-    def _load_flatten(self) -> Any:
-        """The compiled reader, or False (see :meth:`_load_kernel`)."""
-        self._load_kernel()
-        return self._flatten
 
     def _get_nodes(self, t: int, depth: int = 0) -> Term:
         """:meth:`get` node by node (a foreign call or more per node)."""

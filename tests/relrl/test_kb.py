@@ -269,3 +269,25 @@ def test_long_and_cyclic_lists_are_refused_by_both_readers(
             kb.call("numlist", 1, 1001, Var())
         with pytest.raises(PrologError, match="longer than 1000 elements \\(or cyclic\\)"):
             kb.call("cyclist", Var())
+
+
+def test_compiled_calls_load_with_the_first_step_only() -> None:
+    """A process that only loads and queries (relrl check, a shell) never imports numba;
+    the first control step loads the compiled step and reader."""
+    import subprocess
+    import sys
+
+    script = (
+        "import sys\n"
+        "from relrl.kb import KnowledgeBase\n"
+        "from relrl.learners import make_learner\n"
+        "from relrl.loop import Agent\n"
+        f"kb = KnowledgeBase({str(SIS)!r})\n"
+        "kb.query('X = f(a, [b])')\n"
+        "agent = Agent(kb, make_learner('etg'), seed=0)\n"
+        "print('numba' in sys.modules)\n"
+        "agent.step([('see', 'face')])\n"
+        "print('numba' in sys.modules, kb.query('X = f(a, [b])')[0][0][0][1])\n")
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         timeout=120, check=True).stdout.split("\n")
+    assert out[0] == "False" and out[1] == "True ('f', 'a', ['b'])"
