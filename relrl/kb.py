@@ -390,7 +390,7 @@ class _Engine:
             return self._get_nodes(t)
         kind = self.term_type(t)
         if kind != _PL_TERM and kind != _PL_LIST_PAIR:
-            return self._get_nodes(t)
+            return self._get_nodes(t, 0, kind)
         ops, nums, text, stack = self._read_arrays
         while True:
             n = flatten(t, ops, nums, text, stack, MAX_DEPTH, MAX_LIST)
@@ -467,11 +467,12 @@ class _Engine:
                 else:
                     return value
 
-    def _get_nodes(self, t: int, depth: int = 0) -> Term:
-        """:meth:`get` node by node (a foreign call or more per node)."""
+    def _get_nodes(self, t: int, depth: int = 0, kind: int = 0) -> Term:
+        """:meth:`get` node by node (a foreign call or more per node); ``kind``: the
+        term's type when known."""
         if depth > MAX_DEPTH:
             raise _too_deep()
-        kind = self.term_type(t)
+        kind = kind or self.term_type(t)
         if kind == _PL_ATOM:
             return self._text(t, _CVT_ATOM)
         if kind == _PL_INTEGER:
