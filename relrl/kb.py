@@ -69,6 +69,29 @@ _CVT_WRITEQ = 0xC0
 _BUF_DISCARDABLE = 0x0
 _PL_Q_NODEBUG, _PL_Q_CATCH_EXCEPTION = 0x04, 0x08
 
+# relrl._read_kernel's codes (that module imports numba: it is loaded on first use).
+_R_ATOM, _R_INT, _R_FLOAT, _R_STRING, _R_NIL, _R_LIST, _R_TERM, _R_OTHER = range(8)
+_R_ROOT = -1
+_FULL, _DEEP, _LONG = -1, -2, -3
+
+
+def _too_deep() -> PrologError:
+    return PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) cannot be "
+                       "passed to Python", "term_too_deep")
+
+
+def _too_long() -> PrologError:
+    return PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) cannot be passed "
+                       "to Python", "list_too_long")
+
+
+def _grown(array: Any) -> Any:
+    """``array`` twice as long (first axis), zeroed: a compiled reader's room."""
+    import numpy as np
+
+    return np.zeros((2 * array.shape[0], *array.shape[1:]), array.dtype)
+
+
 _KB_MODULE = re.compile(r"\brelrl_kb_\d+:")
 _MAX_RECORDS = 4096
 _MAX_ATOMS = 4096
@@ -105,6 +128,17 @@ def _hashable(value: Term) -> Any:
                 return tuple(map(_hashable, value))
         return value          # atoms only (most percepts): the tuple is its own key
     if kind is list:
+        for item in value:             # a percept list: tuples of atoms, keyed as they are
+            if type(item) is not tuple:
+                break
+            for arg in item:
+                if type(arg) is not str:
+                    break
+            else:
+                continue
+            break
+        else:
+            return (_LIST_KEY, *value)
         return (_LIST_KEY, *map(_hashable, value))
     return (kind.__name__, value)
 
@@ -186,6 +220,7 @@ class _Engine:
         self.recorded = fn("PL_recorded", c_int, c_void_p, T)
         self.erase = fn("PL_erase", None, c_void_p)
         self._records: dict[Any, int] = {}
+        self._wants: dict[Any, int] = {}   # the step's lists of extras, apart from percepts
         self.thread_raise = fn("PL_thread_raise", c_int, c_int, c_int)
         self.prolog_thread = fn("PL_thread_self", c_int)()
         self.busy = False          # a goal of run() or of an open query is running
@@ -202,6 +237,8 @@ class _Engine:
         self._i64, self._f64, self._atom = c_int64(), c_double(), c_size_t()
         self._held: dict[int, str] = {}
         self._step_mark: int | None = None
+        self._kernel: Any = None          # the compiled step: None untried, False none
+        self._flatten: Any = None         # the compiled reader (loaded with the step's)
         self._held_names: dict[str, int] = {}
         self._true = self.hold("true")
 
@@ -228,21 +265,50 @@ class _Engine:
             self._held[atom] = name
         return atom
 
+    def atom_of(self, name: str) -> int:
+        """The handle of atom ``name`` (cached; the cache holds a reference)."""
+        atom = self._atoms.get(name)
+        if atom is None:
+            data = name.encode("utf-8")
+            atom = self.new_atom(_REP_UTF8, len(data), data)
+            if not atom:
+                raise RelrlError(f"cannot make an atom of {name!r}")
+            if len(self._atoms) >= _MAX_ATOMS:   # keep the cache (and what it holds) small
+                for old in self._atoms.values():
+                    self.unregister_atom(old)
+                self._atoms.clear()
+            self._atoms[name] = atom          # the reference keeps the atom alive
+        return atom
+
+    def record_of(self, value: Cached, table: dict[Any, int] | None = None) -> int:
+        """The handle of ``value``'s record in ``table`` (the percepts' by default; made on
+        first use, see :class:`Cached`). A later record of the same table may evict it:
+        use it before making another."""
+        table = self._records if table is None else table
+        rec = table.get(value.key)
+        if rec is None:
+            fid = self.open_frame()
+            try:
+                t = self.new_term_ref()
+                self.put(t, value.value, {})
+                rec = self._keep_record(value.key, t, table)
+            finally:
+                self.discard_frame(fid)
+        return rec
+
+    def _keep_record(self, key: Any, t: int, table: dict[Any, int] | None = None) -> int:
+        table = self._records if table is None else table
+        if len(table) >= _MAX_RECORDS:     # keep the table (and what it holds) small
+            for old in table.values():
+                self.erase(old)
+            table.clear()
+        rec = table[key] = self.record(t)
+        return rec
+
     def put(self, t: int, value: Term, variables: dict[int, int]) -> None:
         """Write ``value`` into term reference ``t``."""
         if isinstance(value, str):
-            atom = self._atoms.get(value)
-            if atom is None:
-                data = value.encode("utf-8")
-                atom = self.new_atom(_REP_UTF8, len(data), data)
-                if not atom:
-                    raise RelrlError(f"cannot make an atom of {value!r}")
-                if len(self._atoms) >= _MAX_ATOMS:   # keep the cache (and what it holds) small
-                    for old in self._atoms.values():
-                        self.unregister_atom(old)
-                    self._atoms.clear()
-                self._atoms[value] = atom          # the reference keeps the atom alive
-            self.put_atom(t, atom)
+            self.put_atom(t, self.atom_of(value))
         elif isinstance(value, bool):
             self.put_chars(t, _PL_ATOM, 4 if value else 5, b"true" if value else b"false")
         elif isinstance(value, int):
@@ -273,13 +339,8 @@ class _Engine:
         elif isinstance(value, Cached):
             rec = self._records.get(value.key)
             if rec is None:
-                if len(self._records) >= _MAX_RECORDS:
-                    for old in self._records.values():
-                        self.erase(old)
-                    self._records.clear()
                 self.put(t, value.value, variables)
-                rec = self.record(t)
-                self._records[value.key] = rec
+                self._keep_record(value.key, t)
             else:
                 self.recorded(rec, t)
         elif isinstance(value, Var):
@@ -312,16 +373,106 @@ class _Engine:
             name = ctypes.string_at(s, n.value).decode("utf-8")
         return name
 
-    def get(self, t: int, depth: int = 0) -> Term:
+    def get(self, t: int) -> Term:
         """Read the term at reference ``t`` as a Python value.
 
+        A compound or a list is read in one compiled call (:mod:`relrl._read_kernel`)
+        once the compiled calls are loaded — with the first control step: a process that
+        never steps (``relrl check``, a shell) does not pay numba's half second of
+        loading —, else node by node, as an atom or a number always is.
+
         Raises:
-            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic).
+            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
+                holds a list longer than :data:`MAX_LIST` (or cyclic).
         """
-        if depth > MAX_DEPTH:
-            raise PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
-                              "cannot be passed to Python", "term_too_deep")
+        flatten = self._flatten
+        if not flatten:
+            return self._get_nodes(t)
         kind = self.term_type(t)
+        if kind != _PL_TERM and kind != _PL_LIST_PAIR:
+            return self._get_nodes(t, 0, kind)
+        ops, nums, text, stack = self._read_arrays
+        while True:
+            n = flatten(t, ops, nums, text, stack, MAX_DEPTH, MAX_LIST)
+            if n != _FULL:
+                break
+            ops, nums, text, stack = self._read_arrays = tuple(
+                _grown(a) for a in self._read_arrays)
+        if n == _DEEP:
+            raise _too_deep()
+        if n == _LONG:
+            raise _too_long()
+        return self._decode(ops[:n].tolist(), nums, text)
+
+    def _decode(self, ops: list[int], nums: Any, text: Any) -> Term:
+        """The value of a stream written by :func:`relrl._read_kernel.flatten`."""
+        names: dict[int, str] = self._held.copy()
+        stack: list[list[Any]] = [[[], 1, _R_ROOT]]
+        i = 0
+        while True:
+            op = ops[i]
+            if op == _R_ATOM:
+                handle = ops[i + 1]
+                value = names.get(handle)
+                if value is None:
+                    value = names[handle] = self._atom_name(handle)
+                i += 2
+            elif op == _R_TERM:
+                handle, arity = ops[i + 1], ops[i + 2]
+                name = names.get(handle)
+                if name is None:
+                    name = names[handle] = self._atom_name(handle)
+                i += 3
+                if arity:
+                    stack.append([[name], arity, _R_TERM])
+                    continue
+                value = (name,)
+            elif op == _R_INT:
+                value = ops[i + 1]
+                i += 2
+            elif op == _R_FLOAT:
+                value = float(nums[ops[i + 1]])
+                i += 2
+            elif op == _R_STRING:
+                start = ops[i + 1]
+                value = text[start:start + ops[i + 2]].tobytes().decode("utf-8")
+                i += 3
+            elif op == _R_NIL:
+                value = []
+                i += 1
+            elif op == _R_LIST:
+                stack.append([[], ops[i + 1] + 1, _R_LIST])      # the elements, the tail
+                i += 2
+                continue
+            else:
+                value = self._get_nodes(ops[i + 1])
+                i += 2
+            while True:                       # the value completes its container(s)
+                top = stack[-1]
+                top[0].append(value)
+                top[1] -= 1
+                if top[1]:
+                    break
+                stack.pop()
+                items = top[0]
+                if top[2] == _R_TERM:
+                    value = tuple(items)
+                elif top[2] == _R_LIST:
+                    value = items
+                    tail = items.pop()
+                    if not (type(tail) is list and not tail):
+                        value = tail          # [a, b|T]: the '[|]' compounds it is made of
+                        for item in reversed(items):
+                            value = ("[|]", item, value)
+                else:
+                    return value
+
+    def _get_nodes(self, t: int, depth: int = 0, kind: int = 0) -> Term:
+        """:meth:`get` node by node (a foreign call or more per node); ``kind``: the
+        term's type when known."""
+        if depth > MAX_DEPTH:
+            raise _too_deep()
+        kind = kind or self.term_type(t)
         if kind == _PL_ATOM:
             return self._text(t, _CVT_ATOM)
         if kind == _PL_INTEGER:
@@ -344,14 +495,13 @@ class _Engine:
             self.put_term(rest, t)
             n = 0
             while self.get_list(rest, head, rest):
-                items.append(self.get(head, depth + 1))
+                items.append(self._get_nodes(head, depth + 1))
                 n += 1
                 if n > MAX_LIST:
-                    raise PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) "
-                                      "cannot be passed to Python", "list_too_long")
+                    raise _too_long()
             if self.term_type(rest) != _PL_NIL:
                 # A partial list [a, b|T]: as the '[|]' compounds it is made of.
-                value: Term = self.get(rest, depth + 1)
+                value: Term = self._get_nodes(rest, depth + 1)
                 for item in reversed(items):
                     value = ("[|]", item, value)
                 return value
@@ -364,14 +514,14 @@ class _Engine:
             values = [self._atom_name(name.value)]
             for i in range(1, arity.value + 1):
                 self.get_arg(i, t, arg)
-                values.append(self.get(arg, depth + 1))
+                values.append(self._get_nodes(arg, depth + 1))
             return tuple(values)
         if kind == _PL_VARIABLE:
             return Var(self._text(t, _CVT_VARIABLE))
         if kind == _PL_RATIONAL:
             from fractions import Fraction
 
-            return Fraction(self._text(t, _CVT_WRITEQ))
+            return Fraction(self._text(t, _CVT_WRITEQ).replace("r", "/"))   # 1r3
         return self._text(t, _CVT_WRITEQ)
 
     # -- running goals ---------------------------------------------------------------------
@@ -434,67 +584,128 @@ class _Engine:
 
         The result's fields come back as arguments of their own and are read with one
         foreign call each, not as a term converted node by node: the robot steps thousands
-        of times a second. Returns ``(code, necessity, outputs, reward, reinforced, mask,
-        action, extras)`` (``extras`` None when empty), or None when the step failed.
-        Raises QueryTimeout or PrologError as :meth:`run` does.
+        of times a second. With numba the whole crossing — arguments, call, reads — is one
+        compiled call (:mod:`relrl._step_kernel`); without it, or for a field the kernel
+        cannot read, the same foreign calls go through ctypes. Returns ``(code, necessity,
+        outputs, reward, reinforced, mask, action, extras)`` (``extras`` None when empty),
+        or None when the step failed. Raises QueryTimeout or PrologError as :meth:`run`
+        does.
         """
         if threading.get_ident() != self.thread:
             raise RelrlError("the Prolog engine belongs to the thread that started it; "
                              "use processes, not threads, for parallel runs")
-        atoms, put_atom = self._atoms, self.put_atom
+        self.calls += 1
+        kernel = self._kernel if self._kernel is not None else self._load_kernel()
+        if kernel and type(percepts) is Cached:
+            return self._kernel_step(kernel, module, percepts, emitted, mode, want, timeout)
         fid = self.open_frame()
         try:
-            self.calls += 1
             a = self.new_term_refs(15)     # fresh variables
-            if module in atoms:
-                put_atom(a, atoms[module])
-            else:
-                self.put(a, module, {})
-            rec = self._records.get(percepts.key) if type(percepts) is Cached else None
-            if rec is not None:
-                self.recorded(rec, a + 1)
-            else:
-                self.put(a + 1, percepts, {})
+            self.put_atom(a, self.atom_of(module))
+            self.put(a + 1, percepts, {})
             self.put_int64(a + 2, emitted)
-            if mode in atoms:
-                put_atom(a + 3, atoms[mode])
-            else:
-                self.put(a + 3, mode, {})
+            self.put_atom(a + 3, self.atom_of(mode))
             if want:
                 self.put(a + 4, want, {})
             else:
                 self.put_nil(a + 4)
             self.put_float(a + 5, timeout)
-            if not self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
-                                       self._gw_step, a):
-                return self._step_failed(timeout, None)
-            atom, i64, f64 = self._atom, self._i64, self._f64
-            get_atom, get_int64, get_float = self.get_atom, self.get_int64, self.get_float
-            held = self._held
-            # No text is converted on this path (atoms are read by handle): any field that
-            # does not fit its one-call read goes to _step_field, which marks the string
-            # stack first (see run()).
-            if not (get_atom(a + 6, atom) and atom.value == self._true):
-                return self._step_failed(timeout, a + 6)
-            code = i64.value if get_int64(a + 7, i64) else self._step_field(a + 7)
-            necessity = held.get(atom.value) if get_atom(a + 8, atom) else None
-            if necessity is None:
-                necessity = self._step_field(a + 8)
-            outputs = []
-            head, rest = self.new_term_ref(), a + 9
-            while self.get_list(rest, head, rest):
-                outputs.append(f64.value if get_float(head, f64) else self._step_field(head))
-            reward = f64.value if get_float(a + 10, f64) else self._step_field(a + 10)
-            reinforced = get_atom(a + 11, atom) and atom.value == self._true
-            mask = i64.value if get_int64(a + 12, i64) else self._step_field(a + 12)
-            action = i64.value if get_int64(a + 13, i64) else self._step_field(a + 13)
-            extras = self._step_field(a + 14) if want and not self.get_nil(a + 14) else None
-            return code, necessity, outputs, reward, bool(reinforced), mask, action, extras
+            ok = self.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION,
+                                     self._gw_step, a)
+            return self._step_read(a, ok, want, timeout)
         finally:
             self.discard_frame(fid)
             if self._step_mark is not None:
                 self.release_strings(self._step_mark)
                 self._step_mark = None
+
+    def _kernel_step(self, kernel: Any, module: str, percepts: Cached, emitted: int,
+                     mode: str, want: list[str], timeout: float) -> tuple | None:
+        """:meth:`step` as one compiled call; what the kernel does not read (see
+        :mod:`relrl._step_kernel`) is read by :meth:`_step_read` from the open frame."""
+        k, io, fo = self._k, self._io, self._fo
+        io[k.MODULE] = self.atom_of(module)
+        io[k.MODE] = self.atom_of(mode)
+        io[k.PERCEPTS] = self.record_of(percepts)
+        io[k.WANT] = self.record_of(Cached(want), self._wants) if want else 0
+        io[k.EMITTED] = emitted
+        fo[k.LIMIT] = timeout
+        status = kernel(io, fo)
+        v = io.tolist()
+        try:
+            if status == 0:
+                necessity = self._held.get(v[k.NECESSITY])
+                if necessity is not None:
+                    n = v[k.OUTPUTS]
+                    values = fo[:k.FIRST_OUTPUT + n].tolist()
+                    extras = self._step_field(v[k.ARGS] + 14) if v[k.EXTRAS] else None
+                    return (v[k.CODE], necessity, values[k.FIRST_OUTPUT:],
+                            values[k.REWARD], v[k.REINFORCED] == self._true, v[k.MASK],
+                            v[k.ACTION], extras)
+            return self._step_read(v[k.ARGS], status != k.RAISED, want, timeout)
+        finally:
+            if v[k.FRAME]:
+                self.discard_frame(v[k.FRAME])
+            if self._step_mark is not None:
+                self.release_strings(self._step_mark)
+                self._step_mark = None
+
+    def _load_kernel(self) -> Any:
+        """The compiled step (:mod:`relrl._step_kernel`), or False without numba or with
+        ``RELRL_KERNELS=0`` in the environment (the ctypes calls do the same); loads the
+        compiled reader (:mod:`relrl._read_kernel`) beside it."""
+        self._kernel = self._flatten = False
+        if os.environ.get("RELRL_KERNELS", "1") == "0":
+            return False
+        try:
+            import llvmlite.binding
+            import numpy as np
+
+            llvmlite.binding.load_library_permanently(self.lib._name)
+            from relrl import _read_kernel as r
+            from relrl import _step_kernel as k
+        except ImportError:      # pragma: no cover - numba is a dependency
+            return False
+        self._flatten = r.flatten
+        self._read_arrays = (np.zeros(4096, np.int64), np.zeros(512, np.float64),
+                             np.zeros(16384, np.uint8), np.zeros((256, 4), np.int64))
+        self._k = k
+        self._io = np.zeros(k.IO_SIZE, np.int64)
+        self._fo = np.zeros(k.FIRST_OUTPUT + 64, np.float64)
+        self._io[k.PRED] = self._gw_step
+        self._io[k.FLAGS] = _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION
+        self._io[k.TRUE] = self._true
+        self._kernel = k.step
+        return self._kernel
+
+    def _step_read(self, a: int, ok: bool, want: list[str], timeout: float) -> tuple | None:
+        """The fields of a ``gw_step/15`` call at argument references ``a``..``a+14``
+        (``ok``: the call returned), read with one foreign call each where they fit."""
+        if not ok:
+            return self._step_failed(timeout, None)
+        atom, i64, f64 = self._atom, self._i64, self._f64
+        get_atom, get_int64, get_float = self.get_atom, self.get_int64, self.get_float
+        held = self._held
+        # No text is converted on this path (atoms are read by handle): any field that
+        # does not fit its one-call read goes to _step_field, which marks the string
+        # stack first (see run()).
+        if not (get_atom(a + 6, atom) and atom.value == self._true):
+            return self._step_failed(timeout, a + 6)
+        code = i64.value if get_int64(a + 7, i64) else self._step_field(a + 7)
+        necessity = held.get(atom.value) if get_atom(a + 8, atom) else None
+        if necessity is None:
+            necessity = self._step_field(a + 8)
+        outputs = []
+        head, rest = self.new_term_ref(), self.new_term_ref()
+        self.put_term(rest, a + 9)
+        while self.get_list(rest, head, rest):
+            outputs.append(f64.value if get_float(head, f64) else self._step_field(head))
+        reward = f64.value if get_float(a + 10, f64) else self._step_field(a + 10)
+        reinforced = get_atom(a + 11, atom) and atom.value == self._true
+        mask = i64.value if get_int64(a + 12, i64) else self._step_field(a + 12)
+        action = i64.value if get_int64(a + 13, i64) else self._step_field(a + 13)
+        extras = self._step_field(a + 14) if want and not self.get_nil(a + 14) else None
+        return code, necessity, outputs, reward, bool(reinforced), mask, action, extras
 
     def _step_field(self, t: int) -> Term:
         """A field of a step's result read by conversion (after marking the string
