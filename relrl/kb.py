@@ -630,9 +630,10 @@ class _Engine:
         io[k.WANT] = self.record_of(Cached(want), self._wants) if want else 0
         io[k.EMITTED] = emitted
         fo[k.LIMIT] = timeout
-        status = kernel(io, fo)
-        v = io.tolist()
+        io[k.FRAME] = 0
         try:
+            status = kernel(io, fo)
+            v = io.tolist()
             if status == 0:
                 necessity = self._held.get(v[k.NECESSITY])
                 if necessity is not None:
@@ -644,8 +645,10 @@ class _Engine:
                             v[k.ACTION], extras)
             return self._step_read(v[k.ARGS], status != k.RAISED, want, timeout)
         finally:
-            if v[k.FRAME]:
-                self.discard_frame(v[k.FRAME])
+            # (read from io: a KeyboardInterrupt may come as soon as the kernel returns)
+            if io[k.FRAME]:
+                self.discard_frame(int(io[k.FRAME]))
+                io[k.FRAME] = 0
             if self._step_mark is not None:
                 self.release_strings(self._step_mark)
                 self._step_mark = None
