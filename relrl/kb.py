@@ -228,7 +228,6 @@ class _Engine:
         self.release_strings = fn("PL_release_string_buffers_from_mark", None, c_size_t)
 
         self._functors: dict[tuple[str, int], int] = {}
-        self._names: dict[int, str] = {}
         self._gw_run = self.predicate(b"gw_run", 3, b"relrl_gateway")
         self.calls = 0
         self._bootstrap()
@@ -248,9 +247,7 @@ class _Engine:
         key = (name, arity)
         f = self._functors.get(key)
         if f is None:
-            data = name.encode("utf-8")
-            atom = self.new_atom(_REP_UTF8, len(data), data)
-            f = self.new_functor(atom, arity)
+            f = self.new_functor(self._new_atom(name), arity)
             self._functors[key] = f  # the functor keeps the atom alive
         return f
 
@@ -259,20 +256,24 @@ class _Engine:
         reads can name it without converting text (see :meth:`step`)."""
         atom = self._held_names.get(name)
         if atom is None:
-            data = name.encode("utf-8")
-            atom = self.new_atom(_REP_UTF8, len(data), data)
+            atom = self._new_atom(name)
             self._held_names[name] = atom
             self._held[atom] = name
+        return atom
+
+    def _new_atom(self, name: str) -> int:
+        """A new reference to atom ``name`` (the caller keeps it)."""
+        data = name.encode("utf-8")
+        atom = self.new_atom(_REP_UTF8, len(data), data)
+        if not atom:
+            raise RelrlError(f"cannot make an atom of {name!r}")
         return atom
 
     def atom_of(self, name: str) -> int:
         """The handle of atom ``name`` (cached; the cache holds a reference)."""
         atom = self._atoms.get(name)
         if atom is None:
-            data = name.encode("utf-8")
-            atom = self.new_atom(_REP_UTF8, len(data), data)
-            if not atom:
-                raise RelrlError(f"cannot make an atom of {name!r}")
+            atom = self._new_atom(name)
             if len(self._atoms) >= _MAX_ATOMS:   # keep the cache (and what it holds) small
                 for old in self._atoms.values():
                     self.unregister_atom(old)
@@ -365,7 +366,7 @@ class _Engine:
         return ctypes.string_at(s, n.value).decode("utf-8")
 
     def _atom_name(self, atom: int) -> str:
-        name = self._names.get(atom)
+        name = self._held.get(atom)
         if name is None:
             n = c_size_t()
             s = c_char_p()
@@ -406,7 +407,7 @@ class _Engine:
 
     def _decode(self, ops: list[int], nums: Any, text: Any) -> Term:
         """The value of a stream written by :func:`relrl._read_kernel.flatten`."""
-        names: dict[int, str] = self._held.copy()
+        names: dict[int, str] = {}
         stack: list[list[Any]] = [[[], 1, _R_ROOT]]
         i = 0
         while True:
@@ -656,7 +657,9 @@ class _Engine:
     def _load_kernel(self) -> Any:
         """The compiled step (:mod:`relrl._step_kernel`), or False without numba or with
         ``RELRL_KERNELS=0`` in the environment (the ctypes calls do the same); loads the
-        compiled reader (:mod:`relrl._read_kernel`) beside it."""
+        compiled reader (:mod:`relrl._read_kernel`) beside it. Loads once."""
+        if self._kernel is not None:
+            return self._kernel
         self._kernel = self._flatten = False
         if os.environ.get("RELRL_KERNELS", "1") == "0":
             return False

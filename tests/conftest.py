@@ -41,7 +41,7 @@ def crossing(request: pytest.FixtureRequest):
     from relrl.kb import _get_engine
 
     engine = _get_engine()
-    kernel = engine._kernel if engine._kernel is not None else engine._load_kernel()
+    kernel = engine._load_kernel()
     flatten = engine._flatten
     assert kernel and flatten, "numba is a dependency: the compiled calls must load"
     on = request.param == "kernel"

@@ -415,7 +415,7 @@ def test_compiled_and_ctypes_crossings_agree(monkeypatch: pytest.MonkeyPatch) ->
     from relrl import _step_kernel
 
     engine = kb_module._get_engine()
-    kernel = engine._kernel if engine._kernel is not None else engine._load_kernel()
+    kernel = engine._load_kernel()
     assert kernel
     statuses: list[int] = []
 

@@ -232,7 +232,7 @@ def test_compiled_reader_reads_what_the_node_reader_reads(goal: str) -> None:
     from relrl.kb import _get_engine
 
     engine = _get_engine()
-    engine._kernel if engine._kernel is not None else engine._load_kernel()
+    engine._load_kernel()
     flatten, arrays = engine._flatten, engine._read_arrays
     assert flatten
     with KnowledgeBase() as kb:
