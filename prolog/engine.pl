@@ -81,6 +81,8 @@ first puts that stream away with engine_park/0: the engine's other predicates th
 the generator do, and so does relrl's gateway before every call that is not a step (a
 user's query, loading a file, keep and resume, ...). A Prolog program that calls
 engine_step/6 itself and draws numbers of its own between steps calls engine_park/0 first.
+A step that raises an error leaves the stream where the step stopped (as it leaves working
+memory and the learner).
 
 ## Errors
 
@@ -147,11 +149,11 @@ set_eng(KB, eng(Prev, Random)) :-
 
 %   KB's stream is now Random (the generator loads it when KB next needs it).
 set_stream(KB, Engine, Random) :-
-    nb_setarg(3, Engine, Random),
-    (   random_owner(KB)
-    ->  nb_setval(relrl_random_owner, none)
-    ;   true
-    ).
+    (   random_owner(KB)                % first: an interrupt between the two writes
+    ->  nb_setval(relrl_random_owner, none)     % must not let a later park overwrite
+    ;   true                                    % Random with the generator's state
+    ),
+    nb_setarg(3, Engine, Random).
 
 %   The generator holds Owner's stream (the KB that stepped last), or that of none.
 random_owner(Owner) :-

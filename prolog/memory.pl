@@ -191,10 +191,7 @@ wm_has(KB, Element) :-
     key_(KB, Key),                      % none: no memory yet
     nb_getval(Key, State),
     State = wm(_, _, _, Elements, _),
-    (   ground(Element)                 % one copy of an element at most
-    ->  memberchk(Element, Elements)
-    ;   member(Element, Elements)
-    ).
+    element_in(Element, Elements).
 
 %!  wm_has_chk(+KB, ?Element) is semidet.
 %
@@ -213,9 +210,13 @@ wm_has_chk(KB, Element) :-
 wm_now(KB, Element) :-
     get(KB, State),
     State = wm(_, _, _, _, Now),
-    (   ground(Element)                 % one copy of an element at most
-    ->  memberchk(Element, Now)
-    ;   member(Element, Now)
+    element_in(Element, Now).
+
+%   Element is in Elements (a memory holds one copy of an element at most).
+element_in(Element, Elements) :-
+    (   ground(Element)
+    ->  memberchk(Element, Elements)
+    ;   member(Element, Elements)
     ).
 
 %!  wm_has_stimulus(+KB, +Stimulus) is semidet.

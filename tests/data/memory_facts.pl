@@ -9,6 +9,7 @@ fact(young).
 fact(seen).
 fact(placed(s)).
 fact(placed(t)).
+fact(near(_)).                      % declared open: any near(X)
 fact(two).                          % goals
 fact(dyn).
 fact(both).
@@ -20,6 +21,7 @@ plain :- percept(see(s)).
 young :- memory(hear(s), 0).
 seen :- see(s).
 placed(S) :- at(S, left).
+near(left) :- see(t).
 two :- percept(a).
 two :- percept(b).
 :- dynamic dyn/0.
