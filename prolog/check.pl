@@ -75,7 +75,8 @@ domain_clause(KB, Head, Body, Ref) :-
     functor(Head, Name, Arity),
     \+ predicate_property(KB:Head, imported_from(_)),
     \+ predicate_property(KB:Head, foreign),
-    catch(clause(KB:Head, Body, Ref), _, fail).
+    catch(clause(KB:Head, Body, Ref),            % a protected (system-like) predicate
+          error(permission_error(access, private_procedure, _), _), fail).
 
 declaration_clause(KB, Head, Ref) :-
     functor(Head, Name, Arity),

@@ -425,8 +425,23 @@ gw_take_abort(Where) :-
 strip_context(error(Formal, context(time:_, _)), error(Formal, _)) :- !.
 strip_context(E, E).
 
+%   Rendering a message or an answer as text failed with Error: the plain rendering is used
+%   instead (fail), unless Error must reach the caller — a time limit, Ctrl-C, abort or a
+%   resource error is never swallowed.
+text_failed(Error) :-
+    (   must_pass(Error)
+    ->  throw(Error)
+    ;   fail
+    ).
+
+must_pass(time_limit_exceeded).
+must_pass(relrl_interrupted).
+must_pass('$aborted').
+must_pass(unwind(_)).
+must_pass(error(resource_error(_), _)).
+
 message_string(E, Message) :-
-    (   catch(message_to_codes(E, Codes), _, fail)
+    (   catch(message_to_codes(E, Codes), Error, text_failed(Error))
     ->  string_codes(Message0, Codes)
     ;   format(string(Message0), "~q", [E])
     ),
@@ -784,7 +799,8 @@ answer_text(Bindings0, Text) :-
     prolog:translate_bindings(Bindings1, Bindings, [], [], _:Residuals),
     name_variables(Bindings-Residuals),
     answer_mode(Options),
-    (   catch(toplevel_text(Bindings, Residuals, Options, Text0), _, fail)
+    (   catch(toplevel_text(Bindings, Residuals, Options, Text0), Error,
+              text_failed(Error))
     ->  true
     ;   format(string(Text0), "~W", [Bindings-Residuals, Options])
     ),

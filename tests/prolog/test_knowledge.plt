@@ -159,4 +159,16 @@ test(nested_limits, [Inner-Outer-Active == time_limit_exceeded-true-true]) :-
     caller_state(After),
     assertion(After == Before).
 
+%   Rendering a message or an answer as text may fail over to a plain rendering, but a
+%   time limit, Ctrl-C or a resource error always reaches the caller (abort too: it cannot
+%   be caught here to be checked).
+test(text_rendering_lets_limits_through, [Passed == [time_limit_exceeded,
+                                                     relrl_interrupted,
+                                                     error(resource_error(memory), c)]]) :-
+    findall(E, ( member(E, [time_limit_exceeded, relrl_interrupted,
+                            error(resource_error(memory), c)]),
+                 catch(relrl_gateway:text_failed(E), E, true) ),
+            Passed),
+    \+ relrl_gateway:text_failed(error(type_error(text, x), _)).
+
 :- end_tests(gateway_call).
