@@ -187,11 +187,10 @@ class LiveServer(Endpoint):
                 self.process.wait()
             self.process = None
 
-    def __enter__(self) -> LiveServer:
-        return self if self.process is not None else self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    @property
+    def running(self) -> bool:
+        """Whether its process serves."""
+        return self.process is not None
 
 
 def _settle() -> None:

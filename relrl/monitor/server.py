@@ -403,6 +403,25 @@ class Endpoint:
         """The Host header values accepted on loopback."""
         return {"127.0.0.1", "localhost", "::1", self.host}
 
+    @property
+    def running(self) -> bool:
+        """Whether it serves (between ``start()`` and ``close()``)."""
+        raise NotImplementedError
+
+    def start(self) -> Endpoint:
+        """Start serving; returns itself."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Stop serving (safe twice)."""
+        raise NotImplementedError
+
+    def __enter__(self) -> Any:
+        return self if self.running else self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
 
 def _quiet(loop: Any, context: dict[str, Any]) -> None:
     """The server loop's errors (an accept that failed, ...) as one log line."""
@@ -473,8 +492,7 @@ class MonitorServer(Endpoint):
                 self._sock.close()
             self._server = None
 
-    def __enter__(self) -> MonitorServer:
-        return self if self._server is not None else self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    @property
+    def running(self) -> bool:
+        """Whether it serves."""
+        return self._server is not None
