@@ -215,7 +215,7 @@ def _child(config: dict[str, Any]) -> int:
     for sig in (signal.SIGINT, signal.SIGHUP):
         signal.signal(sig, signal.SIG_IGN)  # the robot's process decides when it ends
     _settle()
-    logging.basicConfig(level=logging.WARNING, format="relrl monitor: %(message)s")
+    logging.basicConfig(level=logging.WARNING, format="relrl: %(message)s")
     feed = socket.socket(fileno=config["feed_fd"])
     listener = socket.socket(fileno=config["listen_fd"])
     hub = Hub(config["rate"])

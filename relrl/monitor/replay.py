@@ -232,6 +232,7 @@ class Recording:
         self._frame_t = [f["t"] for f in self.frames]
         self._frame_index = {f["index"] for f in self.frames}
         self._tree_t = [x["t"] for x in self.trees]
+        self._warned: set[str] = set()
 
     @property
     def necessities(self) -> list[str]:
@@ -257,8 +258,10 @@ class Recording:
         try:
             return _read(self.folder, "frames", name, limit=MAX_FRAME_BYTES)
         except OSError as exc:
-            log.warning("replay: frames/%s is not served: %s", name,
-                        exc if isinstance(exc, _NotInside) else exc.strerror or exc)
+            if name not in self._warned:  # once a frame, however often it is asked for
+                self._warned.add(name)
+                log.warning("replay: frames/%s is not served: %s", name,
+                            exc if isinstance(exc, _NotInside) else exc.strerror or exc)
             return None
 
     def tree_index(self, t: int) -> int:

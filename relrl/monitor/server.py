@@ -426,7 +426,7 @@ class Endpoint:
 def _quiet(loop: Any, context: dict[str, Any]) -> None:
     """The server loop's errors (an accept that failed, ...) as one log line."""
     exc = context.get("exception")
-    log.warning("monitor: %s%s", context.get("message", "error"),
+    log.warning("the monitor's server: %s%s", context.get("message", "error"),
                 f" ({type(exc).__name__}: {exc})" if exc is not None else "")
 
 
@@ -462,7 +462,9 @@ class MonitorServer(Endpoint):
         sock = sock if sock is not None else listen(self.host, self.port)
         self.port = sock.getsockname()[1]
         app = build_app(self.source, token=self.token, hosts=self.hosts)
-        config = uvicorn.Config(app, http=bounded_protocol(self.limits), log_level="warning",
+        # uvicorn's own lines only for its errors: a client's bad request is not news on the
+        # session's console (a flood of them would flood it)
+        config = uvicorn.Config(app, http=bounded_protocol(self.limits), log_level="error",
                                 access_log=False, lifespan="off", timeout_graceful_shutdown=1,
                                 timeout_keep_alive=self.limits.idle_seconds,  # type: ignore
                                 h11_max_incomplete_event_size=16 * 1024,

@@ -260,3 +260,4 @@ def test_the_pictures_policy_alone_stops_a_link_script(page, tmp_path, monkeypat
         page.locator("a").first.click()
         page.wait_for_timeout(300)
         assert page.evaluate("window.name") != "pwned"
+

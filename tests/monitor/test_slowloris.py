@@ -219,3 +219,33 @@ def test_start_replay_still_serves_in_this_process(tmp_path: Path) -> None:
     folder = write_recording(tmp_path / "rec")
     with start_replay(folder) as server:
         assert isinstance(server, MonitorServer) and _status(server.port) == 200
+
+
+def test_garbage_requests_print_nothing_on_the_sessions_console(tmp_path: Path) -> None:
+    """A client's bad requests are not news on the session's terminal: 300 of them (bad
+    request lines, bad headers, heads over 16 KiB) add no line to what the session prints --
+    a flood of them would flood its console and its log."""
+    script = episode(tmp_path, steps=100_000, perception="symbolic")
+    proc = subprocess.Popen([sys.executable, "-m", "relrl", "run", str(script), "--monitor",
+                             "--step-seconds", "0.01", "-q"], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, preexec_fn=default_signals)
+    try:
+        assert proc.stdout is not None
+        said = proc.stdout.readline()
+        port = int(re.search(r"monitor: http://127\.0\.0\.1:(\d+)/", said).group(1))
+        for i in range(300):
+            with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+                s.sendall([b"\x00\xff garbage\r\n\r\n", b"GET / HTTP/1.1\r\nHost\r\n\r\n",
+                           b"GET / HTTP/1.1\r\nX: " + b"a" * 20000 + b"\r\n\r\n"][i % 3])
+                assert s.recv(4096).startswith(b"HTTP/1.1 4")
+        assert _status(port) == 200
+        proc.send_signal(signal.SIGINT)
+        rest, _ = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 128 + signal.SIGINT
+    lines = [x for x in rest.splitlines() if x.strip()]
+    assert not [x for x in lines if "HTTP" in x or "request" in x.lower()], lines
+    assert len(lines) <= 8, lines  # the summary and the stop message, nothing per request
