@@ -133,8 +133,8 @@ class LiveServer(Endpoint):
             theirs.close()
         self._feed = feed
         try:
-            self._feed_once()  # the state at start, before the child serves
             feed.settimeout(START_SECONDS)
+            self._feed_once()  # the state at start, before the child serves
             ready = feed.recv(1)
             feed.settimeout(None)
         except OSError:
@@ -162,9 +162,11 @@ class LiveServer(Endpoint):
             while not self._closing.wait(period):
                 self._feed_once()
             self._feed_once()  # the last state (the session's end)
-        except OSError as exc:  # the child ended: the robot goes on without a page
+        except Exception as exc:  # noqa: BLE001 - a side thread: said, never raised
+            # the child ended, or a view could not be sent: the robot goes on without a page
             if not self._closing.is_set():
-                log.warning("the monitor stopped serving (%s); the session goes on", exc)
+                log.warning("the monitor stopped serving (%s: %s); the session goes on",
+                            type(exc).__name__, exc)
 
     def close(self) -> None:
         """Send the last state, end the serving process (safe twice)."""

@@ -249,3 +249,29 @@ def test_garbage_requests_print_nothing_on_the_sessions_console(tmp_path: Path) 
     lines = [x for x in rest.splitlines() if x.strip()]
     assert not [x for x in lines if "HTTP" in x or "request" in x.lower()], lines
     assert len(lines) <= 8, lines  # the summary and the stop message, nothing per request
+
+
+def test_a_server_process_that_dies_costs_the_session_nothing(tmp_path: Path) -> None:
+    """``kill -9`` of the monitor's process: the session says so in one line and goes on to
+    its end, with everything written."""
+    script = episode(tmp_path, steps=400, perception="symbolic")
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "relrl", "run", str(script), "--monitor",
+                             "--out", str(out), "--no-plots", "--step-seconds", "0.01", "-q"],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, preexec_fn=default_signals)
+    try:
+        assert proc.stdout is not None
+        said = proc.stdout.readline()
+        assert "monitor: http" in said, said
+        children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
+        _wait(lambda: _lines(out / "trace.jsonl") >= 20)
+        os.kill(int(children[0]), signal.SIGKILL)
+        rest, _ = proc.communicate(timeout=180)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, said + rest
+    assert rest.count("the monitor stopped serving") == 1 and "Traceback" not in rest, rest
+    assert json.loads((out / "summary.json").read_text())["steps"] == 400
