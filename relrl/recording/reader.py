@@ -1,0 +1,221 @@
+"""A recorded session read back from its MCAP file (``relrl replay FILE.mcap``).
+
+:class:`McapRecording` reads the file once, in file order, with the ``mcap`` library's stream
+reader (chunk CRCs checked), joins each time unit's channels back into its trace row, and
+keeps the trees, the events and where each frame is. It answers what the replay page asks
+(:meth:`row`, :meth:`frame_at`, :meth:`frame_bytes`, :meth:`tree_at`) as a recorded folder
+does, and never writes.
+
+A file cut short (the session killed before it closed the file) is read up to its last
+complete chunk, and :attr:`McapRecording.cut` says so; anything else wrong -- not an MCAP
+file, a damaged chunk, a message that is not what its channel says, no session in it -- is a
+:class:`~relrl.errors.UserError` naming the file: one line, exit status 2.
+"""
+
+from __future__ import annotations
+
+import bisect
+import json
+from pathlib import Path
+from typing import Any
+
+from relrl.errors import UserError
+from relrl.recording.channels import (EVENTS, IMAGE, ROW_CHANNELS, SESSION, TREE, join_row)
+
+__all__ = ["McapRecording", "MCAP_MAGIC"]
+
+#: the eight bytes an MCAP file starts (and, when complete, ends) with.
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+_ROW_TOPICS = {ch.topic for ch in ROW_CHANNELS}
+_FIRST = ROW_CHANNELS[0].topic  # a time unit exists when it has percepts
+
+
+def _json(path: Path, topic: str, data: bytes) -> dict[str, Any]:
+    try:
+        msg = json.loads(data)
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise UserError(f"{path}: a message on {topic} is not JSON ({exc})") from None
+    if not isinstance(msg, dict):
+        raise UserError(f"{path}: a message on {topic} is not a JSON object")
+    if topic != SESSION.topic and not isinstance(msg.get("t"), int):
+        raise UserError(f"{path}: a message on {topic} has no time unit t")
+    return msg
+
+
+class McapRecording:
+    """A session recorded as MCAP, read whole (but the frames) when opened.
+
+    Args:
+        path: the ``.mcap`` file.
+
+    Attributes:
+        rows: one trace row per time unit, in order.
+        frames: ``{"index", "t", "log_time"}`` per recorded frame.
+        trees: ``{"t", "graph"}`` whenever the tree changed.
+        events: evaluations and naming executions.
+        manifest: what was run (``session.json``'s content, when the session finished).
+        cut: ``None``, or why the file ends early (read up to its last complete chunk).
+
+    Raises:
+        UserError: no such file, not an MCAP file, damaged, or no session in it.
+    """
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+        self.folder = self.path.parent
+        if not self.path.is_file():
+            raise UserError(f"{path}: no such file")
+        with open(self.path, "rb") as fh:
+            if fh.read(8) != MCAP_MAGIC:
+                raise UserError(f"{path}: not an MCAP file")
+        self.rows: list[dict[str, Any]] = []
+        self.frames: list[dict[str, Any]] = []
+        self.trees: list[dict[str, Any]] = []
+        self.events: list[dict[str, Any]] = []
+        self.info: dict[str, Any] = {}
+        self.manifest: dict[str, Any] = {}
+        self.summary: dict[str, Any] = {}
+        self.attachments: dict[str, bytes] = {}
+        self.cut: str | None = None
+        self._jpeg: dict[int, bytes] = {}  # frames of a cut file (no index to seek with)
+        self._read()
+        if not self.rows:
+            what = "cut short before its first complete chunk" if self.cut else \
+                "not a recorded relrl session (no /relrl/percepts messages)"
+            raise UserError(f"{path}: {what}")
+        self._t = [int(r["t"]) for r in self.rows]
+        self._frame_t = [int(f["t"]) for f in self.frames]
+        self._tree_t = [int(x["t"]) for x in self.trees]
+
+    def _read(self) -> None:
+        from mcap.exceptions import EndOfFile, McapError
+        from mcap.records import Attachment, Channel, Footer, Message, Metadata
+        from mcap.stream_reader import StreamReader
+
+        channels: dict[int, str] = {}
+        units: dict[int, list[dict[str, Any]]] = {}
+        unit_at: dict[int, int] = {}  # log time -> time unit, for pairing frames
+        complete = False
+        with open(self.path, "rb") as fh:
+            try:
+                for record in StreamReader(fh, validate_crcs=True,
+                                           record_size_limit=1 << 30).records:
+                    if isinstance(record, Channel):
+                        channels[record.id] = record.topic
+                    elif isinstance(record, Message):
+                        topic = channels.get(record.channel_id)
+                        if topic is None:
+                            raise UserError(f"{self.path}: a message on channel "
+                                            f"{record.channel_id}, which was never declared")
+                        self._message(topic, record, units, unit_at)
+                    elif isinstance(record, Metadata):
+                        self._metadata(record.name, record.metadata)
+                    elif isinstance(record, Attachment):
+                        self.attachments[record.name] = record.data
+                    elif isinstance(record, Footer):
+                        complete = True
+            except EndOfFile:
+                pass
+            except (McapError, ValueError, OSError) as exc:
+                raise UserError(f"{self.path}: damaged MCAP file "
+                                f"({type(exc).__name__}: {exc})") from None
+        if complete:  # frames are read when shown, through the file's chunk index
+            self._jpeg.clear()
+        else:
+            last = ROW_CHANNELS[-1].topic  # a unit cut in the middle of its channels
+            units = {t: p for t, p in units.items() if p and last in {m["_topic"] for m in p}}
+            self.cut = (f"cut short (the session was stopped before it closed the file): "
+                        f"read up to its last complete chunk, {len(units)} time units")
+        for parts in units.values():
+            for msg in parts:
+                del msg["_topic"]
+        self.rows = [join_row(parts) for _, parts in sorted(units.items())]
+
+    @property
+    def _schema(self) -> Any:
+        from mcap.records import Schema
+
+        return Schema(id=1, name=IMAGE.schema, encoding=IMAGE.schema_encoding,
+                      data=IMAGE.schema_data)
+
+    def _message(self, topic: str, record: Any, units: dict[int, list[dict[str, Any]]],
+                 unit_at: dict[int, int]) -> None:
+        if topic in _ROW_TOPICS:
+            msg = _json(self.path, topic, record.data)
+            t = msg["t"]
+            if topic == _FIRST:
+                units.setdefault(t, [])
+                unit_at[record.log_time] = t
+            parts = units.get(t)
+            if parts is not None:
+                msg["_topic"] = topic
+                parts.append(msg)
+            elif topic == "/relrl/perception":  # the last frame, after the last unit
+                unit_at[record.log_time] = t
+        elif topic == IMAGE.topic:
+            index = len(self.frames) + 1
+            t = unit_at.get(record.log_time, max(unit_at.values(), default=0))
+            self.frames.append({"index": index, "t": t, "log_time": record.log_time})
+            self._jpeg[index] = record.data  # dropped when the file is complete (below)
+        elif topic == TREE.topic:
+            msg = _json(self.path, topic, record.data)
+            self.trees.append({"t": msg["t"], "graph": msg.get("graph")})
+        elif topic == EVENTS.topic:
+            self.events.append(_json(self.path, topic, record.data))
+        elif topic == SESSION.topic:
+            self.info = _json(self.path, topic, record.data)
+
+    def _metadata(self, name: str, data: dict[str, str]) -> None:
+        if name in ("relrl.session", "relrl.summary"):
+            try:
+                value = json.loads(data.get("json", "{}"))
+            except json.JSONDecodeError as exc:
+                raise UserError(f"{self.path}: metadata {name} is not JSON ({exc})") from None
+            if name == "relrl.session":
+                self.manifest = value
+            else:
+                self.summary = value
+
+    @property
+    def necessities(self) -> list[str]:
+        """The necessity units, in order."""
+        return (self.manifest.get("necessities") or self.info.get("necessities")
+                or list(self.rows[0].get("activation", {})))
+
+    def row(self, t: int) -> dict[str, Any] | None:
+        """The trace row of time unit ``t`` (``None`` outside the session)."""
+        i = bisect.bisect_left(self._t, t)
+        return self.rows[i] if i < len(self._t) and self._t[i] == t else None
+
+    def frame_at(self, t: int) -> dict[str, Any] | None:
+        """The newest recorded frame at or before time unit ``t``."""
+        i = bisect.bisect_right(self._frame_t, t) - 1
+        return self.frames[i] if i >= 0 else None
+
+    def frame_bytes(self, index: int) -> bytes | None:
+        """The JPEG bytes of recorded frame ``index`` (from 1)."""
+        if not 1 <= index <= len(self.frames):
+            return None
+        from mcap.exceptions import McapError
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
+
+        data = self._jpeg.get(index)
+        try:
+            if data is None:
+                ns = self.frames[index - 1]["log_time"]
+                with open(self.path, "rb") as fh:
+                    for _, _, msg, image in make_reader(
+                            fh, decoder_factories=[DecoderFactory()]).iter_decoded_messages(
+                            topics=[IMAGE.topic], start_time=ns, end_time=ns + 1):
+                        return bytes(image.data)
+                return None
+            decode = DecoderFactory().decoder_for("cdr", self._schema)
+            return bytes(decode(data).data)
+        except (McapError, ValueError, OSError):  # the file changed under the replay
+            return None
+
+    def tree_at(self, t: int) -> dict[str, Any] | None:
+        """The learner's tree as it was at time unit ``t``."""
+        i = bisect.bisect_right(self._tree_t, t) - 1
+        return self.trees[i]["graph"] if i >= 0 else None
