@@ -8,6 +8,8 @@ source                     meaning
 ``frames/``                a folder of images, read in name order (``dir://frames``)
 ``session/``               a session recorded by relrl (``recording://session``): its frames
 ``photo.png``              one image, read once (``image://photo.png``)
+``bag.mcap[:TOPIC]``       a ROS 2 bag's images at their recorded times (``mcap://bag.mcap``;
+                           :mod:`perception.bag`; the ``mcap`` extra)
 ``synthetic://``           :func:`perception.render.render` of a :class:`SceneView`
 =========================  ==========================================================
 
@@ -237,6 +239,13 @@ def _recording(path: str) -> Camera:
     return RecordedCamera(path)
 
 
+def _bag(source: str) -> Camera:
+    from perception.bag import BagCamera, parse_bag_source
+
+    path, topic = parse_bag_source(source)
+    return BagCamera(path, topic)
+
+
 def _video(path: str) -> Camera:
     if not Path(path).is_file():
         raise CameraError(f"no such video file: {path!r}")
@@ -250,6 +259,7 @@ SOURCES: dict[str, Callable[[str], Camera]] = {
     "dir": _Folder,
     "image": _Image,
     "recording": _recording,
+    "mcap": _bag,
     "synthetic": lambda rest: _synthetic("synthetic://" + rest),
 }
 
@@ -268,6 +278,8 @@ def open_camera(source: str | int) -> Camera:
     elif Path(src).is_dir():
         scheme = "recording" if (Path(src) / "frames.jsonl").is_file() else "dir"
         rest = src
+    elif src.lower().endswith(".mcap") or ".mcap:" in src:
+        scheme, rest = "mcap", src
     elif Path(src).suffix.lower() in _IMAGE_EXT:
         scheme, rest = "image", src
     else:
