@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from perception.errors import CameraError
 from perception.camera import Camera
+from perception.errors import CameraError
 from perception.imagesize import check_frame_size
 
 __all__ = ["IMAGE_TYPES", "BagCamera", "parse_bag_source"]

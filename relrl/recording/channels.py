@@ -26,8 +26,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CHANNELS", "ROW_CHANNELS", "Channel", "annotations_of", "join_row",
-           "joint_state_of", "split_row"]
+__all__ = ["CHANNELS", "ROW_CHANNELS", "Channel", "annotations_of", "cdr_encoders",
+           "join_row", "joint_state_of", "split_row"]
 
 _TIME = """================================================================================
 MSG: builtin_interfaces/Time
@@ -121,9 +121,11 @@ JSON_SCHEMAS: dict[str, dict[str, Any]] = {
         {"t": _T, "head": {"type": ["object", "null"]}}),
     "relrl.Perception": _object(
         "relrl.Perception", "What perception found in the frame the unit decided on (face "
-        "box and pose, the most salient area, its colour and place) and the frame's index",
+        "box and pose, the most salient area, its colour and place), the recorded frame's "
+        "index and where the head looked when it was seen",
         {"t": _T, "overlay": {"type": ["object", "null"]},
-         "frame": {"type": ["integer", "null"]}}),
+         "frame": {"type": ["integer", "null"]},
+         "frame_looking_at": {"type": ["string", "null"]}}),
     "relrl.Interaction": _object(
         "relrl.Interaction", "The rest of the time unit: running CGI and eye contacts, the "
         "caregiver, where the robot looks, words heard and said, naming",
@@ -188,11 +190,13 @@ ROW_CHANNELS: tuple[Channel, ...] = (
     Channel("/relrl/response", "relrl.Response", "json", ("response", "allowed",
                                                            "explanation")),
     Channel("/relrl/head", "relrl.Head", "json", ("head",)),
-    Channel("/relrl/perception", "relrl.Perception", "json", ("overlay", "frame")),
+    Channel("/relrl/perception", "relrl.Perception", "json",
+            ("overlay", "frame", "frame_looking_at")),
     # the rest of the row, whatever the session adds (caregiver, focus, heard, ...)
     Channel("/relrl/interaction", "relrl.Interaction", "json", ()),
 )
 _REST = ROW_CHANNELS[-1]
+PERCEPTION = ROW_CHANNELS[-2]
 _KNOWN = {"t"} | {k for ch in ROW_CHANNELS for k in ch.keys}
 
 #: every channel, in the order they are registered.
@@ -271,8 +275,10 @@ def annotations_of(overlay: dict[str, Any] | None, ns: int) -> dict[str, Any]:
         px, py = obj["peak"]
         points.append({"timestamp": stamp, "type": 4, "thickness": 2.0, "outline_color": red,
                        "outline_colors": [], "fill_color": _color(0, 0, 0, 0),
-                       "points": [{"x": px - 5.0, "y": float(py)}, {"x": px + 5.0, "y": float(py)},
-                                  {"x": float(px), "y": py - 5.0}, {"x": float(px), "y": py + 5.0}]})
+                       "points": [{"x": px - 5.0, "y": float(py)},
+                                  {"x": px + 5.0, "y": float(py)},
+                                  {"x": float(px), "y": py - 5.0},
+                                  {"x": float(px), "y": py + 5.0}]})
         texts.append(_label(obj["box"][0], obj["box"][1] - 4,
                             f"{obj.get('colour') or 'object'} at {obj.get('place')} "
                             f"(saliency {obj.get('saliency')})", stamp, yellow))
@@ -290,3 +296,12 @@ def joint_state_of(head: dict[str, Any], ns: int) -> dict[str, Any]:
             "name": names,
             "position": [math.radians(float(servos[n]["deg"])) for n in names],
             "velocity": [], "effort": []}
+
+
+def cdr_encoders() -> dict[str, Any]:
+    """Topic -> ROS 2 CDR encoder (a message as a dict -> bytes) of the CDR channels, built
+    by mcap-ros2-support from the definitions above (the ``mcap`` extra)."""
+    from mcap_ros2._dynamic import serialize_dynamic  # its writer's own encoder factory
+
+    return {ch.topic: serialize_dynamic(ch.schema, ch.schema_data.decode())[ch.schema]
+            for ch in CHANNELS if ch.encoding == "cdr"}

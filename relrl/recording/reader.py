@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import Any
 
 from relrl.errors import UserError
-from relrl.recording.channels import (EVENTS, IMAGE, ROW_CHANNELS, SESSION, TREE, join_row)
+from relrl.recording.channels import EVENTS, IMAGE, ROW_CHANNELS, SESSION, TREE, join_row
 
-__all__ = ["McapRecording", "MCAP_MAGIC"]
+__all__ = ["MCAP_MAGIC", "McapRecording", "open_recording"]
 
 #: the eight bytes an MCAP file starts (and, when complete, ends) with.
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -205,7 +205,7 @@ class McapRecording:
             if data is None:
                 ns = self.frames[index - 1]["log_time"]
                 with open(self.path, "rb") as fh:
-                    for _, _, msg, image in make_reader(
+                    for _, _, _, image in make_reader(
                             fh, decoder_factories=[DecoderFactory()]).iter_decoded_messages(
                             topics=[IMAGE.topic], start_time=ns, end_time=ns + 1):
                         return bytes(image.data)
@@ -219,3 +219,24 @@ class McapRecording:
         """The learner's tree as it was at time unit ``t``."""
         i = bisect.bisect_right(self._tree_t, t) - 1
         return self.trees[i]["graph"] if i >= 0 else None
+
+
+def open_recording(path: str | Path) -> Any:
+    """What ``relrl replay PATH`` reads: an ``.mcap`` file, a session folder's
+    ``session.mcap``, or -- a folder written with ``--out`` alone, or recorded by an earlier
+    relrl -- its trace (:class:`relrl.monitor.replay.Recording`).
+
+    Raises:
+        UserError: nothing recorded there, or a bad file.
+    """
+    p = Path(path)
+    if p.is_dir() and (p / "session.mcap").is_file():
+        p = p / "session.mcap"
+    elif p.is_dir() and (p / "frames.jsonl").is_file():
+        raise UserError(f"{path}: a session recorded as a folder of frames by an earlier "
+                        f"relrl; convert it once with: relrl migrate {path}")
+    if p.is_dir() or (not p.exists() and p.suffix.lower() != ".mcap"):
+        from relrl.monitor.replay import Recording
+
+        return Recording(p)
+    return McapRecording(p)

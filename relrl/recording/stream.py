@@ -23,8 +23,20 @@ import threading
 import time
 from typing import Any, Protocol
 
-from relrl.recording.channels import (ANNOTATIONS, EVENTS, IMAGE, JOINTS, SESSION, TREE,
-                                      Channel, annotations_of, joint_state_of, split_row)
+from relrl.recording.channels import (
+    ANNOTATIONS,
+    EVENTS,
+    IMAGE,
+    JOINTS,
+    PERCEPTION,
+    SESSION,
+    TREE,
+    Channel,
+    annotations_of,
+    cdr_encoders,
+    joint_state_of,
+    split_row,
+)
 
 __all__ = ["QUEUE", "SessionStream", "Sink"]
 
@@ -58,18 +70,6 @@ def to_json(msg: dict[str, Any]) -> bytes:
         return json.dumps(_finite(msg), separators=(",", ":"), default=str).encode()
 
 
-class _Cdr:
-    """ROS 2 CDR encoders of the recording's two ROS channels (mcap-ros2-support's)."""
-
-    def __init__(self) -> None:
-        from mcap_ros2._dynamic import serialize_dynamic
-
-        self.encode = {}
-        for ch in (IMAGE, JOINTS):
-            self.encode[ch.topic] = serialize_dynamic(ch.schema, ch.schema_data.decode())[
-                ch.schema]
-
-
 class SessionStream:
     """Encode a session's channels in a thread and write them to every sink.
 
@@ -84,7 +84,7 @@ class SessionStream:
         self.frames = 0
         self.frame_bytes = 0
         self.units = 0
-        self._cdr = _Cdr()
+        self._cdr = cdr_encoders()
         self._queue: queue.Queue[tuple[Any, ...] | None] = queue.Queue(maxsize=QUEUE)
         self._error: BaseException | None = None
         self._closed = False
@@ -108,6 +108,15 @@ class SessionStream:
         row's ``overlay`` is what perception found in it)."""
         self._put(("step", time.time_ns(), row, frame))
 
+    def frame(self, t: int, index: int, frame: Any, overlay: dict[str, Any] | None,
+              looking_at: str | None = None) -> None:
+        """A frame with no time unit of its own (the last one, after the last unit)."""
+        self._put(("frame", time.time_ns(), t, index, frame, overlay, looking_at))
+
+    def attach(self, name: str, media_type: str, data: bytes) -> None:
+        """A file carried inside the recording (the sinks that keep files)."""
+        self._put(("attach", name, media_type, data))
+
     def tree(self, t: int, graph: dict[str, Any] | None) -> None:
         """The learner's tree, when it changed."""
         self._put(("json", TREE, time.time_ns(), {"t": t, "graph": graph}))
@@ -128,34 +137,66 @@ class SessionStream:
             self._send(channel, ns, to_json(msg))
         head = row.get("head")
         if head:
-            self._send(JOINTS, ns, self._cdr.encode[JOINTS.topic](joint_state_of(head, ns)))
+            self._send(JOINTS, ns, self._cdr[JOINTS.topic](joint_state_of(head, ns)))
         if frame is not None:
-            from relrl.monitor.frames import encode_jpeg
+            self._encode_frame(ns, frame, row.get("overlay"))
 
-            jpeg = encode_jpeg(frame, self.quality)
-            stamp = {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
-            self._send(IMAGE, ns, self._cdr.encode[IMAGE.topic](
-                {"header": {"stamp": stamp, "frame_id": "camera"}, "format": "jpeg",
-                 "data": jpeg}))
-            self._send(ANNOTATIONS, ns, to_json(annotations_of(row.get("overlay"), ns)))
-            self.frames += 1
-            self.frame_bytes += len(jpeg)
+    def _encode_frame(self, ns: int, frame: Any, overlay: dict[str, Any] | None) -> None:
+        from relrl.monitor.frames import encode_jpeg
+
+        jpeg = encode_jpeg(frame, self.quality)
+        stamp = {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
+        self._send(IMAGE, ns, self._cdr[IMAGE.topic](
+            {"header": {"stamp": stamp, "frame_id": "camera"}, "format": "jpeg",
+             "data": jpeg}))
+        self._send(ANNOTATIONS, ns, to_json(annotations_of(overlay, ns)))
+        self.frames += 1
+        self.frame_bytes += len(jpeg)
+
+    def _encode(self, item: tuple[Any, ...]) -> None:
+        kind = item[0]
+        if kind == "step":
+            self._encode_step(*item[1:])
+        elif kind == "frame":
+            _, ns, t, index, frame, overlay, looked = item
+            self._send(PERCEPTION, ns, to_json({"t": t, "overlay": overlay, "frame": index,
+                                                "frame_looking_at": looked}))
+            self._encode_frame(ns, frame, overlay)
+        elif kind == "attach":
+            for sink in self.sinks:
+                if hasattr(sink, "add_attachment"):
+                    sink.add_attachment(*item[1:])
+        else:
+            _, channel, ns, msg = item
+            self._send(channel, ns, to_json(msg))
 
     def _run(self) -> None:
-        while (item := self._queue.get()) is not None:
-            if self._error is not None:
-                continue  # a sink failed: drain, the loop raises at its next call
+        while True:
+            item = self._queue.get()
             try:
-                if item[0] == "step":
-                    self._encode_step(*item[1:])
-                else:
-                    _, channel, ns, msg = item
-                    self._send(channel, ns, to_json(msg))
+                if item is None:
+                    return
+                if self._error is None:  # after a sink failed: drain, the loop raises
+                    self._encode(item)
             except Exception as exc:  # noqa: BLE001 - raised again in the control loop
                 self._error = exc
+            finally:
+                self._queue.task_done()
 
-    def close(self) -> dict[str, Any]:
-        """Encode what is queued, close every sink (safe twice); returns the figures."""
+    def stats(self) -> dict[str, Any]:
+        """What was encoded: time units, frames, their bytes."""
+        return {"units": self.units, "frames": self.frames, "frame_bytes": self.frame_bytes,
+                "jpeg_quality": self.quality}
+
+    def drain(self) -> dict[str, Any]:
+        """Wait until everything queued is encoded and written; returns :meth:`stats`."""
+        if not self._closed:
+            self._queue.join()
+        return self.stats()
+
+    def close(self, metadata: dict[str, dict[str, Any]] | None = None) -> dict[str, Any]:
+        """Encode what is queued, add ``metadata`` (name -> JSON-ready dict) to the sinks
+        that keep it, close every sink (safe twice); returns :meth:`stats`."""
         if not self._closed:
             self._closed = True
             self._queue.put(None)
@@ -163,11 +204,13 @@ class SessionStream:
             first: BaseException | None = self._error
             for sink in self.sinks:
                 try:
+                    if first is None and metadata and hasattr(sink, "add_metadata"):
+                        for name, value in metadata.items():
+                            sink.add_metadata(name, {"json": to_json(value).decode()})
                     sink.close()
                 except Exception as exc:  # noqa: BLE001 - every sink is closed
                     first = first or exc
             self._error = None
             if first is not None:
                 raise first
-        return {"units": self.units, "frames": self.frames, "frame_bytes": self.frame_bytes,
-                "jpeg_quality": self.quality}
+        return self.stats()
