@@ -55,6 +55,7 @@ class _Client:
         self.queue: deque[bytes] = deque(maxlen=BACKLOG)
         self.wake = asyncio.Event()
         self.dropped = 0
+        self.sender: Any = None
 
 
 class FoxgloveServer:
@@ -82,6 +83,7 @@ class FoxgloveServer:
         self._thread: threading.Thread | None = None
         self._stop: asyncio.Event | None = None
         self.sent = 0
+        self.dropped = 0
         self.refused = 0
 
     @property
@@ -96,6 +98,8 @@ class FoxgloveServer:
         """Hand one encoded message over (dropped when the server is this far behind)."""
         cid = self._ids.get(channel.topic)
         if cid is not None:
+            if len(self._inbox) == BACKLOG:
+                self.dropped += 1  # the server thread is this far behind: the oldest goes
             self._inbox.append((cid, log_time, data))
 
     # -- start and stop -------------------------------------------------------------------
@@ -151,7 +155,8 @@ class FoxgloveServer:
         self._stop = asyncio.Event()
         async with serve(self._handle, sock=sock, subprotocols=[SUBPROTOCOL],
                          process_request=self._check, max_size=1 << 16, max_queue=16,
-                         ping_interval=20, ping_timeout=20, compression=None):
+                         ping_interval=20, ping_timeout=20, close_timeout=1,
+                         compression=None):
             ready.set()
             while not self._stop.is_set():
                 self._fan_out()
@@ -159,8 +164,12 @@ class FoxgloveServer:
                     await asyncio.wait_for(self._stop.wait(), PERIOD)
                 except TimeoutError:
                     pass
-            for client in list(self._clients):
-                await client.ws.close(1001, "the session ended")
+            for client in list(self._clients):  # a client that stopped reading is cut off
+                client.sender.cancel()
+                try:
+                    await asyncio.wait_for(client.ws.close(1001, "the session ended"), 1)
+                except (TimeoutError, OSError):
+                    client.ws.transport.abort()
 
     def _check(self, connection: Any, request: Any) -> Any:
         """Refuse a wrong Host (loopback), a missing token (elsewhere), too many clients."""
@@ -210,7 +219,7 @@ class FoxgloveServer:
     async def _handle(self, ws: Any) -> None:
         client = _Client(ws)
         self._clients.add(client)
-        sender = asyncio.create_task(self._send_loop(client))
+        client.sender = asyncio.create_task(self._send_loop(client))
         try:
             await ws.send(json.dumps({"op": "serverInfo", "name": "relrl", "capabilities": [],
                                       "supportedEncodings": [], "metadata": {},
@@ -222,7 +231,7 @@ class FoxgloveServer:
             pass
         finally:
             self._clients.discard(client)
-            sender.cancel()
+            client.sender.cancel()
 
     async def _request(self, client: _Client, raw: Any) -> None:
         if isinstance(raw, bytes):

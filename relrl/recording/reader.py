@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import bisect
 import json
+import struct
 from pathlib import Path
 from typing import Any
 
@@ -88,7 +89,7 @@ class McapRecording:
         self._tree_t = [int(x["t"]) for x in self.trees]
 
     def _read(self) -> None:
-        from mcap.exceptions import EndOfFile, McapError
+        from mcap.exceptions import EndOfFile
         from mcap.records import Attachment, Channel, Footer, Message, Metadata
         from mcap.stream_reader import StreamReader
 
@@ -97,28 +98,32 @@ class McapRecording:
         unit_at: dict[int, int] = {}  # log time -> time unit, for pairing frames
         complete = False
         with open(self.path, "rb") as fh:
-            try:
-                for record in StreamReader(fh, validate_crcs=True,
-                                           record_size_limit=1 << 30).records:
-                    if isinstance(record, Channel):
-                        channels[record.id] = record.topic
-                    elif isinstance(record, Message):
-                        topic = channels.get(record.channel_id)
-                        if topic is None:
-                            raise UserError(f"{self.path}: a message on channel "
-                                            f"{record.channel_id}, which was never declared")
-                        self._message(topic, record, units, unit_at)
-                    elif isinstance(record, Metadata):
-                        self._metadata(record.name, record.metadata)
-                    elif isinstance(record, Attachment):
-                        self.attachments[record.name] = record.data
-                    elif isinstance(record, Footer):
-                        complete = True
-            except EndOfFile:
-                pass
-            except (McapError, ValueError, OSError) as exc:
-                raise UserError(f"{self.path}: damaged MCAP file "
-                                f"({type(exc).__name__}: {exc})") from None
+            records = StreamReader(fh, validate_crcs=True, record_size_limit=1 << 30).records
+            while True:
+                try:
+                    record = next(records)
+                except StopIteration:
+                    break
+                except (EndOfFile, struct.error):  # cut inside a record or its length
+                    break
+                except Exception as exc:  # noqa: BLE001 - only the file's bytes are read
+                    # here: a CRC, decompression (zstd, lz4) or record error is damage
+                    raise UserError(f"{self.path}: damaged MCAP file "
+                                    f"({type(exc).__name__}: {exc})") from None
+                if isinstance(record, Channel):
+                    channels[record.id] = record.topic
+                elif isinstance(record, Message):
+                    topic = channels.get(record.channel_id)
+                    if topic is None:
+                        raise UserError(f"{self.path}: a message on channel "
+                                        f"{record.channel_id}, which was never declared")
+                    self._message(topic, record, units, unit_at)
+                elif isinstance(record, Metadata):
+                    self._metadata(record.name, record.metadata)
+                elif isinstance(record, Attachment):
+                    self.attachments[record.name] = record.data
+                elif isinstance(record, Footer):
+                    complete = True
         if complete:  # frames are read when shown, through the file's chunk index
             self._jpeg.clear()
         else:
@@ -196,7 +201,6 @@ class McapRecording:
         """The JPEG bytes of recorded frame ``index`` (from 1)."""
         if not 1 <= index <= len(self.frames):
             return None
-        from mcap.exceptions import McapError
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
 
@@ -206,13 +210,14 @@ class McapRecording:
                 ns = self.frames[index - 1]["log_time"]
                 with open(self.path, "rb") as fh:
                     for _, _, _, image in make_reader(
-                            fh, decoder_factories=[DecoderFactory()]).iter_decoded_messages(
-                            topics=[IMAGE.topic], start_time=ns, end_time=ns + 1):
+                            fh, validate_crcs=True,
+                            decoder_factories=[DecoderFactory()]).iter_decoded_messages(
+                            topics=[IMAGE.topic], starting_at=ns, ending_at=ns):
                         return bytes(image.data)
                 return None
             decode = DecoderFactory().decoder_for("cdr", self._schema)
             return bytes(decode(data).data)
-        except (McapError, ValueError, OSError):  # the file changed under the replay
+        except Exception:  # noqa: BLE001 - the file changed or was damaged under the replay
             return None
 
     def tree_at(self, t: int) -> dict[str, Any] | None:

@@ -130,6 +130,7 @@ def _cut(path: Path) -> Path:
     ("cut", "cut short"),
     ("not_mcap", "not an MCAP file"),
     ("topic", "no topic '/nope'"),
+    ("damaged", "damaged MCAP file"),
 ])
 def test_bad_bags_are_one_line(tmp_path: Path, case: str, says: str) -> None:
     from mcap_ros2.writer import Writer
@@ -153,7 +154,17 @@ def test_bad_bags_are_one_line(tmp_path: Path, case: str, says: str) -> None:
         bag.write_bytes(b"#ROSBAG V2.0\n" + b"\0" * 100)
     elif case == "topic":
         source = f"{write_bag(bag, scenes(2))}:/nope"
-    if case == "encoding":
+    elif case == "damaged":
+        from mcap.reader import make_reader
+
+        write_bag(bag, scenes(4))
+        with open(bag, "rb") as fh:
+            chunk = make_reader(fh).get_summary().chunk_indexes[0]
+        data = bytearray(bag.read_bytes())
+        for i in range(chunk.chunk_start_offset + 300, chunk.chunk_start_offset + 364):
+            data[i] ^= 0xFF
+        bag.write_bytes(bytes(data))
+    if case in ("encoding", "damaged"):
         with pytest.raises(CameraError, match=says), open_camera(source) as cam:
             cam.read()
     else:

@@ -148,17 +148,28 @@ def test_a_stalled_client_never_holds_the_writer() -> None:
             return ws
 
         loop = asyncio.new_event_loop()
-        ws = loop.run_until_complete(stalled())  # its loop no longer runs: it never reads
+        _ws = loop.run_until_complete(stalled())  # its loop no longer runs: it never reads
         big = b"x" * 200_000
-        t0 = time.perf_counter()
+        took = 0.0
         for i in range(3000):
+            t0 = time.perf_counter()
             server.write(IMAGE, i, big)
             server.write(ROW_CHANNELS[3], i, b'{"t":1,"reward":0}')
-        took = time.perf_counter() - t0
+            took = max(took, time.perf_counter() - t0)
+            if i % 300 == 0:
+                time.sleep(0.05)  # the server's thread hands them over meanwhile
         time.sleep(0.5)
-        assert took < 1.0
-        loop.run_until_complete(ws.close())
-        loop.close()
+        assert took < 0.05  # no write ever waited for the client
+        client = next(iter(server._clients))
+        assert client.dropped > 0  # the server dropped what the client could not take
+        t0 = time.perf_counter()
+        server.close()  # the client still stalled: it is cut off, not waited for
+        assert time.perf_counter() - t0 < 3
+    tasks = asyncio.all_tasks(loop)
+    for task in tasks:
+        task.cancel()
+    loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
+    loop.close()
 
 
 def test_bad_address_is_one_line() -> None:
@@ -166,3 +177,67 @@ def test_bad_address_is_one_line() -> None:
 
     with pytest.raises(ConfigError, match="port must be a number"):
         FoxgloveServer("127.0.0.1:99999")
+
+
+def test_a_live_session_in_foxglove(tmp_path) -> None:
+    """relrl run --foxglove: a client subscribes to the camera, its annotations, the
+    percepts and the joint states, and decodes each with the advertised schema."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from mcap.records import Schema
+    from mcap_ros2.decoder import DecoderFactory
+
+    from tests.conftest import ROOT
+    from tests.monitor.conftest import episode
+
+    script = episode(tmp_path, steps=400)
+    proc = subprocess.Popen([sys.executable, "-m", "relrl", "-q", "run", str(script),
+                             "--head", "sim", "--foxglove", "127.0.0.1:0", "--step-seconds",
+                             "0.02", "--no-plots"], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        url = None
+        for line in proc.stdout:
+            if line.startswith("foxglove: "):
+                url = line.split()[1]
+                break
+        assert url and url.startswith("ws://127.0.0.1:")
+
+        async def client() -> dict:
+            ws, _, adv = await _hello(url)
+            chans = {c["topic"]: c for c in adv["channels"]}
+            wanted = ["/camera/image/compressed", "/camera/annotations", "/relrl/percepts",
+                      "/head/joint_states"]
+            await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
+                {"id": i, "channelId": chans[t]["id"]} for i, t in enumerate(wanted)]}))
+            got: dict[str, list] = {}
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and len(got) < len(wanted):
+                raw = await asyncio.wait_for(ws.recv(), 30)
+                if isinstance(raw, bytes):
+                    sub, ns = struct.unpack_from("<IQ", raw, 1)
+                    topic = wanted[sub]
+                    ch = chans[topic]
+                    if ch["encoding"] == "cdr":
+                        schema = Schema(id=ch["id"], name=ch["schemaName"], encoding="ros2msg",
+                                        data=ch["schema"].encode())
+                        msg = DecoderFactory().decoder_for("cdr", schema)(raw[13:])
+                    else:
+                        msg = json.loads(raw[13:])
+                    got.setdefault(topic, []).append(msg)
+            await ws.close()
+            return got
+
+        got = asyncio.run(client())
+    finally:
+        proc.kill()
+        proc.wait(30)
+    assert set(got) == {"/camera/image/compressed", "/camera/annotations", "/relrl/percepts",
+                        "/head/joint_states"}
+    assert got["/camera/image/compressed"][0].format == "jpeg"
+    assert bytes(got["/camera/image/compressed"][0].data[:2]) == b"\xff\xd8"  # a JPEG
+    assert "percepts" in got["/relrl/percepts"][0]
+    assert len(got["/head/joint_states"][0].name) >= 2
+    assert not Path(tmp_path / "session.mcap").exists()  # live only: nothing written
