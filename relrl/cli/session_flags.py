@@ -27,7 +27,8 @@ def add_session_arguments(parser: argparse.ArgumentParser) -> None:
                    help="serve a live web page of the session (default 127.0.0.1 and a free "
                         "port, printed at start; off localhost a token is required)")
     g.add_argument("--monitor-rate", type=float, default=10.0, metavar="HZ",
-                   help="views and frames sent to the browser per second, at most (10)")
+                   help="views and frames sent to the browser (and to Foxglove, when not "
+                        "recording) per second, at most (10)")
     g.add_argument("--monitor-hold", action="store_true",
                    help="keep the page up after the session ends, until Ctrl-C")
     g.add_argument("--foxglove", nargs="?", const="", default=None, metavar="HOST:PORT",
@@ -151,13 +152,13 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
             note = " (token required: not bound to localhost)" if session.server.token else ""
             print(f"monitor: {session.server.url}{note}", flush=True)
         if args.foxglove is not None:
-            from relrl.monitor.foxglove import FoxgloveServer
+            from relrl.recording.recorder import Recorder
 
-            opts.foxglove = FoxgloveServer(args.foxglove or None).start()
+            opts.recorder = Recorder(foxglove=args.foxglove)
             opts.live_rate = args.monitor_rate
-            session.closers.append(opts.foxglove)
-            note = " (token required: not bound to localhost)" if opts.foxglove.token else ""
-            print(f"foxglove: {opts.foxglove.url}{note} (Foxglove: Open connection, "
+            session.closers.append(opts.recorder)
+            note = " (token required: not bound to localhost)" if opts.recorder.token else ""
+            print(f"foxglove: {opts.recorder.url}{note} (in Foxglove: Open connection, "
                   "Foxglove WebSocket)", flush=True)
         yield session
     finally:

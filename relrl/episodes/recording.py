@@ -101,46 +101,42 @@ class SessionTap:
         record: record the session into ``out/session.mcap``.
         record_rate: frames per second at most (0: every time unit).
         record_quality: JPEG quality.
-        foxglove: the live :class:`~relrl.monitor.foxglove.FoxgloveServer`, or ``None``.
+        recorder: a started :class:`~relrl.recording.recorder.Recorder` (serving Foxglove),
+            or ``None`` (one is started when recording).
         live_rate: time units (and frames) sent to Foxglove per second at most when the
             session is not recorded (a recorded session sends every unit it records).
     """
 
     def __init__(self, run: Any, out: Path | None, env: Any, head: Any = None, *,
                  hub: Any = None, record: bool = False, record_rate: float = 10.0,
-                 record_quality: int = 85, foxglove: Any = None,
+                 record_quality: int = 85, recorder: Any = None,
                  live_rate: float = 10.0) -> None:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
         self.trace = open(out / "trace.jsonl", "w", encoding="utf-8") \
             if out is not None else None  # noqa: SIM115
-        record = record and out is not None
-        self.stream: Any = None
+        self.recording = record and out is not None
+        self.recorder, self._own = recorder, False
+        self.quality = int(record_quality)
         self.frames = 0
-        self._frame_rate = _Rate(record_rate if record else live_rate)
-        self._live = _Rate(0 if record else live_rate)  # a unit sent to a live-only stream
-        sinks: list[Any] = []
-        if record:
-            from relrl.recording.mcapfile import McapFile
+        self._frame_rate = _Rate(record_rate if self.recording else live_rate)
+        self._live = _Rate(0 if self.recording else live_rate)  # units sent when live only
+        self.files: dict[str, str] = {}
+        if self.recording:
+            if self.recorder is None:
+                from relrl.recording.recorder import Recorder
 
-            sinks.append(McapFile(out / RECORDING))
-        if foxglove is not None:
-            sinks.append(foxglove)
-        if sinks:
-            from relrl.recording.stream import SessionStream
-
-            self.stream = SessionStream(sinks, quality=record_quality)
+                self.recorder, self._own = Recorder(), True
+            self.recorder.open(out / RECORDING)
+            self.files = _copy_script(run.episode, out)
+            self.files["recording"] = RECORDING
+            for name in ("episode.toml", "domain.pl"):
+                if (out / name).is_file():
+                    self.recorder.attach(name, "text/plain", (out / name).read_bytes())
         self._tree_key: Any = None
         self._tree_graph: dict[str, Any] | None = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
-        self.files: dict[str, str] = {}
-        if record:
-            self.files = _copy_script(run.episode, out)
-            self.files["recording"] = RECORDING
-            for name in ("episode.toml", "domain.pl"):
-                if (out / name).is_file():
-                    self.stream.attach(name, "text/plain", (out / name).read_bytes())
         from relrl.terms import format_term
 
         ep = run.episode
@@ -154,8 +150,8 @@ class SessionTap:
         }
         if hub is not None:
             hub.info.update(self.info)
-        if self.stream is not None:
-            self.stream.session(self.info)
+        if self.recorder is not None:
+            self.recorder.session(self.info)
 
     def start(self) -> None:
         """The world has been reset: remember the first frame it perceived."""
@@ -172,7 +168,7 @@ class SessionTap:
         """What the next step is to report from its one gateway call: working memory and
         the explanation when this time unit is traced or shown, nothing otherwise."""
         self._asked = (self.trace is not None or (self.hub is not None and self.hub.due())
-                       or (self.stream is not None and self._live.due()))
+                       or (self.recorder is not None and self._live.due()))
         return WANTS if self._asked else ()
 
     def step(self, record: Any, phase: str, *, outcome: str | None = None,
@@ -197,26 +193,32 @@ class SessionTap:
                       "heard": info["words"], "naming": outcome, "said": said,
                       "overlay": overlay_of(percept, frame)}
         framed = None
-        if self.stream is not None and frame is not None and self._frame_rate.due():
+        if self.recorder is not None and frame is not None and self._frame_rate.due():
             self._frame_rate.took()
             self.frames += 1
             view.extra["frame"] = self.frames
             view.extra["frame_looking_at"] = looked  # where the head was when it was seen
             framed = frame
         row = view.row()
+        sent = self.recorder is not None and (framed is not None or self._live.due())
+        line = json.dumps(row, sort_keys=True) if self.trace is not None or sent else ""
         if self.trace is not None:
-            self.trace.write(json.dumps(row, sort_keys=True) + "\n")
+            self.trace.write(line + "\n")
             self.trace.flush()
         if publish:
             hub.publish(dict(row), frame)
-        if self.stream is not None and (framed is not None or self._live.due()):
+        if sent:  # the writer process encodes the channels from the line
+            from relrl.monitor.frames import encode_jpeg
+
             self._live.took()
-            self.stream.step(row, framed)
+            self.recorder.unit(time.time_ns(), line.encode(),
+                               encode_jpeg(framed, self.quality) if framed is not None
+                               else None)
         self._tree(run.t)
         return row
 
     def _tree(self, t: int, force: bool = False) -> None:
-        if self.hub is None and self.stream is None:
+        if self.hub is None and self.recorder is None:
             return
         now = time.perf_counter()
         if not force and now < self._tree_next:
@@ -232,15 +234,15 @@ class SessionTap:
         self._tree_key = key
         if self.hub is not None:
             self.hub.set_tree(graph)
-        if self.stream is not None:
-            self.stream.tree(t, graph)
+        if self.recorder is not None:
+            self.recorder.tree(t, graph)
 
     def event(self, kind: str, **data: Any) -> None:
         """A session event (evaluation, naming execution) for the monitor and the recording."""
         if self.hub is not None:
             self.hub.event(kind, t=self.run.t, **data)
-        if self.stream is not None:
-            self.stream.event(kind, self.run.t, **data)
+        if self.recorder is not None:
+            self.recorder.event(kind, self.run.t, **data)
 
     def finish(self) -> dict[str, Any]:
         """The session ended: the last tree, the last frame (when every unit is recorded).
@@ -250,28 +252,31 @@ class SessionTap:
         """
         self._tree(self.run.t, force=True)
         frame, percept, looked = self._seen
-        if self.stream is not None and self._frame_rate.rate <= 0 and frame is not None:
+        if self.recording and self._frame_rate.rate <= 0 and frame is not None:
+            from relrl.monitor.frames import encode_jpeg
+
             self.frames += 1
-            self.stream.frame(self.run.t + 1, self.frames, frame, overlay_of(percept, frame),
-                              looked)
+            self.recorder.last_frame(time.time_ns(), {
+                "t": self.run.t + 1, "overlay": overlay_of(percept, frame),
+                "frame": self.frames, "frame_looking_at": looked},
+                encode_jpeg(frame, self.quality))
         if self.hub is not None:
             self.hub.finish()
-        if self.stream is None:
+        if not self.recording:
             return {}
-        stats = self.stream.drain()
-        return {"frames": stats["frames"], "frame_bytes": stats["frame_bytes"],
-                "record_rate": self._frame_rate.rate, "jpeg_quality": stats["jpeg_quality"],
-                "file": RECORDING if self.files else None}
+        return {**self.recorder.stats(), "record_rate": self._frame_rate.rate,
+                "jpeg_quality": self.quality, "file": RECORDING}
 
     def close(self, manifest: dict[str, Any] | None = None,
-              summary: dict[str, Any] | None = None) -> dict[str, Any]:
+              summary: dict[str, Any] | None = None) -> None:
         """Close the recording -- with what was run and its summary in it, when given --
-        and the trace (safe twice); returns the recording's figures."""
-        stats: dict[str, Any] = {}
-        if self.stream is not None:
-            meta = {name: value for name, value in (("relrl.session", manifest),
-                                                    ("relrl.summary", summary)) if value}
-            stats = self.stream.close(meta)
-        if self.trace is not None and not self.trace.closed:
-            self.trace.close()
-        return stats
+        and the trace (safe twice)."""
+        try:
+            if self.recording and self.recorder is not None:
+                self.recorder.close_file({name: value for name, value in (
+                    ("relrl.session", manifest), ("relrl.summary", summary)) if value})
+        finally:
+            if self._own:
+                self.recorder.close()
+            if self.trace is not None and not self.trace.closed:
+                self.trace.close()

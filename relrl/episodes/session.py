@@ -97,7 +97,7 @@ class RunOptions:
             (``poll()`` once per time unit) or a queue (``get_nowait()``), or ``None``.
         plots: write PNG plots (needs matplotlib).
         monitor: the live monitor's :class:`relrl.monitor.Hub`, or ``None``.
-        foxglove: the live :class:`relrl.monitor.foxglove.FoxgloveServer`, or ``None``.
+        recorder: a :class:`relrl.recording.recorder.Recorder` serving Foxglove, or ``None``.
         live_rate: time units sent to Foxglove per second at most, when not recording.
         record: record the session into ``out/session.mcap`` (:mod:`.recording`).
         record_rate: recorded frames per second at most (0: every time unit).
@@ -117,7 +117,7 @@ class RunOptions:
     words: Any = None
     plots: bool = True
     monitor: Any = None
-    foxglove: Any = None
+    recorder: Any = None
     live_rate: float = 10.0
     record: bool = False
     record_rate: float = 10.0
@@ -250,7 +250,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         env, actuator = _world(episode, opts)
         run.tap = SessionTap(run, out, env, getattr(actuator, "head", None), hub=opts.monitor,
                              record=opts.record, record_rate=opts.record_rate,
-                             record_quality=opts.record_quality, foxglove=opts.foxglove,
+                             record_quality=opts.record_quality, recorder=opts.recorder,
                              live_rate=opts.live_rate)
         phase_name = episode.phase_at(1).name
         interaction = Interaction(env, run.agent, actuator=actuator,

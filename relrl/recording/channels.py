@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any
 
 __all__ = ["CHANNELS", "ROW_CHANNELS", "Channel", "annotations_of", "cdr_encoders",
-           "join_row", "joint_state_of", "split_row"]
+           "encode_row", "join_row", "joint_state_of", "split_row", "to_json"]
 
 _TIME = """================================================================================
 MSG: builtin_interfaces/Time
@@ -224,6 +224,32 @@ def split_row(row: dict[str, Any]) -> list[tuple[Channel, dict[str, Any]]]:
     rest.update((k, v) for k, v in row.items() if k not in _KNOWN)
     out.append((_REST, rest))
     return out
+
+
+_ENCODE = json.JSONEncoder(separators=(",", ":"), allow_nan=False, default=str).encode
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def to_json(msg: dict[str, Any]) -> bytes:
+    """A message as compact JSON bytes (non-finite numbers as ``null``: JSON has none)."""
+    try:
+        return _ENCODE(msg).encode()
+    except ValueError:
+        return _ENCODE(_finite(msg)).encode()
+
+
+def encode_row(row: dict[str, Any]) -> list[tuple[Channel, bytes]]:
+    """:func:`split_row`, each message encoded as JSON."""
+    return [(ch, to_json(msg)) for ch, msg in split_row(row)]
 
 
 def join_row(parts: list[dict[str, Any]]) -> dict[str, Any]:

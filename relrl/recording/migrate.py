@@ -29,6 +29,7 @@ from relrl.recording.channels import (
     cdr_encoders,
     joint_state_of,
     split_row,
+    to_json,
 )
 from relrl.recording.channels import JOINTS as JOINT_STATES
 
@@ -77,7 +78,6 @@ def migrate_folder(folder: str | Path) -> Path:
         UserError: not such a folder, already migrated, or a damaged file in it.
     """
     from relrl.recording.mcapfile import McapFile
-    from relrl.recording.stream import to_json
 
     folder = Path(folder)
     if not (folder / "trace.jsonl").is_file():

@@ -124,8 +124,8 @@ class McapRecording:
                     self.attachments[record.name] = record.data
                 elif isinstance(record, Footer):
                     complete = True
-        if complete:  # frames are read when shown, through the file's chunk index
-            self._jpeg.clear()
+        if complete and self._index_agrees():  # frames are read when shown, through the
+            self._jpeg.clear()                 # file's chunk index
         else:
             last = ROW_CHANNELS[-1].topic  # a unit cut in the middle of its channels
             units = {t: p for t, p in units.items() if p and last in {m["_topic"] for m in p}}
@@ -135,6 +135,20 @@ class McapRecording:
             for msg in parts:
                 del msg["_topic"]
         self.rows = [join_row(parts) for _, parts in sorted(units.items())]
+
+    def _index_agrees(self) -> bool:
+        """Whether the file's summary counts the frames this reading found (else its index
+        is not trusted, and the frames read are kept)."""
+        from mcap.reader import make_reader
+
+        try:
+            with open(self.path, "rb") as fh:
+                summary = make_reader(fh).get_summary()
+            ids = [i for i, ch in summary.channels.items() if ch.topic == IMAGE.topic]
+            counted = sum(summary.statistics.channel_message_counts.get(i, 0) for i in ids)
+        except Exception:  # noqa: BLE001 - a damaged summary: the index is not used
+            return False
+        return counted == len(self.frames)
 
     @property
     def _schema(self) -> Any:

@@ -14,46 +14,30 @@ from perception.render import SceneView, render
 from relrl.cli import main
 from relrl.monitor.frames import decode_jpeg
 from relrl.recording.reader import McapRecording
-from relrl.recording.stream import SessionStream
 from tests.monitor.conftest import episode
 
 
-class _Sink:
-    """Keeps what the stream writes."""
-
-    def __init__(self) -> None:
-        self.got: list[tuple[str, int, bytes]] = []
-
-    def write(self, channel, log_time: int, data: bytes) -> None:
-        self.got.append((channel.topic, log_time, data))
-
-    def close(self) -> None:
-        pass
-
-
 def test_frames_round_trip_through_jpeg(tmp_path: Path) -> None:
+    """A frame as the session records it: JPEG in a ROS 2 CompressedImage, decoded by
+    mcap-ros2-support, close to the frame."""
+    from mcap.records import Schema
     from mcap_ros2.decoder import DecoderFactory
 
+    from relrl.monitor.frames import encode_jpeg
     from relrl.recording.channels import IMAGE
+    from relrl.recording.encoder import Encoder
 
     frames = [render(SceneView(place, "frontal", {"left": "apple"}, 1.0, k))
               for k, place in enumerate(["centre", "left", "down", "right"])]
-    sink = _Sink()
-    stream = SessionStream([sink], quality=90)
-    for t, frame in enumerate(frames, 1):
-        stream.step({"t": t, "percepts": [], "overlay": None, "frame": t}, frame)
-    stats = stream.close()
-    stream.close()  # safe twice
-    assert stats["frames"] == 4
-    from mcap.records import Schema
-
+    encoder = Encoder()
     schema = Schema(id=1, name=IMAGE.schema, encoding="ros2msg", data=IMAGE.schema_data)
     decode = DecoderFactory().decoder_for("cdr", schema)
-    images = [decode(data) for topic, _, data in sink.got if topic == IMAGE.topic]
-    assert stats["frame_bytes"] == sum(len(m.data) for m in images)
-    for frame, msg in zip(frames, images, strict=True):
-        assert msg.format == "jpeg"
-        back = decode_jpeg(bytes(msg.data))
+    for t, frame in enumerate(frames, 1):
+        jpeg = encode_jpeg(frame, 90)
+        messages = encoder.unit(t, {"t": t, "percepts": [], "overlay": None, "frame": t}, jpeg)
+        image = [decode(data) for ch, _, data in messages if ch is IMAGE]
+        assert len(image) == 1 and image[0].format == "jpeg" and bytes(image[0].data) == jpeg
+        back = decode_jpeg(bytes(image[0].data))
         assert back.shape == frame.shape
         err = np.abs(back.astype(int) - frame.astype(int)).mean()
         psnr = 10 * np.log10(255 ** 2 / np.mean((back.astype(float) - frame) ** 2))

@@ -15,7 +15,7 @@ from websockets.exceptions import InvalidStatus
 
 from relrl.monitor.foxglove import MAX_CLIENTS, SUBPROTOCOL, FoxgloveServer
 from relrl.recording.channels import CHANNELS, IMAGE, ROW_CHANNELS, TREE
-from relrl.recording.stream import SessionStream
+from relrl.recording.encoder import Encoder
 
 
 def _row(t: int) -> dict:
@@ -33,9 +33,14 @@ async def _hello(url: str) -> tuple[object, dict, dict]:
 
 
 def test_advertise_subscribe_message() -> None:
+    encoder = Encoder()
     with FoxgloveServer("127.0.0.1:0") as server:
-        stream = SessionStream([server])
-        stream.tree(0, {"nodes": [{"id": 0, "kind": "leaf", "label": "x"}], "edges": []})
+        def send(messages: list) -> None:
+            for message in messages:
+                server.write(*message)
+
+        send(encoder.tree(time.time_ns(), {"t": 0, "graph": {
+            "nodes": [{"id": 0, "kind": "leaf", "label": "x"}], "edges": []}}))
 
         async def client() -> list:
             ws, info, adv = await _hello(f"ws://127.0.0.1:{server.port}")
@@ -56,7 +61,7 @@ def test_advertise_subscribe_message() -> None:
             deadline = time.monotonic() + 10
             while time.monotonic() < deadline and len([g for g in got if g[0] == 7]) < 5:
                 await asyncio.sleep(0.05)
-                stream.step(_row(len(got) + 1))
+                send(encoder.unit(time.time_ns(), _row(len(got) + 1)))
                 try:
                     raw = await asyncio.wait_for(ws.recv(), 0.5)
                 except TimeoutError:
@@ -68,7 +73,6 @@ def test_advertise_subscribe_message() -> None:
             return got
 
         got = asyncio.run(client())
-        stream.close()
     rewards = [m for s, _, m in got if s == 7]
     assert len(rewards) >= 5 and all(set(m) == {"t", "reward"} for m in rewards)
     trees = [m for s, _, m in got if s == 8]

@@ -131,7 +131,8 @@ def test_bad_recordings_are_one_line(recorded: Path, tmp_path: Path) -> None:
 
 def test_damage_anywhere_is_never_a_traceback(recorded: Path, tmp_path: Path) -> None:
     """Bytes flipped at ten places through the file: one line and exit 2, or (a length
-    field made to run past the end) read as cut short, with a note; never a traceback."""
+    field made to run past the end) read as cut short, with a note, or (the summary's index
+    hit) read whole from its messages; never a traceback."""
     data = (recorded / "session.mcap").read_bytes()
     for k in range(1, 11):
         bad = bytearray(data)
@@ -145,20 +146,20 @@ def test_damage_anywhere_is_never_a_traceback(recorded: Path, tmp_path: Path) ->
                              timeout=120, cwd=ROOT)
         assert "Traceback" not in out.stderr, (k, out.stderr)
         assert out.returncode in (0, 2) and len(out.stderr.strip().splitlines()) <= 1, k
-        if out.returncode == 0:
-            assert "cut short" in out.stderr
+        if out.returncode == 0:  # read as cut, or the damage was in the summary's index
+            assert "cut short" in out.stderr or "40 time units, 41 frames" in out.stdout
 
 
-def test_kill_9_leaves_a_file_readable_to_its_last_chunk(tmp_path: Path) -> None:
-    from mcap.exceptions import EndOfFile
-    from mcap.reader import NonSeekingReader
-
+def _session_killed(tmp_path: Path, name: str, writer_too: bool) -> Path:
+    """A recorded session killed with SIGKILL a few seconds in (and its writer process with
+    it, first, when ``writer_too``)."""
     script = episode(tmp_path, steps=5000)
-    out = tmp_path / "killed"
+    out = tmp_path / name
     proc = subprocess.Popen([sys.executable, "-m", "relrl", "-q", "run", str(script), "--out",
                              str(out), "--record", "--record-rate", "0", "--no-plots"],
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     path = out / "session.mcap"
+    writer = None
     try:
         deadline = time.monotonic() + 240
         while time.monotonic() < deadline:  # a few seconds of session: a few chunks
@@ -166,10 +167,34 @@ def test_kill_9_leaves_a_file_readable_to_its_last_chunk(tmp_path: Path) -> None
                 break
             time.sleep(0.2)
         time.sleep(1.5)
+        children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
+        writer = int(children[0])
+        if writer_too:
+            os.kill(writer, signal.SIGKILL)
     finally:
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(30)
     assert proc.returncode == -signal.SIGKILL
+    deadline = time.monotonic() + 30  # the writer, left alone, ends at the end of its input
+    while Path(f"/proc/{writer}").exists() and time.monotonic() < deadline:
+        try:
+            os.waitpid(writer, os.WNOHANG)
+        except ChildProcessError:
+            pass
+        if Path(f"/proc/{writer}/stat").exists() and \
+                Path(f"/proc/{writer}/stat").read_text().split()[2] == "Z":
+            break
+        time.sleep(0.1)
+    return out
+
+
+def test_kill_9_of_session_and_writer_leaves_a_file_readable_to_its_last_chunk(
+        tmp_path: Path) -> None:
+    from mcap.exceptions import EndOfFile
+    from mcap.reader import NonSeekingReader
+
+    out = _session_killed(tmp_path, "killed", writer_too=True)
+    path = out / "session.mcap"
     # the mcap library's own stream reader reads it up to where it was cut
     counts: dict[str, int] = {}
     with open(path, "rb") as fh:
@@ -190,6 +215,19 @@ def test_kill_9_leaves_a_file_readable_to_its_last_chunk(tmp_path: Path) -> None
                              "0.3"], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert replay.returncode == 0, replay.stderr
     assert "cut short" in replay.stderr
+
+
+def test_kill_9_of_the_session_leaves_a_complete_file(tmp_path: Path) -> None:
+    """The writer process sees its input end and closes the file with its summary: every
+    unit handed over is in it (the trace may hold the last few more)."""
+    out = _session_killed(tmp_path, "killed", writer_too=False)
+    with open(out / "session.mcap", "rb") as fh:
+        assert make_reader(fh).get_summary() is not None  # complete: summary and footer
+    rec = McapRecording(out / "session.mcap")
+    assert rec.cut is None
+    trace = [json.loads(x) for x in (out / "trace.jsonl").read_text().splitlines() if x]
+    assert len(trace) - 30 <= len(rec.rows) <= len(trace) and len(rec.rows) >= 5
+    assert rec.rows == trace[:len(rec.rows)]
 
 
 def _old_folder(tmp_path: Path) -> Path:
@@ -243,3 +281,36 @@ def test_migrate_an_old_folder(tmp_path: Path) -> None:
     again = subprocess.run([sys.executable, "-m", "relrl", "migrate", str(old)],
                            capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert again.returncode == 2 and "already there" in again.stderr
+
+
+def test_the_file_is_never_a_link_nor_written_over(tmp_path: Path) -> None:
+    from relrl.errors import OutputError
+    from relrl.recording.recorder import Recorder
+
+    (tmp_path / "elsewhere.txt").write_text("keep me")
+    (tmp_path / "session.mcap").symlink_to(tmp_path / "elsewhere.txt")
+    rec = Recorder()
+    try:
+        with pytest.raises(OutputError, match="already there"):
+            rec.open(tmp_path / "session.mcap")
+        rec.open(tmp_path / "other.mcap")  # the writer is still there for a good path
+        assert rec.close_file() > 0
+    finally:
+        rec.close()
+        rec.close()  # safe twice
+    assert (tmp_path / "elsewhere.txt").read_text() == "keep me"
+
+
+def test_a_writer_that_dies_is_one_line_in_the_session(tmp_path: Path) -> None:
+    from relrl.errors import OutputError
+    from relrl.recording.recorder import Recorder
+
+    rec = Recorder()
+    rec.open(tmp_path / "s.mcap")
+    rec._proc.kill()
+    rec._proc.wait()
+    with pytest.raises(OutputError, match="the recording's writer stopped"):
+        for t in range(10_000):  # the pipe breaks at the first flush
+            rec.unit(time.time_ns(), b'{"t":%d}' % t)
+    rec.close()  # reported once, when it happened; closing only cleans up
+    rec.close()
