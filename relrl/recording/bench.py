@@ -7,6 +7,8 @@ every time unit's channels are recorded, nothing else) or ``render`` (frames ren
 perceived, recorded at the default ``--record-rate``). The loop's rate is timed from inside:
 the session polls its word source once per time unit, and the bench's source notes the time.
 Pairs run back to back in alternating order; the ratio is the median of the pairs' ratios.
+The recording's encoding and writing run in a process of their own
+(:mod:`relrl.recording.child`); its CPU time is reported beside the session's.
 """
 
 from __future__ import annotations
@@ -58,16 +60,22 @@ class _Clock:
 
 
 def _once(script: Path, out: Path | None, record: bool) -> dict[str, float]:
+    import resource
+
     from relrl.episodes import RunOptions, load_episode, run_episode
 
     clock = _Clock()
     opts = RunOptions(out=out, plots=False, record=record, words=clock)
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     run_episode(load_episode(script), opts)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)  # the writer process, waited for
+    writer = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     units = clock.calls - 1
     (w0, c0, p0), (w1, c1, p1) = clock.first, clock.last
     size = (out / "session.mcap").stat().st_size if record else 0
     return {"units_per_second": units / (w1 - w0), "loop_cpu_us": 1e6 * (c1 - c0) / units,
             "process_cpu_us": 1e6 * (p1 - p0) / units, "mcap_bytes": size,
+            "writer_cpu_us": 1e6 * writer / units,
             "units": units}
 
 
@@ -82,8 +90,9 @@ def bench_recording(steps: int = 3000, *, pairs: int = 6,
 
     Returns:
         the medians of each kind, the median pair ratio (the target: at least 0.9), the
-        control thread's and the whole process's CPU time per unit, and the file's bytes per
-        time unit.
+        control thread's and the session process's CPU time per unit, the writer process's
+        (which runs beside the session, on another core when there is one), and the file's
+        bytes per time unit.
     """
     from relrl.resources import example
 
@@ -111,4 +120,6 @@ def bench_recording(steps: int = 3000, *, pairs: int = 6,
             "loop_cpu_us_record": med(recorded, "loop_cpu_us"),
             "process_cpu_us_out": med(plain, "process_cpu_us"),
             "process_cpu_us_record": med(recorded, "process_cpu_us"),
+            # the writer process's CPU over the whole run (its start-up included), per unit
+            "writer_cpu_us_record": med(recorded, "writer_cpu_us"),
             "mcap_bytes_per_unit": med(recorded, "mcap_bytes") / steps}

@@ -6,7 +6,8 @@ standard input what a time unit produced: the trace line the session wrote anywa
 frame is recorded, its JPEG -- a few microseconds of the control loop's time. The writer
 process encodes the channels, writes the MCAP file and serves Foxglove; a slower disk makes
 the loop wait (the pipe is the bound) rather than lose a time unit. One clock: the session's
-wall clock in nanoseconds, read once per time unit.
+wall clock in nanoseconds, read once per time unit. The pipe holds :data:`PIPE_BYTES`, so a
+writer that waits for a core on a busy machine does not hold the session up at once.
 
 Example::
 
@@ -39,6 +40,21 @@ __all__ = ["Recorder"]
 REPLY_SECONDS = 60.0
 #: the pipe is flushed at least this often (the live view's latency).
 FLUSH_SECONDS = 0.05
+#: room in the pipe to the writer: about 600 time units of trace lines.
+PIPE_BYTES = 1 << 20
+#: what the session buffers before a write to the pipe (fewer system calls and wake-ups).
+BUFFER_BYTES = 1 << 16
+
+
+def _widen(pipe: Any) -> None:
+    """Give the pipe :data:`PIPE_BYTES` of room where the system allows it (Linux): the
+    session goes on while the writer waits for a core on a busy machine."""
+    import fcntl
+
+    try:
+        fcntl.fcntl(pipe.fileno(), getattr(fcntl, "F_SETPIPE_SZ", 1031), PIPE_BYTES)
+    except OSError:  # above the system's limit (/proc/sys/fs/pipe-max-size): its default
+        pass
 
 
 class Recorder:
@@ -63,8 +79,10 @@ class Recorder:
             cmd += ["--foxglove", foxglove]
         self._err = tempfile.TemporaryFile()  # noqa: SIM115 - read when the writer fails
         self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                      stderr=self._err, start_new_session=True)
+                                      stderr=self._err, start_new_session=True,
+                                      bufsize=BUFFER_BYTES)
         self._pipe = self._proc.stdin
+        _widen(self._pipe)
         self._flushed = time.monotonic()
         self._reported = False
         self.path: Path | None = None
