@@ -13,10 +13,11 @@ The rules of ``--monitor``: **read-only** (no capability is offered; a client's 
 publish, parameter or service request is answered with an error status and ignored);
 **localhost by default** with the Host header checked; bound elsewhere, a token printed at
 start is required (``?token=`` in the address or ``Authorization: Bearer``); **at most**
-:data:`MAX_CLIENTS` clients; and it **never stalls the session**: the encoding thread hands
-messages over by appending to a bounded deque; the server's own thread (asyncio, the
+:data:`MAX_CLIENTS` clients; and it **never stalls the session**: messages are handed over by
+appending to a bounded deque; the server's own thread (asyncio, the
 ``websockets`` package) sends them, each client from a bounded queue of its own, so a slow
-client loses old messages instead of holding anyone up.
+client loses old messages instead of holding anyone up. The server runs in the recording's
+writer process (:mod:`relrl.recording.child`), not in the session's.
 """
 
 from __future__ import annotations
@@ -59,8 +60,8 @@ class _Client:
 
 
 class FoxgloveServer:
-    """A Foxglove WebSocket server in a daemon thread; a sink of a
-    :class:`~relrl.recording.stream.SessionStream`.
+    """A Foxglove WebSocket server in a daemon thread, fed encoded messages (it runs in the
+    recording's writer process, :mod:`relrl.recording.child`).
 
     Args:
         address: ``HOST:PORT`` (default 127.0.0.1:8765; port 0: a free one).
