@@ -34,6 +34,7 @@ SUBCOMMANDS: dict[str, str] = {
     "replay": "relrl.cli.replay",
     "migrate": "relrl.cli.migrate",
     "tree": "relrl.cli.tree",
+    "report": "relrl.cli.report",
 }
 
 
