@@ -25,6 +25,28 @@ def _row(t: int) -> dict:
             "head": None, "metrics": {}, "overlay": None}
 
 
+def _run(coro) -> object:
+    """Run a client coroutine on an event loop of its own, in a thread (the test process may
+    have a loop running in its main thread: Playwright's)."""
+    import threading
+
+    out: list = []
+
+    def target() -> None:
+        try:
+            out.append(asyncio.run(coro))
+        except BaseException as exc:  # noqa: BLE001 - raised again in the test
+            out.append(exc)
+
+    thread = threading.Thread(target=target)
+    thread.start()
+    thread.join(120)
+    assert out, "the client never finished"
+    if isinstance(out[0], BaseException):
+        raise out[0]
+    return out[0]
+
+
 async def _hello(url: str) -> tuple[object, dict, dict]:
     ws = await connect(url, subprotocols=[SUBPROTOCOL], open_timeout=10)
     info = json.loads(await ws.recv())
@@ -72,7 +94,7 @@ def test_advertise_subscribe_message() -> None:
             await ws.close()
             return got
 
-        got = asyncio.run(client())
+        got = _run(client())
     rewards = [m for s, _, m in got if s == 7]
     assert len(rewards) >= 5 and all(set(m) == {"t", "reward"} for m in rewards)
     trees = [m for s, _, m in got if s == 8]
@@ -97,7 +119,7 @@ def test_read_only_and_bad_requests_answered_with_status() -> None:
             await ws.close()
             return out
 
-        answers = asyncio.run(client())
+        answers = _run(client())
     assert all(a["op"] == "status" and a["level"] == 2 for a in answers)
     assert "read-only" in answers[0]["message"]
 
@@ -128,7 +150,7 @@ def test_host_token_and_client_bound() -> None:
             for ws, _, _ in held:
                 await ws.close()
 
-        asyncio.run(clients())
+        _run(clients())
     with FoxgloveServer("127.0.0.1:0", token="s3cret") as server:
         async def tokens() -> None:
             with pytest.raises(InvalidStatus) as err:
@@ -138,7 +160,7 @@ def test_host_token_and_client_bound() -> None:
             assert info["op"] == "serverInfo"
             await ws.close()
 
-        asyncio.run(tokens())
+        _run(tokens())
 
 
 def test_a_stalled_client_never_holds_the_writer() -> None:
@@ -152,7 +174,14 @@ def test_a_stalled_client_never_holds_the_writer() -> None:
             return ws
 
         loop = asyncio.new_event_loop()
-        _ws = loop.run_until_complete(stalled())  # its loop no longer runs: it never reads
+        import threading
+
+        held: list = []  # the connection, made on a loop that then stops running
+        connect_thread = threading.Thread(
+            target=lambda: held.append(loop.run_until_complete(stalled())))
+        connect_thread.start()
+        connect_thread.join(30)
+        assert held
         big = b"x" * 200_000
         took = 0.0
         for i in range(3000):
@@ -169,11 +198,16 @@ def test_a_stalled_client_never_holds_the_writer() -> None:
         t0 = time.perf_counter()
         server.close()  # the client still stalled: it is cut off, not waited for
         assert time.perf_counter() - t0 < 3
-    tasks = asyncio.all_tasks(loop)
-    for task in tasks:
-        task.cancel()
-    loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
-    loop.close()
+    def clean() -> None:
+        tasks = asyncio.all_tasks(loop)
+        for task in tasks:
+            task.cancel()
+        loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
+        loop.close()
+
+    cleaner = threading.Thread(target=clean)
+    cleaner.start()
+    cleaner.join(30)
 
 
 def test_bad_address_is_one_line() -> None:
@@ -234,7 +268,7 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
             await ws.close()
             return got
 
-        got = asyncio.run(client())
+        got = _run(client())
     finally:
         proc.kill()
         proc.wait(30)
