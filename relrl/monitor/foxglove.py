@@ -32,8 +32,7 @@ import time
 from collections import deque
 from typing import Any
 
-from relrl.errors import ConfigError
-from relrl.monitor.server import is_loopback, parse_address
+from relrl.monitor.server import is_loopback, listen, parse_address
 from relrl.recording.channels import CHANNELS, Channel
 
 __all__ = ["MAX_CLIENTS", "SUBPROTOCOL", "FoxgloveServer"]
@@ -111,16 +110,7 @@ class FoxgloveServer:
         Raises:
             ConfigError: the address cannot be bound.
         """
-        family = socket.AF_INET6 if ":" in self.host else socket.AF_INET
-        sock = socket.socket(family, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((self.host, self.port))
-        except (OSError, OverflowError) as exc:
-            sock.close()
-            raise ConfigError(f"Foxglove's server cannot listen on {self.host}:{self.port}: "
-                              f"{getattr(exc, 'strerror', None) or exc}") from None
-        sock.listen(MAX_CLIENTS)
+        sock = listen(self.host, self.port, "Foxglove's server", MAX_CLIENTS)
         self.port = sock.getsockname()[1]
         ready = threading.Event()
         self._thread = threading.Thread(target=self._serve, args=(sock, ready),

@@ -25,7 +25,7 @@ from typing import Any
 
 from relrl.errors import ConfigError
 
-__all__ = ["MonitorServer", "build_app", "is_loopback", "parse_address"]
+__all__ = ["MonitorServer", "build_app", "is_loopback", "listen", "parse_address"]
 
 STATIC = Path(__file__).resolve().parent / "static"
 DEFAULT_HOST = "127.0.0.1"
@@ -56,6 +56,26 @@ def parse_address(text: str | None) -> tuple[str, int]:
         raise ConfigError(f"bad monitor address {text!r}: the port must be a number in "
                           "0..65535 (use HOST:PORT, e.g. 127.0.0.1:8765)")
     return host, int(port)
+
+
+def listen(host: str, port: int, what: str, backlog: int) -> socket.socket:
+    """A TCP socket bound to ``host:port`` and listening (port 0: a free one).
+
+    Raises:
+        ConfigError: the address cannot be bound (in use, not on this machine), naming
+            ``what`` would have listened there.
+    """
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind((host, port))
+    except (OSError, OverflowError) as exc:
+        sock.close()
+        raise ConfigError(f"{what} cannot listen on {host}:{port}: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None
+    sock.listen(backlog)
+    return sock
 
 
 def is_loopback(host: str) -> bool:
@@ -268,16 +288,7 @@ class MonitorServer:
         """
         import uvicorn
 
-        family = socket.AF_INET6 if ":" in self.host else socket.AF_INET
-        sock = socket.socket(family, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((self.host, self.port))
-        except (OSError, OverflowError) as exc:
-            sock.close()
-            raise ConfigError(f"the monitor cannot listen on {self.host}:{self.port}: "
-                              f"{getattr(exc, 'strerror', None) or exc}") from None
-        sock.listen(16)
+        sock = listen(self.host, self.port, "the monitor", 16)
         self.port = sock.getsockname()[1]
         hosts = {"127.0.0.1", "localhost", "::1", self.host}
         app = build_app(self.source, token=self.token, hosts=hosts)

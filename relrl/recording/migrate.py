@@ -13,7 +13,6 @@ time unit: the units are spread evenly over the session's recorded duration
 from __future__ import annotations
 
 import datetime as _dt
-import json
 from pathlib import Path
 from typing import Any
 
@@ -36,28 +35,6 @@ from relrl.recording.channels import JOINTS as JOINT_STATES
 __all__ = ["migrate_folder"]
 
 
-def _jsonl(path: Path) -> list[dict[str, Any]]:
-    if not path.is_file():
-        return []
-    rows = []
-    for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
-        if line.strip():
-            try:
-                rows.append(json.loads(line))
-            except json.JSONDecodeError as exc:
-                raise UserError(f"{path}:{n}: not a JSON line ({exc.msg})") from None
-    return rows
-
-
-def _json(path: Path) -> dict[str, Any]:
-    if not path.is_file():
-        return {}
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise UserError(f"{path}:{exc.lineno}: not JSON ({exc.msg})") from None
-
-
 def _start_ns(manifest: dict[str, Any], folder: Path) -> int:
     stamp = manifest.get("recorded")
     if isinstance(stamp, str):
@@ -77,19 +54,15 @@ def migrate_folder(folder: str | Path) -> Path:
     Raises:
         UserError: not such a folder, already migrated, or a damaged file in it.
     """
+    from relrl.monitor.replay import Recording
     from relrl.recording.mcapfile import McapFile
 
     folder = Path(folder)
-    if not (folder / "trace.jsonl").is_file():
-        raise UserError(f"{folder}: not a session folder (no trace.jsonl)")
     target = folder / "session.mcap"
     if target.exists():
         raise UserError(f"{target}: already there; the folder needs no migration")
-    rows = _jsonl(folder / "trace.jsonl")
-    if not rows:
-        raise UserError(f"{folder}/trace.jsonl: the trace is empty")
-    frames = _jsonl(folder / "frames.jsonl")
-    manifest, summary = _json(folder / "session.json"), _json(folder / "summary.json")
+    old = Recording(folder)  # the folder's reader: its errors name the file and line
+    rows, frames, manifest, summary = old.rows, old.frames, old.manifest, old.summary
     start = _start_ns(manifest, folder)
     per_unit = int(1e9 * float(manifest.get("seconds") or len(rows) / 10) / len(rows))
     first = int(rows[0]["t"])
@@ -114,9 +87,10 @@ def migrate_folder(folder: str | Path) -> Path:
                                  cdr[JOINT_STATES.topic](joint_state_of(row["head"], ns))))
         seen = {r.get("frame"): r for r in rows if r.get("frame")}
         for index, entry in sorted(by_frame.items()):
-            path = folder / entry.get("file", f"frames/{index:06d}.jpg")
-            if not path.is_file():
-                raise UserError(f"{path}: frame {index} of frames.jsonl is missing")
+            jpeg = old.frame_bytes(index)
+            if jpeg is None:
+                raise UserError(f"{folder}/frames/{index:06d}.jpg: frame {index} of "
+                                "frames.jsonl is missing")
             ns = at(entry["t"])
             stamp = {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
             if index not in seen:  # the last frame, after the last unit
@@ -125,14 +99,14 @@ def migrate_folder(folder: str | Path) -> Path:
                      "frame_looking_at": entry.get("looking_at")})))
             messages.append((ns, len(messages), IMAGE, cdr[IMAGE.topic](
                 {"header": {"stamp": stamp, "frame_id": "camera"}, "format": "jpeg",
-                 "data": path.read_bytes()})))
+                 "data": jpeg})))
             overlay = (seen.get(index) or {}).get("overlay")
             messages.append((ns, len(messages), ANNOTATIONS,
                              to_json(annotations_of(overlay, ns))))
-        for tree in _jsonl(folder / "trees.jsonl"):
+        for tree in old.trees:
             messages.append((at(tree["t"]), len(messages), TREE,
                              to_json({"t": tree["t"], "graph": tree.get("graph")})))
-        for event in _jsonl(folder / "events.jsonl"):
+        for event in old.events:
             messages.append((at(event["t"]), len(messages), EVENTS, to_json(event)))
         for ns, _, ch, data in sorted(messages, key=lambda m: (m[0], m[1])):
             out.write(ch, ns, data)

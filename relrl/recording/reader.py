@@ -14,13 +14,13 @@ file, a damaged chunk, a message that is not what its channel says, no session i
 
 from __future__ import annotations
 
-import bisect
 import json
 import struct
 from pathlib import Path
 from typing import Any
 
 from relrl.errors import UserError
+from relrl.monitor.replay import Recording
 from relrl.recording.channels import EVENTS, IMAGE, ROW_CHANNELS, SESSION, TREE, join_row
 
 __all__ = ["MCAP_MAGIC", "McapRecording", "open_recording"]
@@ -43,8 +43,9 @@ def _json(path: Path, topic: str, data: bytes) -> dict[str, Any]:
     return msg
 
 
-class McapRecording:
-    """A session recorded as MCAP, read whole (but the frames) when opened.
+class McapRecording(Recording):
+    """A session recorded as MCAP, read whole (but the frames) when opened; answers what the
+    replay page asks as a recorded folder (:class:`~relrl.monitor.replay.Recording`) does.
 
     Args:
         path: the ``.mcap`` file.
@@ -61,7 +62,7 @@ class McapRecording:
         UserError: no such file, not an MCAP file, damaged, or no session in it.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path) -> None:  # the file is read here, not the folder
         self.path = Path(path)
         self.folder = self.path.parent
         if not self.path.is_file():
@@ -201,16 +202,6 @@ class McapRecording:
         return (self.manifest.get("necessities") or self.info.get("necessities")
                 or list(self.rows[0].get("activation", {})))
 
-    def row(self, t: int) -> dict[str, Any] | None:
-        """The trace row of time unit ``t`` (``None`` outside the session)."""
-        i = bisect.bisect_left(self._t, t)
-        return self.rows[i] if i < len(self._t) and self._t[i] == t else None
-
-    def frame_at(self, t: int) -> dict[str, Any] | None:
-        """The newest recorded frame at or before time unit ``t``."""
-        i = bisect.bisect_right(self._frame_t, t) - 1
-        return self.frames[i] if i >= 0 else None
-
     def frame_bytes(self, index: int) -> bytes | None:
         """The JPEG bytes of recorded frame ``index`` (from 1)."""
         if not 1 <= index <= len(self.frames):
@@ -234,16 +225,11 @@ class McapRecording:
         except Exception:  # noqa: BLE001 - the file changed or was damaged under the replay
             return None
 
-    def tree_at(self, t: int) -> dict[str, Any] | None:
-        """The learner's tree as it was at time unit ``t``."""
-        i = bisect.bisect_right(self._tree_t, t) - 1
-        return self.trees[i]["graph"] if i >= 0 else None
-
 
 def open_recording(path: str | Path) -> Any:
     """What ``relrl replay PATH`` reads: an ``.mcap`` file, a session folder's
-    ``session.mcap``, or -- a folder written with ``--out`` alone, or recorded by an earlier
-    relrl -- its trace (:class:`relrl.monitor.replay.Recording`).
+    ``session.mcap``, or -- a folder written with ``--out`` alone, or recorded as a folder of
+    frames by an earlier relrl -- the folder (:class:`relrl.monitor.replay.Recording`).
 
     Raises:
         UserError: nothing recorded there, or a bad file.
@@ -251,11 +237,6 @@ def open_recording(path: str | Path) -> Any:
     p = Path(path)
     if p.is_dir() and (p / "session.mcap").is_file():
         p = p / "session.mcap"
-    elif p.is_dir() and (p / "frames.jsonl").is_file():
-        raise UserError(f"{path}: a session recorded as a folder of frames by an earlier "
-                        f"relrl; convert it once with: relrl migrate {path}")
     if p.is_dir() or (not p.exists() and p.suffix.lower() != ".mcap"):
-        from relrl.monitor.replay import Recording
-
         return Recording(p)
     return McapRecording(p)

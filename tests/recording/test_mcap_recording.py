@@ -261,7 +261,14 @@ def _old_folder(tmp_path: Path) -> Path:
 
 def test_migrate_an_old_folder(tmp_path: Path) -> None:
     old = _old_folder(tmp_path)
-    assert "relrl migrate" in _replay_says(old)  # told how, not guessed
+    from perception.camera import open_camera
+    from perception.errors import CameraError
+
+    with pytest.raises(CameraError, match="relrl migrate"):  # told how, not guessed
+        open_camera(str(old))
+    replay = subprocess.run([sys.executable, "-m", "relrl", "replay", str(old), "--seconds",
+                             "0"], capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert replay.returncode == 0 and "12 time units, 4 frames" in replay.stdout  # as before
     before = {p.name: p.read_bytes() for p in old.rglob("*") if p.is_file()}
     out = subprocess.run([sys.executable, "-m", "relrl", "migrate", str(old)],
                          capture_output=True, text=True, timeout=120, cwd=ROOT)
@@ -276,6 +283,8 @@ def test_migrate_an_old_folder(tmp_path: Path) -> None:
     assert rec.events == [{"kind": "evaluation", "t": 6, "cgi_mean": 0.5}]
     assert rec.tree_at(5)["nodes"][0]["kind"] == "leaf"
     assert rec.rows[-1] and rec.manifest["episode"] == "short"
+    with open_camera(str(old)) as camera:  # now the folder's session.mcap, every frame
+        assert sum(1 for _ in camera) == 4
     t0 = rec.frames[0]["log_time"]
     assert abs(t0 / 1e9 - 1740910445.0) < 1.0  # on the session's recorded clock
     again = subprocess.run([sys.executable, "-m", "relrl", "migrate", str(old)],
