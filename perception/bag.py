@@ -163,6 +163,7 @@ class BagCamera(Camera):
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
 
+        self._decoders = DecoderFactory()  # one per bag: it keeps each schema's decoder
         self._fh.seek(0)
         reader = make_reader(self._fh, validate_crcs=True,
                              decoder_factories=[DecoderFactory()])

@@ -143,7 +143,7 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["host:port"]),
     ("perceive-not-a-bag", ["perceive", "{d}/junk.mcap"], ["junk.mcap", "not an MCAP file"]),
     ("perceive-bag-topic", ["perceive", "{d}/junk.mcap:/camera"], ["junk.mcap"]),
-    ("migrate-missing", ["migrate", "{d}/nope"], ["nope", "trace.jsonl"]),
+    ("migrate-missing", ["migrate", "{d}/nope"], ["nope", "no such folder"]),
     ("report-missing", ["report", "{d}/nope"], ["nope", "not a run folder"]),
     ("migrate-a-file", ["migrate", "{d}/afile"], ["afile"]),
     ("tree-missing", ["tree", "{d}/nope.pl", "--domain", "{fruits}"], ["nope.pl"]),
