@@ -351,8 +351,15 @@ class LiveSource:
         return svg
 
 
-def listen(host: str, port: int) -> socket.socket:
+def listen(host: str, port: int, what: str = "the monitor",
+           backlog: int | None = None) -> socket.socket:
     """A TCP socket listening on ``host:port`` (port 0: a free one).
+
+    Args:
+        host, port: the address.
+        what: who would listen there, for the message.
+        backlog: connections the kernel may hold before they are accepted (default
+            :data:`BACKLOG`).
 
     Raises:
         ConfigError: the address cannot be bound (in use, not on this machine).
@@ -364,10 +371,10 @@ def listen(host: str, port: int) -> socket.socket:
     try:
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         sock.bind((host, port))
-        sock.listen(BACKLOG)
+        sock.listen(BACKLOG if backlog is None else backlog)
     except (OSError, OverflowError) as exc:
         sock.close()
-        raise ConfigError(f"the monitor cannot listen on {host}:{port}: "
+        raise ConfigError(f"{what} cannot listen on {host}:{port}: "
                           f"{getattr(exc, 'strerror', None) or exc}") from None
     return sock
 

@@ -29,6 +29,10 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
     assert side["inferences_per_step"] > 100
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "tg_steps_per_second>=3000" in figures["targets"]
+    rec = figures["recording"]
+    assert rec["units_per_second_out"] > 0 and rec["units_per_second_record"] > 0
+    assert rec["mcap_bytes_per_unit"] > 0
+    assert "recording_units_ratio>=0.9" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
 
 
