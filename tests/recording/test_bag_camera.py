@@ -106,7 +106,9 @@ def test_session_runs_on_a_bag(tmp_path: Path) -> None:
     bag does, keeping what it learned)."""
     from tests.monitor.conftest import episode
 
-    bag = write_bag(tmp_path / "robot.mcap", scenes(40), hz=5.0)  # 8 s of camera
+    # 20 s of camera for a 20-step session: time to spare on a loaded machine (frames are
+    # played at their recorded times, so a slow step skips frames)
+    bag = write_bag(tmp_path / "robot.mcap", scenes(100), hz=5.0)
     script = episode(tmp_path, steps=20)
     out = subprocess.run([sys.executable, "-m", "relrl", "run", str(script), "--camera",
                           f"{bag}:/camera/image_raw", "--out", str(tmp_path / "out"),

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import cv2
 import jsonschema
@@ -103,7 +104,8 @@ def test_replay_an_mcap_file(recorded: Path) -> None:
 
 
 def _replay_says(path: Path) -> str:
-    out = subprocess.run([sys.executable, "-m", "relrl", "replay", str(path), "--seconds", "0"],
+    out = subprocess.run([sys.executable, "-m", "relrl", "replay", str(path),
+                          "--seconds", "0.1"],
                          capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert out.returncode == 2, out
     assert "Traceback" not in out.stderr and len(out.stderr.strip().splitlines()) == 1
@@ -142,7 +144,7 @@ def test_damage_anywhere_is_never_a_traceback(recorded: Path, tmp_path: Path) ->
         path = tmp_path / f"bad{k}.mcap"
         path.write_bytes(bytes(bad))
         out = subprocess.run([sys.executable, "-m", "relrl", "replay", str(path),
-                              "--seconds", "0"], capture_output=True, text=True,
+                              "--seconds", "0.1"], capture_output=True, text=True,
                              timeout=120, cwd=ROOT)
         assert "Traceback" not in out.stderr, (k, out.stderr)
         assert out.returncode in (0, 2) and len(out.stderr.strip().splitlines()) <= 1, k
@@ -267,7 +269,7 @@ def test_migrate_an_old_folder(tmp_path: Path) -> None:
     with pytest.raises(CameraError, match="relrl migrate"):  # told how, not guessed
         open_camera(str(old))
     replay = subprocess.run([sys.executable, "-m", "relrl", "replay", str(old), "--seconds",
-                             "0"], capture_output=True, text=True, timeout=120, cwd=ROOT)
+                             "0.1"], capture_output=True, text=True, timeout=120, cwd=ROOT)
     assert replay.returncode == 0 and "12 time units, 4 frames" in replay.stdout  # as before
     before = {p.name: p.read_bytes() for p in old.rglob("*") if p.is_file()}
     out = subprocess.run([sys.executable, "-m", "relrl", "migrate", str(old)],
@@ -323,3 +325,38 @@ def test_a_writer_that_dies_is_one_line_in_the_session(tmp_path: Path) -> None:
             rec.unit(time.time_ns(), b'{"t":%d}' % t)
     rec.close()  # reported once, when it happened; closing only cleans up
     rec.close()
+
+
+def _handmade(path: Path, rows: list[dict[str, Any]]) -> Path:
+    """An MCAP file written with the ``mcap`` library alone: one JSON message per row
+    channel and time unit (no relrl writer involved)."""
+    from mcap.writer import Writer
+
+    from relrl.recording.channels import ROW_CHANNELS
+
+    with open(path, "wb") as fh:
+        w = Writer(fh)
+        w.start()
+        ids = {}
+        for ch in ROW_CHANNELS:
+            schema = w.register_schema(ch.schema, ch.schema_encoding, ch.schema_data)
+            ids[ch.topic] = w.register_channel(ch.topic, "json", schema)
+        for i, row in enumerate(rows):
+            for ch in ROW_CHANNELS:
+                part = {"t": row["t"], **{k: row[k] for k in ch.keys if k in row}}
+                w.add_message(ids[ch.topic], log_time=i, publish_time=i, data=json.dumps(
+                    part).encode())
+        w.finish()
+    return path
+
+
+def test_an_mcap_file_is_checked_as_a_folder_is(tmp_path: Path) -> None:
+    """The replay's shapes (relrl.monitor.schema) apply to an MCAP recording's rows: a
+    wrong type is one line naming the file and the time unit, never a 500 later."""
+    good = {"t": 0, "activation": {"socialize": 0.5}, "reward": 1.0, "percepts": []}
+    assert McapRecording(_handmade(tmp_path / "ok.mcap", [good])).rows[0]["reward"] == 1.0
+    bad = _handmade(tmp_path / "bad.mcap", [good, {**good, "t": 1, "activation": "high"}])
+    said = _replay_says(bad)
+    assert "bad.mcap" in said and "time unit 1" in said and "activation" in said
+    nested = _handmade(tmp_path / "nested.mcap", [{**good, "percepts": [[[[[]]]]]}])
+    assert McapRecording(nested).rows  # lists nest as a folder's do
