@@ -370,7 +370,7 @@ check_tree(KB, Tests, TestTerm, NodeTerms, Nodes) :-
     maplist(check_node(TestsTerm, NT, N, Parents, [none|Necessities], Responses), NodeTerms,
             Nodes),
     functor(Seen, seen, N),
-    reach(ById, Seen, [0-0-0]),
+    reach([0-0-0], ById, Seen),
     (   between(1, N, I), arg(I, Seen, S), var(S)
     ->  arg(I, ById, Stray),
         Id is I - 1,
@@ -479,8 +479,8 @@ is_tests(etg_tests(_)).
 %   Walk the tree from the root, marking each node reached in Seen: Stack holds Id-Yes-No,
 %   the tests known to hold (Yes) and to fail (No) on the way to node Id, as bit masks. A
 %   leaf's representative must agree with them (a state that reaches the leaf).
-reach(_, _, []).
-reach(ById, Seen, [Id-Yes-No|Stack]) :-
+reach([], _, _).
+reach([Id-Yes-No|Stack], ById, Seen) :-
     I is Id + 1,
     arg(I, Seen, true),
     arg(I, ById, T),
@@ -491,7 +491,7 @@ reach(ById, Seen, [Id-Yes-No|Stack]) :-
         No1 is No \/ Bit,
         push(YesChild, Yes1, No, Stack, Stack1),
         push(NoChild, Yes, No1, Stack1, Stack2),
-        reach(ById, Seen, Stack2)
+        reach(Stack2, ById, Seen)
     ;   Node = leaf(Rep, _),
         (   Rep == none
         ->  true
@@ -500,7 +500,7 @@ reach(ById, Seen, [Id-Yes-No|Stack]) :-
         ;   policy_refuse(T, "leaf ~d: its state ~d does not reach it (the tests on the path \c
                               from the root disagree)", [Id, Rep])
         ),
-        reach(ById, Seen, Stack)
+        reach(Stack, ById, Seen)
     ).
 
 push(nil, _, _, Stack, Stack) :- !.
