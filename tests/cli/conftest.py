@@ -73,7 +73,22 @@ def corpus(tmp_path_factory) -> Path:
     for name, text in eps.items():
         (d / name).write_text(text)
     hostile_policies(d)
+    hostile_tomls(d)
     return d
+
+
+def hostile_tomls(d: Path) -> None:
+    """Episode scripts and calibrations nested 3,000 deep, or naming a device."""
+    from head.calibration import DEFAULT_CALIBRATION
+
+    deep = {"array": "[" * 3000 + "]" * 3000, "table": "{ a = " * 3000 + "1" + " }" * 3000}
+    cal = DEFAULT_CALIBRATION.read_text()
+    for name, nest in deep.items():
+        (d / f"deep_{name}.toml").write_text(episode_text() + f"[learner]\nx = {nest}\n")
+        (d / f"cal_deep_{name}.toml").write_text(cal + f"\n[extra]\nx = {nest}\n")
+    (d / "dev_zero.toml").symlink_to("/dev/zero")
+    (d / "cal_scripts_dev_zero.toml").write_text(
+        cal.replace("[head]\n", '[head]\nscripts = "/dev/zero"\n', 1))
 
 
 #: a hand-made ETG tree over the fruits domain's tests: {q} is the Q of the one entry.
