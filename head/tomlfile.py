@@ -19,7 +19,6 @@ import errno
 import os
 import re
 import stat
-from pathlib import Path
 
 __all__ = ["MAX_BYTES", "MAX_NESTING", "read_limited", "too_deep"]
 
