@@ -294,3 +294,16 @@ def test_a_refused_policy_is_never_saved_again(capsys, corpus):
     one_line_exit_2(capsys, ["run", str(corpus / "load_cycle.toml"), "--out", str(out)],
                     "p_cycle.pl:", "a cycle")
     assert not (out / "again.pl").exists() and not (out / "summary.json").exists()
+
+
+def test_user_clauses_piped_into_the_shell(capfd, monkeypatch):
+    """``[user].`` then clauses, piped: loaded as a file named user; a bad clause is one
+    line naming user and its line, nothing loaded, exit 2."""
+    monkeypatch.setattr(sys, "stdin", io.StringIO("[user].\nok(1).\nend_of_file.\nok(X).\n"))
+    assert main(["shell", str(FRUITS)]) == 0
+    assert capfd.readouterr().out == "true.\nX = 1.\n"
+    monkeypatch.setattr(sys, "stdin", io.StringIO("[user].\nok(1).\nbad(\n"))
+    assert main(["shell", str(FRUITS)]) == 2
+    captured = capfd.readouterr()
+    assert captured.out.startswith("error: user:2: Syntax error")
+    assert "iri_scheme" not in captured.err and "Traceback" not in captured.err
