@@ -1,9 +1,11 @@
-"""The bad-input corpus of issue 14, every subcommand: one line naming the value, exit 2.
+"""The bad-input corpus, every subcommand: one line naming the value, exit 2.
 
-Each case is ``relrl ARGV`` run in this process (an escaping exception fails the test with its
-traceback) and the words the one line must contain. ``{d}`` is the corpus folder
-(``conftest.corpus``), ``{fruits}`` the fruits domain. Outputs that must *not* be written are
-checked in ``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
+It holds 112 cases in :data:`CASES` (a test checks this count), and the tests below it for
+inputs whose answer is more than one line. Each case is ``relrl ARGV`` run in this process
+(an escaping exception fails the test with its traceback) and the words the one line must
+contain. ``{d}`` is the corpus folder (``conftest.corpus``: hostile files, policies and TOML
+included), ``{fruits}`` the fruits domain. Outputs that must *not* be written are checked in
+``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
 """
 
 from __future__ import annotations
@@ -213,6 +215,10 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
     needles = [n.format(d=corpus) for n in needles]
     one_line_exit_2(capsys, argv, *needles)
+
+
+def test_the_corpus_says_how_many_cases_it_holds():
+    assert f"It holds {len(CASES)} cases" in " ".join(__doc__.split())
 
 
 def test_every_subcommand_is_in_the_corpus():
