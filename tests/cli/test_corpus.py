@@ -1,6 +1,6 @@
 """The bad-input corpus, every subcommand: one line naming the value, exit 2.
 
-It holds 115 cases in :data:`CASES` (a test checks this count), and the tests below it for
+It holds 118 cases in :data:`CASES` (a test checks this count), and the tests below it for
 inputs whose answer is more than one line. Each case is ``relrl ARGV`` run in this process
 (an escaping exception fails the test with its traceback) and the words the one line must
 contain. ``{d}`` is the corpus folder (``conftest.corpus``: hostile files, policies and TOML
@@ -201,10 +201,6 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("head-calibration-scripts-dev-zero", ["head", "--calibration",
                                            "{d}/cal_scripts_dev_zero.toml", "status"],
      ["cal_scripts_dev_zero.toml", "head.scripts", "/dev/zero", "not a regular file"]),
-    # ---- report ----------------------------------------------------------------------------
-    ("report-missing-run", ["report", "{d}/nope"], ["nope", "not a run folder"]),
-    ("report-not-a-run", ["report", "{d}/adir"], ["adir/results.json", "no such file"]),
-    ("report-update-missing", ["report", "--update", "{d}/nope.md"], ["nope.md"]),
     # ---- demo ------------------------------------------------------------------------------
     ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
