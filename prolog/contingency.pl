@@ -15,6 +15,7 @@
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(rules).
+:- use_module(policy, [policy_refuse/3, policy_number/3]).
 
 /** <module> Contingency learning
 
@@ -227,27 +228,63 @@ relrl_engine:learner_save(contingency, KB, S) :-
 
 relrl_engine:learner_policy_term(contingency, learned_behaviour(_, _, _, _)).
 
-%   Rebuild the rules from policy terms read as data. A learned rule's antecedent is
-%   state(Code); any other antecedent must be one the domain itself authored (a policy file
-%   never brings a goal of its own to run).
+%   Rebuild the rules from policy terms read as data, checked as a whole before anything
+%   changes. A learned rule's antecedent is state(Code), Code a state of the domain's
+%   features; any other antecedent must be one the domain itself authored (a policy file
+%   never brings a goal of its own to run). Responses and necessities (or none) are the
+%   domain's, a fitness is a finite number >= 0, and no rule is given twice.
 relrl_engine:learner_restore(contingency, KB, Terms) :-
-    findall(behaviour(A, R, N, F), member(learned_behaviour(A, R, N, F), Terms), Rules),
-    maplist(check_rule(KB), Rules),
+    engine_config(KB, features, Features),
+    length(Features, NF),
+    engine_config(KB, responses, Responses),
+    engine_config(KB, necessities, Necessities),
+    include(is_rule_term, Terms, RuleTerms),       % the terms read, not copies
+    maplist(check_rule(KB, NF, Responses, [none|Necessities]), RuleTerms),
+    include(is_learned_rule, RuleTerms, Learned),
+    map_list_to_pairs(rule_key, Learned, Keyed),
+    msort(Keyed, Sorted),
+    (   append(_, [K-_, K-Twice|_], Sorted)
+    ->  policy_refuse(Twice, "this learned rule is given twice (its fitness would count \c
+                             twice)", [])
+    ;   true
+    ),
+    findall(behaviour(A, R, N, F), member(learned_behaviour(A, R, N, F), RuleTerms), Rules),
     contingency_restore(KB, Rules).
 
-check_rule(KB, behaviour(A, R, N, F)) :-
+is_rule_term(learned_behaviour(_, _, _, _)).
+
+is_learned_rule(learned_behaviour(state(_), _, _, _)).
+
+rule_key(learned_behaviour(A, R, N, _), rule(A, R, N)).
+
+check_rule(KB, NF, Responses, Necessities, T) :-
+    T = learned_behaviour(A, R, N, F),
     (   A = state(Code)
-    ->  must_be(nonneg, Code)
+    ->  (   integer(Code), Code >= 0, Code < 1 << NF
+        ->  true
+        ;   policy_refuse(T, "~q is not a state of this domain (its ~d features give codes \c
+                              0 to 2^~d - 1)", [A, NF, NF])
+        )
     ;   behaviour_rule(KB, A0, R0, N0, _), A0 =@= A, R0 =@= R, N0 =@= N
     ->  true
-    ;   domain_error(authored_behaviour_rule, behaviour(A, R, N))
+    ;   policy_refuse(T, "~q is neither state(Code) nor the antecedent of one of the \c
+                          domain's behaviour rules for ~q (a policy brings no goal of its \c
+                          own)", [A, R])
     ),
-    (   kb_response(KB, R0), R0 =@= R
+    (   member(R1, Responses), R1 =@= R
     ->  true
-    ;   domain_error(response, R)
+    ;   policy_refuse(T, "~q is not a response of this domain", [R])
     ),
-    must_be(atom, N),
-    must_be(number, F).
+    (   member(N1, Necessities), N1 == N
+    ->  true
+    ;   policy_refuse(T, "~q is not a necessity of this domain (nor none)", [N])
+    ),
+    policy_number(T, "the fitness", F),
+    (   F >= 0
+    ->  true
+    ;   policy_refuse(T, "the fitness ~q is negative (a fitness is a slice of the \c
+                          roulette wheel, >= 0)", [F])
+    ).
 
 relrl_engine:learner_snapshot(contingency, KB, matched(Matches)) :-
     (   matched_(KB, Matches0)
