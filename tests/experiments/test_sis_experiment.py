@@ -160,3 +160,26 @@ def test_claims_judged_on_a_summary() -> None:
     claims = paper_claims(paperlike)
     assert [c["held"] for c in claims.values()] == [False, False, True]
     assert claims["later"]["values"]["cgi_final"]["contingency"] == 0.97
+
+
+@pytest.mark.parametrize("preset", [None, "paper-2012"])
+def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_path: Path,
+                                                     capsys, monkeypatch) -> None:
+    import relrl.experiments.main as experiments_main
+    from relrl.learners import LEARNERS
+
+    ran = []
+
+    def fake_run_sis(config, out, **kwargs):   # the banner is the test, not the run
+        ran.append(config)
+        return {"summary": {}}, []
+
+    monkeypatch.setattr(experiments_main, "run_sis", fake_run_sis)
+    args = ["demo", "--out", str(tmp_path / "d")] + (["--preset", preset] if preset else [])
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert f"{len(LEARNERS)} learners ({', '.join(LEARNERS)})" in out
+    assert f"setting: {ran[0].setting()}" in out
+    assert ran[0].preset == preset
+    assert ("setting: preset paper-2012" in out) == (preset == "paper-2012")
+    assert ("setting: the fixed task" in out) == (preset is None)
