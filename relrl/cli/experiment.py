@@ -303,7 +303,7 @@ def run(args: argparse.Namespace) -> int:
                                           engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
     print(summary_table(results["summary"]))
-    if any(c["held"] is not None for c in results["claims"].values()):
+    if any(c["held"] is not None for c in results.get("claims", {}).values()):
         print("\nthe paper's claims (docs/experiment1.md):")
         print(claims_table(results["claims"]))
     return _finish(results, files, out.path)
