@@ -20,6 +20,7 @@
             engine_config/3,          % +KB, ?Key, ?Value
             engine_learner/2,         % +KB, -Learner
             engine_responses/2,       % +KB, -Responses
+            engine_all_allowed/2,     % +KB, +Allowed
             engine_necessities/2,     % +KB, -Necessities
             engine_holds/2,           % +KB, +Goal
             engine_relational_state/2 % +KB, -Facts
@@ -246,6 +247,18 @@ engine_config(KB, Key, Value) :-
 
 engine_responses(KB, Responses) :-
     run(KB, run(_, _, _, Responses, _, _, _, _, _)).
+
+%!  engine_all_allowed(+KB, +Allowed:list) is semidet.
+%
+%   Allowed, the allowed responses a learner hook was given, is the engine's own list of
+%   every response of KB (no constraint rule forbids one this step): a test in constant
+%   time (the same term), for a learner that need not look at the responses one by one
+%   then. Fails when it is not, or when KB has no engine.
+
+engine_all_allowed(KB, Allowed) :-
+    engine_key(KB, Key),
+    nb_current(Key, engine(run(_, _, _, Responses, _, _, _, _, _), _, _)),
+    Responses == Allowed.
 
 %!  engine_necessities(+KB, -Necessities:list) is det.
 %

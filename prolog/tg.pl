@@ -18,6 +18,7 @@
 :- use_module(tg_bias).
 :- use_module(tg_stats).
 :- use_module(tg_tree).
+:- use_module(tg_classes).
 :- reexport(tg_knowledge).
 
 /** <module> TG: a first-order incremental regression-tree Q-learner
@@ -82,6 +83,7 @@ tg_init(KB, Params) :-
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
+    tg_response_index(Bias, Responses, Index),
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
@@ -91,7 +93,7 @@ tg_init(KB, Params) :-
     atom_concat('$tg:', KB, DK),
     Half is max(0, round(Half0)),
     nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                       novelty(Beta, Conf)), Leaves0, none, 0, 0)),
+                       novelty(Beta, Conf)), Leaves0, none, 0, 0, Index)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -125,14 +127,16 @@ tg_q(KB, Facts, Action, N, Q) :-
 
 %!  tg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
-%   Action is one of the Allowed responses. With Mode learn or explore: with temperature
-%   T > 0, drawn with probability proportional to exp(Q / T) (Boltzmann exploration);
-%   with T = 0, a random one with probability epsilon and otherwise a greedy one. With
-%   Mode greedy, one with the largest Q. Ties are broken at random. While learning (Mode
-%   learn), the Q of a leaf that no example has reached for the last K examples inserted
-%   in the tree counts as Q + stale_bonus * sqrt(K): a part of the Q-function that went
-%   stale while the rest moved is tried again (the exploration bonus of Sutton's Dyna-Q+,
-%   here per leaf).
+%   Action is one of the Allowed responses, chosen over the *classes* of responses no test
+%   of the language bias tells apart in the state Facts (tg_classes.pl): each class is
+%   scored by one representative, a class is chosen, and a member of it uniformly. With
+%   Mode learn or explore: with temperature T > 0, a class is drawn with probability
+%   proportional to exp(Q / T) (Boltzmann exploration); with T = 0, a random class with
+%   probability epsilon and otherwise a greedy one. With Mode greedy, one with the largest
+%   Q. Ties are broken at random. While learning (Mode learn), the Q of a leaf that no
+%   example has reached for the last K examples inserted in the tree counts as Q +
+%   stale_bonus * sqrt(K): a part of the Q-function that went stale while the rest moved is
+%   tried again (the exploration bonus of Sutton's Dyna-Q+, here per leaf).
 %
 %   Directed exploration (novelty_bonus Beta > 0, Mode learn): Q(s, a) counts as
 %   Q + tg_bonus/5, an upper confidence bound (UCB, optimism in the face of uncertainty)
@@ -150,28 +154,43 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     tg_data(KB, D),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf)), Leaves, Cache,
-           Version, Clock),
+           Version, Clock, Index),
+    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version), F1 == Facts, N1 == N,
+        A1 == Allowed
+    ->  Classes = Classes0, Ids = Ids0
+    ;   classes(KB, Index, Facts, Allowed, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  random_member(Action, Allowed)
-    ;   (   Cache = last(F1, N1, A1, Ids, Version), F1 == Facts, N1 == N, A1 == Allowed
-        ->  true
-        ;   maplist(sorted_leaf(KB, Facts, N), Allowed, Ids)
-        ),
-        (   Mode == learn, Beta > 0
-        ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)), Allowed,
-                    Ids, Qs)
+    ->  random_member(Class, Classes)
+    ;   (   Mode == learn, Beta > 0
+        ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)),
+                    Classes, Ids, Qs)
         ;   Mode == learn, Kappa > 0
         ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
         ;   maplist(leaf_q(Leaves), Ids, Qs)
         ),
         max_list(Qs, Best),
         (   Mode \== greedy, Tau > 0
-        ->  softmax_member(Qs, Allowed, Best, Tau, Action)
-        ;   ties(Qs, Allowed, Best, Ties),
-            random_member(Action, Ties)
+        ->  softmax_member(Qs, Classes, Best, Tau, Class)
+        ;   ties(Qs, Classes, Best, Ties),
+            random_member(Class, Ties)
         )
+    ),
+    tg_class_member(Index, Class, Action).
+
+%   The classes of the Allowed responses in the state Facts; when no constraint rule
+%   forbids a response (Allowed is the engine's own list of every response) they come from
+%   the index without a pass over the responses.
+classes(KB, Index, Facts, Allowed, Classes) :-
+    (   engine_all_allowed(KB, Allowed)
+    ->  tg_classes(Index, Facts, Allowed, true, Classes)
+    ;   tg_classes(Index, Facts, Allowed, false, Classes)
     ).
+
+class_leaf(KB, Facts, N, cls(A, _), Leaf) :-
+    tg_sort_(KB, Facts, A, N, Leaf).
 
 leaf_q(Leaves, Id, Q) :-
     arg(Id, Leaves, L),
@@ -183,7 +202,7 @@ bonus_q(Leaves, Kappa, Clock, Id, Q) :-
     arg(7, L, Last),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
 
-novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), A, Id, Q) :-
+novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), cls(A, _), Id, Q) :-
     arg(Id, Leaves, L),
     arg(1, L, Q0),
     arg(7, L, Last),
@@ -196,7 +215,7 @@ novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), A, Id, Q) :-
 %   (tg_choose/6; 0 when novelty_bonus is 0).
 
 tg_bonus(KB, Facts, A, N, Bonus) :-
-    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf)), Leaves, _, _, Clock)),
+    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf)), Leaves, _, _, Clock, _)),
     (   Beta > 0
     ->  tg_sort_(KB, Facts, A, N, Id),
         arg(Id, Leaves, L),
@@ -268,24 +287,24 @@ pick([W|Ws], [A|As], X, Action) :-
 %
 %   Learn from transition(S0, A0, N0, Reward, Reinforced, S1, N1, Allowed1): insert the
 %   example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the responses
-%   Allowed1 (over every response when none is allowed).
+%   Allowed1 (over every response when none is allowed). The max is taken over one
+%   representative of each class of responses (tg_classes.pl): the members of a class have
+%   the same Q.
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _), Leaves, _, Version, _),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _), Leaves, _, Version, _, Index),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
-    maplist(sorted_leaf(KB, S1, N1), Next, Ids),
+    classes(KB, Index, S1, Next, Classes),
+    maplist(class_leaf(KB, S1, N1), Classes, Ids),
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    nb_setarg(3, D, last(S1, N1, Allowed1, Ids, Version)),
+    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version)),
     insert(KB, D, S0, A0, N0, Target).
-
-sorted_leaf(KB, Facts, N, A, Leaf) :-
-    tg_sort_(KB, Facts, A, N, Leaf).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
@@ -299,7 +318,7 @@ tg_insert(KB, Facts, A, N, Target) :-
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _), Leaves, _, _, Clock0),
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
     tg_sort_(KB, Facts, A, N, Leaf),

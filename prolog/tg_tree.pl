@@ -91,7 +91,7 @@ tg_put_tree(KB, Tree) :-
 %   Stats is the live l/8 term of leaf LeafId (above).
 
 tg_leaf(KB, Id, L) :-
-    tg_data(KB, tg(_, Leaves, _, _, _)),
+    tg_data(KB, tg(_, Leaves, _, _, _, _)),
     arg(Id, Leaves, L).
 
 %!  tg_empty_leaves(+Capacity, -Leaves) is det.

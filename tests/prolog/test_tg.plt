@@ -294,7 +294,7 @@ test(forgetting_rescales, [true(abs(Today - Expected) < 1.0e-9)]) :-
 
 today_weight(KB, Today) :-
     relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base)),
-    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _), _, _, _, Clock)),
+    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _), _, _, _, Clock, _)),
     Today is M / 2 ** ((Clock - Base) / H).
 
 test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-
