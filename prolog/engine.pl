@@ -56,6 +56,7 @@ touches its own file and one line of learners.pl.
 
   | learner(Name)                                   | registers Name                         |
   | learner_property(Name, external)                | Python chooses (Q-learning over numpy) |
+  | learner_property(Name, view(relational))        | reads the relational view only: no state code is computed for it (a step reports code 0) |
   | learner_init(Name, KB, Params)                  | start afresh                           |
   | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
   | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
@@ -116,7 +117,9 @@ gateway can name the rule.
 %   so one KB never sees another's), holding engine(Run, Prev, Random):
 %     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
 %               Necessities, Plan) — fixed for a run, read without copying; Plan is the
-%               state code's plan (relrl_state:state_plan/4)
+%               state code's plan (relrl_state:state_plan/4), or relational(Plan) for a
+%               learner that reads the relational view only (the plan then only tells
+%               whether a reinforcer is sensed)
 %     Prev    prev(State, Necessity) of the last step, or none
 %     Random  the KB's random state, while the generator does not hold it (see
 %             random_owner/1: while it does, the generator's state is the KB's)
@@ -292,12 +295,14 @@ engine_configure(KB, Learner, Params, Seed) :-
     state_mark(StateMark),                            % once this one is in place
     motivation_units(KB, Units0),
     motivation_compiled(KB, Units0, Units),
-    state_plan(KB, Features, Reinforcers, Plan),
+    state_plan(KB, Features, Reinforcers, Plan0),
+    (   learner_property(Learner, view(relational))
+    ->  Plan = relational(Plan0)
+    ;   Plan = Plan0
+    ),
     (   has_constraints(KB)
     ->  Constraints = true
-    ;   findall(I, nth0(I, Responses, _), AllIx),     % no constraint rules: all allowed,
-        foldl(set_bit, AllIx, 0, AllMask),            % always (computed once)
-        Constraints = none(AllIx, AllMask)
+    ;   Constraints = none                            % no constraint rules: all allowed
     ),
     fresh_random(Seed, Random),
     engine_key(KB, Key),
@@ -391,9 +396,11 @@ engine_forget(KB) :-
 %   explain (the learner's explanation for this step's state).
 %
 %   Out = step(Code, Necessity, Ys, Reward, Reinforced, Allowed, Action, Extras): the state
-%   code, the active necessity (or none), the necessity units' outputs (a list in
+%   code (0 for a learner with learner_property(L, view(relational)), which never reads
+%   it), the active necessity (or none), the necessity units' outputs (a list in
 %   declaration order), the reward for the previous response, true/false, the allowed
-%   responses as a bit mask (bit i set when response i is allowed), the index of the
+%   responses as a bit mask (bit i set when response i is allowed; -1 when every response
+%   is, as always in a domain without constraint rules), the index of the
 %   learner's choice (-1 for a learner outside Prolog, or when nothing is allowed), and
 %   Extras, a list of Key-Value pairs for Want.
 
@@ -413,7 +420,7 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
         wm_insert(KB, [emitted(Emitted)|Percepts])
     ;   wm_insert(KB, Percepts)
     ),
-    plan_code(KB, Plan, Code, Reinforced),
+    view_code(KB, Plan, Code, Reinforced),
     learner_view(Learner, KB, Code, State),
     motivation_values(KB, Units, _, Ys, Active),
     (   Reinforced == true
@@ -437,6 +444,15 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
     ),
     extras(Want, KB, Learner, State, Active, Extras).
 
+%   The state code and whether a reinforcer is sensed; for a learner that reads the
+%   relational view only, no code (0): the engine does not compute what no one reads.
+view_code(KB, Plan, Code, Reinforced) :-
+    (   Plan = relational(Plan0)
+    ->  Code = 0,
+        plan_reinforced(KB, Plan0, Reinforced)
+    ;   plan_code(KB, Plan, Code, Reinforced)
+    ).
+
 learner_view(Learner, KB, Code, State) :-
     (   learner_state(Learner, KB, Code, State0)
     ->  State = State0
@@ -456,10 +472,12 @@ extra(KB, Learner, State, N, explain, [explain-E|T], T) :- !,
 extra(_, _, _, _, What, _, _) :-
     domain_error(step_report, What).
 
+%   Mask is -1 when every response is allowed (no constraint rules): a world with many
+%   responses does not pay for a mask of as many bits every step.
 allowed(KB, Constraints, Responses, Allowed, Mask) :-
-    (   Constraints = none(_, AllMask)
+    (   Constraints == none
     ->  Allowed = Responses,
-        Mask = AllMask
+        Mask = -1
     ;   allowed_(Responses, KB, 0, Allowed, 0, Mask)
     ).
 
@@ -473,9 +491,6 @@ allowed_([R|Rs], KB, I, Allowed, Mask0, Mask) :-
     ),
     I1 is I + 1,
     allowed_(Rs, KB, I1, Allowed1, Mask1, Mask).
-
-set_bit(I, M0, M) :-
-    M is M0 \/ (1 << I).
 
 forbidden(KB, R) :-
     engine_holds(KB, forbidden(R)).
@@ -513,7 +528,7 @@ engine_explain(KB, When, Explanation) :-
     (   When == last,
         engine(KB, engine(_, prev(State, N), _))
     ->  true
-    ;   plan_code(KB, Plan, Code),
+    ;   view_code(KB, Plan, Code, _),
         learner_view(Learner, KB, Code, State),
         motivation_peek(KB, Units, _, N)
     ),

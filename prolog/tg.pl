@@ -531,6 +531,8 @@ tg_candidates(KB, LeafId, Texts) :-
 
 relrl_engine:learner(tg).
 
+relrl_engine:learner_property(tg, view(relational)).
+
 relrl_engine:learner_init(tg, KB, Params) :-
     tg_init(KB, Params).
 
