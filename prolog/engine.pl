@@ -18,6 +18,7 @@
             engine_param/3,           % +KB, ?Name, ?Value
             engine_params/2,          % +KB, -Params
             engine_config/3,          % +KB, ?Key, ?Value
+            engine_policy_info/2,     % +KB, -Info
             engine_learner/2,         % +KB, -Learner
             engine_responses/2,       % +KB, -Responses
             engine_all_allowed/2,     % +KB, +Allowed
@@ -66,6 +67,7 @@ touches its own file and one line of learners.pl.
   | learner_save(Name, KB, Stream)                  | write the learned knowledge as clauses |
   | learner_policy_term(Name, Term)                 | Term may appear in Name's policy file  |
   | learner_restore(Name, KB, Terms)                | rebuild from policy terms (data)       |
+  | learner_policy_info(Name, KB, Info)             | optional: what a policy is tied to in the domain (default: its features and responses) |
   | learner_text(Name, KB, Text)                    | optional: the knowledge as text        |
   | learner_graph(Name, KB, graph(Nodes, Edges))    | optional: a tree as a graph            |
   | learner_knowledge(Name, KB, Terms)              | optional: the knowledge as terms       |
@@ -106,6 +108,7 @@ gateway can name the rule.
     learner_save/3,
     learner_policy_term/2,
     learner_restore/3,
+    learner_policy_info/3,
     learner_text/3,
     learner_graph/3,
     learner_knowledge/3,
@@ -637,30 +640,48 @@ engine_resume(KB, Slot) :-
 slot_key(KB, Slot, Key) :-
     atomic_list_concat(['$relrl_snap:', KB, ':', Slot], Key).
 
+%!  engine_policy_info(+KB, -Info:list) is det.
+%
+%   What a policy of KB's learner is tied to in the domain, Key(Value) terms written in the
+%   policy's header (engine_save/3) and compared with the loaded domain's when a policy is
+%   read (policy.pl): the learner's learner_policy_info/3 (a relational learner: its
+%   relations and language bias, the same in every world of a family, so its policy loads
+%   in any of them), else [features(Features), responses(Responses)]. Each Key(Value) has
+%   one argument.
+
+engine_policy_info(KB, Info) :-
+    run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
+    (   learner_policy_info(Learner, KB, Info0)
+    ->  Info = Info0
+    ;   Info = [features(Features), responses(Responses)]
+    ).
+
 %!  engine_save(+KB, +File, +Header:string) is det.
 %
-%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with the
-%   domain's features and responses, then the learner's own clauses. Plain swipl consults
+%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with what
+%   the policy is tied to in the domain (engine_policy_info/2), then the learner's own
+%   clauses. Plain swipl consults
 %   the file; relrl reads it back as data (policy.pl). The file is written next to File
 %   and renamed into place, so a reader never sees half a policy.
 
 engine_save(KB, File, Header) :-
-    run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
+    engine_learner(KB, Learner),
+    engine_policy_info(KB, Info),
     atom_concat(File, '.tmp', Tmp),
     setup_call_cleanup(
         open(Tmp, write, S, [encoding(utf8)]),
-        write_policy(S, KB, Learner, Features, Responses, Header),
+        write_policy(S, KB, Learner, Info, Header),
         close(S)),
     rename_file(Tmp, File).
 
-write_policy(S, KB, Learner, Features, Responses, Header) :-
+write_policy(S, KB, Learner, Info, Header) :-
     split_string(Header, "\n", "", Lines),
     forall(member(L, Lines), format(S, "% ~w~n", [L])),
     format(S, "% Consult in plain swipl, or load with: relrl shell DOMAIN.pl --policy FILE~n",
            []),
     format(S, "% relrl reads this file as data: a directive or a foreign clause is refused.~n~n",
            []),
-    portray_clause(S, relrl_policy(Learner, [features(Features), responses(Responses)])),
+    portray_clause(S, relrl_policy(Learner, Info)),
     nl(S),
     (   learner_save(Learner, KB, S)
     ->  true

@@ -7,7 +7,8 @@
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
             tg_size/2,            % +KB, -Size
-            tg_candidates/3       % +KB, ?LeafId, -Texts
+            tg_candidates/3,      % +KB, ?LeafId, -Texts
+            tg_policy_info/2      % +KB, -Info
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -515,6 +516,18 @@ tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
     tree_counts(Y, T1-L0-C0, Mid),
     tree_counts(N, Mid, Out).
 
+%!  tg_policy_info(+KB, -Info:list) is det.
+%
+%   What a tg policy is tied to in the domain: [relations(Templates), rmodes(Modes),
+%   rconsts(Consts)], the relational view's templates and the language bias (tg_bias/2). A bias of typed
+%   variables names no place, toy or colour of the world, so these are the same in every
+%   world of a family (the generated worlds of the scaling benchmark, whatever their size)
+%   and a policy learned in one loads in any other.
+
+tg_policy_info(KB, [relations(Templates), rmodes(Modes), rconsts(Consts)]) :-
+    findall(T, declared(KB, relation(T)), Templates),
+    tg_get_tree(KB, tree(_, _, bias(Modes, Consts), _)).
+
 %!  tg_candidates(+KB, ?LeafId, -Texts:list) is nondet.
 %
 %   Texts are the candidate tests of leaf LeafId, written with their variables named.
@@ -553,6 +566,9 @@ relrl_engine:learner_size(tg, KB, Size) :-
 
 relrl_engine:learner_save(tg, KB, Stream) :-
     tg_save(KB, Stream).
+
+relrl_engine:learner_policy_info(tg, KB, Info) :-
+    tg_policy_info(KB, Info).
 
 relrl_engine:learner_policy_term(tg, Term) :-
     tg_policy_term(Term).

@@ -37,8 +37,10 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
 
     out = Path(out_dir)
     (out / "domains").mkdir(parents=True, exist_ok=True)
-    for size in sorted(set(config.sizes) | set(config.transfer_sizes
-                                              if config.transfer != "none" else [])):
+    transfer_sizes = (set(config.transfer_sizes) | {config.transfer_from}
+                      if config.transfer == "sizes" else set(config.transfer_sizes)
+                      if config.transfer != "none" else set())
+    for size in sorted(set(config.sizes) | transfer_sizes):
         config.world_of(size).write_domain(out / "domains")
     tasks = [(config, *job) for job in config.jobs()]
     points = config.budget // config.block + 1
@@ -183,15 +185,19 @@ def plot(out: Path, results: dict[str, Any]) -> list[Path]:
               _ordered(summary["transfer"], config["learners"]) for size, row in rows]
     if groups:
         xs = range(len(groups))
+        trained = {"places": "trained places", "kinds": "trained kinds",
+                   "sizes": f"P={config.get('transfer_from')}, where it learned"}
         ax.bar([x - 0.2 for x in xs], [g[2]["cgi_trained"] or 0 for g in groups], 0.4,
-               label="trained places" if config["transfer"] == "places" else "trained kinds")
+               label=trained.get(config["transfer"], "trained"))
         ax.bar([x + 0.2 for x in xs], [g[2]["cgi_unseen"] or 0 for g in groups], 0.4,
                label="unseen (zero-shot)")
         ax.set_xticks(list(xs))
         ax.set_xticklabels([f"{lr}\nP={s}" for lr, s, _ in groups], fontsize=8)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("CGI (no learning)")
-    ax.set_title(f"Zero-shot transfer ({config['transfer']} held out)")
+    ax.set_title("Zero-shot transfer to other world sizes (no learning)"
+                 if config["transfer"] == "sizes" else
+                 f"Zero-shot transfer ({config['transfer']} held out)")
     ax.legend()
     ax.grid(alpha=0.3, axis="y")
     save(fig, "transfer.png")
@@ -241,6 +247,12 @@ def scaling_table(results: dict[str, Any], timing: dict[str, Any] | None = None)
                 + ("  (partial)" if r["partial"] else ""))
     for learner, rows in _ordered(results["summary"]["transfer"], learners):
         for size, r in rows:
+            if "from" in r:         # cross-size transfer
+                unseen = ("not loaded" if r["cgi_unseen"] is None else
+                          f"{r['cgi_unseen']:.2f} (lowest seed {r['cgi_unseen_min']:.2f})")
+                lines.append(f"transfer {learner:<12} P={r['from']} -> P={size:<3} learned at "
+                             f"{r['cgi_trained'] or 0:.2f}  here {unseen}")
+                continue
             lines.append(f"transfer {learner:<12} P={size:<3} trained {r['cgi_trained'] or 0:.2f}"
                          f"  unseen {r['cgi_unseen'] or 0:.2f}")
     return "\n".join(lines)
