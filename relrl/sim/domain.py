@@ -116,7 +116,7 @@ def domain_text(world: World) -> str:
 def _relational(world: World) -> str:
     """The relational view and language bias sections (the syntax of docs/tg.md)."""
     lay = world.layout
-    colours, kinds = world.colour_names, world.kind_names
+    kinds = world.kind_names
     lines = [_section("The relational view (learner tg)"), "",
              "% What the robot perceives now, as relations over agents, places, toys, colours "
              "and words.", "relation(sees(_Thing)).", "relation(gaze(_Who, _Place)).",
