@@ -495,25 +495,27 @@ put_leaf(D, Id, L) :-
 %
 %   Size is size(Positions, Details). Positions = nodes + entries in the paper's sense: every
 %   node (test or leaf) and every stored Q value (one per leaf). Details:
-%   [nodes=, tests=, leaves=, entries=, candidates=, statistics=]; statistics counts the
-%   numbers kept only to decide splits: count, sum and sum of squares for each leaf and for
-%   each candidate of each leaf.
+%   [nodes=, tests=, leaves=, entries=, candidates=, candidates_max=, statistics=];
+%   candidates counts the candidate tests of every leaf, candidates_max those of the leaf
+%   with most; statistics counts the numbers kept only to decide splits: count, sum and sum
+%   of squares for each leaf and for each candidate of each leaf.
 
 tg_size(KB, size(Positions, [nodes=Nodes, tests=Tests, leaves=Leaves, entries=Leaves,
-                             candidates=Cands, statistics=Stats])) :-
+                             candidates=Cands, candidates_max=Max, statistics=Stats])) :-
     tg_get_tree(KB, tree(Root, _, _, _)),
-    tree_counts(Root, 0-0-0, Tests-Leaves-Cands),
+    tree_counts(Root, c(0, 0, 0, 0), c(Tests, Leaves, Cands, Max)),
     Nodes is Tests + Leaves,
     Positions is Nodes + Leaves,
     Stats is 3 * (Leaves + Cands).
 
-tree_counts(leaf(_, _, _, Cs), T-L0-C0, T-L-C) :-
+tree_counts(leaf(_, _, _, Cs), c(T, L0, C0, M0), c(T, L, C, M)) :-
     L is L0 + 1,
     length(Cs, K),
-    C is C0 + K.
-tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
+    C is C0 + K,
+    M is max(M0, K).
+tree_counts(node(_, _, _, Y, N), c(T0, L0, C0, M0), Out) :-
     T1 is T0 + 1,
-    tree_counts(Y, T1-L0-C0, Mid),
+    tree_counts(Y, c(T1, L0, C0, M0), Mid),
     tree_counts(N, Mid, Out).
 
 %!  tg_policy_info(+KB, -Info:list) is det.

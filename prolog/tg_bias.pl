@@ -6,6 +6,7 @@
             conj_goal/6,          % +Literals, +Facts, +Action, +Necessity, +Bound, -Goal
             literal_holds/4,      % +Literal, +Facts, +Action, +Necessity
             bias_problem/2,       % +KB, -Problem
+            bias_warning/2,       % +KB, -Warning
             name_variables/2,     % +Vars, -Names
             conj_text/3           % +Literals, +Names, -Text
           ]).
@@ -326,6 +327,49 @@ mode_problem(KB, M, Msg) :-
         \+ ( declared(KB, rmode(M2)), mode_type(M2, -, T) )
     ->  format(string(Msg), "rmode ~w: +~q can never be bound (no rmode introduces a \c
                              variable of type ~q with -~q)", [MT, T, T, T])
+    ).
+
+%!  bias_warning(+KB, -Warning) is nondet.
+%
+%   Warning is problem(File, Line, Message) for a #T type whose constants grow with the
+%   world: more than 10 of them, or one for each of at least three responses (rconst(place,
+%   P) for every look(P)). Every #T literal is one candidate test per constant in every
+%   leaf, so such a bias makes the learner's work grow with the world, and a test on one
+%   ground place says nothing about the others. File and Line are those of the first rmode
+%   that uses #T. A domain with such a bias is valid; relrl check prints the warning.
+
+bias_warning(KB, problem(File, Line, Msg)) :-
+    findall(T, ( declared(KB, rmode(M)), mode_type(M, #, T), T \== necessity ), Ts0),
+    sort(Ts0, Ts),
+    member(T, Ts),
+    findall(C, declared(KB, rconst(T, C)), Cs0),
+    sort(Cs0, Cs),
+    length(Cs, K),
+    findall(C, ( member(C, Cs), once(( kb_response(KB, R), response_argument(R, C) )) ),
+            Used),
+    length(Used, U),
+    (   U >= 3
+    ->  Used = [E1, E2|_],
+        format(string(Msg), "rconst type ~q has a constant for each of ~d responses' \c
+               arguments (~q, ~q, ...): its #~q tests grow with the world (one candidate \c
+               per constant in every leaf); use +~q/-~q variables and keep as constants \c
+               only the few the task distinguishes, as a type of their own",
+               [T, U, E1, E2, T, T, T])
+    ;   K > 10
+    ->  format(string(Msg), "rconst type ~q has ~d constants: every #~q literal is one \c
+               candidate test per constant in every leaf; if they grow with the world, use \c
+               +~q/-~q variables", [T, K, T, T, T])
+    ),
+    once(( declaration(KB, rmode(M), Ref), mode_type(M, #, T) )),
+    clause_where(Ref, File, Line).
+
+response_argument(R, C) :-
+    compound(R),
+    R =.. [_|Args],
+    member(A, Args),
+    (   A == C
+    ->  true
+    ;   response_argument(A, C)
     ).
 
 %   A mode written with relrl's operators (#agent, not #(agent)).

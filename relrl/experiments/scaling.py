@@ -184,7 +184,7 @@ def run_scaling_job(config: ScalingConfig, learner: str, size: int, seed: int,
             "learning_steps": session.learned,
             "cgi_final": curve[-1]["cgi_mean"],
             "cgi_literal_final": curve[-1]["cgi_literal_mean"],
-            "memory": session.memory(), "states_met": len(session.learning_states),
+            "memory": session.memory(), "states_met": session.states_met(),
             "learning": session.learning_summary(),
         }
         if kind == "transfer" and config.transfer == "sizes":
@@ -270,6 +270,14 @@ def summarize(jobs: list[dict[str, Any]], config: ScalingConfig) -> dict[str, An
                        "cgi_final": mean([j["cgi_final"] for j in mine]),
                        "cgi_literal_final": mean([j["cgi_literal_final"] for j in mine]),
                        "memory_positions": mean([j["memory"]["positions"] for j in mine]),
+                       # a relational learner's candidate tests per leaf (None for others)
+                       "candidates_per_leaf": mean([j["memory"]["candidates"]
+                                                    / j["memory"]["leaves"] for j in mine
+                                                    if "candidates" in j["memory"]
+                                                    and j["memory"].get("leaves")]),
+                       "candidates_max": max((j["memory"]["candidates_max"] for j in mine
+                                              if "candidates_max" in j["memory"]),
+                                             default=None),
                        "states_met": mean([j["states_met"] for j in mine]),
                        "learning_steps": mean([j["learning_steps"] for j in mine]),
                        "partial": any(j.get("partial", False) for j in mine)}

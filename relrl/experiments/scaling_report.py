@@ -103,7 +103,8 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
         files.append(path)
 
     keys = ["seeds", "reached", "steps_to_threshold", "steps_to_threshold_max", "cgi_final",
-            "cgi_literal_final", "memory_positions", "states_met", "learning_steps"]
+            "cgi_literal_final", "memory_positions", "candidates_per_leaf", "candidates_max",
+            "states_met", "learning_steps"]
     table("scaling.csv", ["learner", "size", *keys],
           [[lr, int(size), *(row[k] for k in keys)]
            for lr, rows in _ordered(summary["learn"], learners) for size, row in rows])
@@ -233,7 +234,7 @@ def scaling_table(results: dict[str, Any], timing: dict[str, Any] | None = None)
             speed.setdefault((t["learner"], t["size"]), []).append(
                 t["learning_steps_per_second"])
     lines = [f"{'learner':<12} {'P':>3} {'reached':>7} {'to 0.9':>8} {'CGI':>6} "
-             f"{'literal':>7} {'memory':>8} {'steps/s':>8}"]
+             f"{'literal':>7} {'memory':>8} {'cand/leaf':>9} {'steps/s':>8}"]
     learners = results["config"]["learners"]
     for learner, rows in _ordered(results["summary"]["learn"], learners):
         for size, r in rows:
@@ -243,7 +244,9 @@ def scaling_table(results: dict[str, Any], timing: dict[str, Any] | None = None)
                 f"{learner:<12} {size:>3} {r['reached']:>3}/{r['seeds']:<3} "
                 f"{'never' if to is None else f'{to:,.0f}':>8} {r['cgi_final']:>6.2f} "
                 f"{r['cgi_literal_final']:>7.2f} {r['memory_positions']:>8,.0f} "
-                f"{sum(sp) / len(sp) if sp else float('nan'):>8,.0f}"
+                + (f"{r['candidates_per_leaf']:>9.1f} " if r.get("candidates_per_leaf")
+                   is not None else f"{'-':>9} ")
+                + f"{sum(sp) / len(sp) if sp else float('nan'):>8,.0f}"
                 + ("  (partial)" if r["partial"] else ""))
     for learner, rows in _ordered(results["summary"]["transfer"], learners):
         for size, r in rows:
