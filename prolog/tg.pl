@@ -79,8 +79,10 @@ tg_init(KB, Params) :-
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
                             min_examples, stale_bonus, half_life, novelty_bonus,
-                            novelty_confidence],
-            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf]),
+                            novelty_confidence, keep_examples],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf,
+             Keep0]),
+    Keep is max(0, round(Keep0)),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
@@ -88,13 +90,13 @@ tg_init(KB, Params) :-
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
-    tg_new_stats(Qinit, 0, K, 0, L),
+    tg_new_stats(Qinit, 0, K, 0, Keep, L),
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
     Half is max(0, round(Half0)),
     nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                       novelty(Beta, Conf)), Leaves0, none, 0, 0, Index)),
+                       novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -154,7 +156,7 @@ tg_q(KB, Facts, Action, N, Q) :-
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     tg_data(KB, D),
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf)), Leaves, Cache,
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
            Version, Clock, Index),
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version), F1 == Facts, N1 == N,
         A1 == Allowed
@@ -216,7 +218,8 @@ novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), cls(A, _), Id, 
 %   (tg_choose/6; 0 when novelty_bonus is 0).
 
 tg_bonus(KB, Facts, A, N, Bonus) :-
-    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf)), Leaves, _, _, Clock, _)),
+    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf), _), Leaves, _, _, Clock,
+                   _)),
     (   Beta > 0
     ->  tg_sort_(KB, Facts, A, N, Id),
         arg(Id, Leaves, L),
@@ -230,7 +233,7 @@ tg_bonus(KB, Facts, A, N, Bonus) :-
 %   its upper confidence bound is Mean + Conf * sqrt(Var / n), capped at Beta, and Beta
 %   when n < 2. The bonus is the largest bound, and 0 when all are below 0.
 novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus) :-
-    L = l(_, _, M, S, SS, C, _, Base),
+    L = l(_, _, M, S, SS, C, _, Base, _),
     (   Half =:= 0
     ->  W = 1
     ;   W is 2 ** ((Clock - Base) / Half)       % stored units / W = today's weights
@@ -294,7 +297,7 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _), Leaves, _, Version, _, Index),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, _, Version, _, Index),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
@@ -319,12 +322,12 @@ tg_insert(KB, Facts, A, N, Target) :-
     insert(KB, D, Facts, A, N, Target).
 
 insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _), Leaves, _, _, Clock0, _),
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
     tg_sort_(KB, Facts, A, N, Leaf),
     arg(Leaf, Leaves, L),
-    L = l(Q0, N0, _, _, _, C, _, _),
+    L = l(Q0, N0, _, _, _, C, _, _, Ring),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
     nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
@@ -337,6 +340,7 @@ insert(KB, D, Facts, A, N, Target) :-
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
     tg_cands_(KB, Leaf, Facts, A, N, Hits),
     count_hits(Hits, C, W, E),
+    keep_example(Ring, ex(Facts, A, N, E, Clock)),
     (   N1 /\ 3 =:= 0,                              % every fourth example
         MinW is MinEx * W,                          % min_examples in stored units
         M >= 2 * MinW,
@@ -349,8 +353,9 @@ insert(KB, D, Facts, A, N, Target) :-
         Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
         f_significant(FStat, Dof, Corrected)
     ->  M2t is Mt - M1t,
-        QYes is Q + S1 / M1, QNo is Q + (S - S1) / (M - M1),
-        split(KB, D, Leaf, I, s(M1t, QYes), s(M2t, QNo))
+        DYes is S1 / M1, DNo is (S - S1) / (M - M1),  % the sides' mean TD errors
+        QYes is Q + DYes, QNo is Q + DNo,
+        split(KB, D, Leaf, I, s(M1t, QYes, DYes), s(M2t, QNo, DNo))
     ;   true
     ).
 
@@ -375,6 +380,18 @@ weight(L, Half, Clock, W) :-
             W = 1.0
         ;   W is 2 ** E
         )
+    ).
+
+%   The leaf's last Keep examples, in a ring (one slot written in place).
+keep_example(Ring, Ex) :-
+    functor(Ring, _, Arity),
+    (   Arity =:= 1
+    ->  true
+    ;   arg(1, Ring, Next),
+        Slot is Next + 1,
+        nb_setarg(Slot, Ring, Ex),
+        Next1 is Next mod (Arity - 1) + 1,
+        nb_setarg(1, Ring, Next1)
     ).
 
 rescale(L, Scale) :-
@@ -427,9 +444,14 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
 % ---- splitting -----------------------------------------------------------------------------
 
 %   Split leaf LeafId on its candidate I; the children start from their partitions:
-%   s(Weight, Q) each (today's weights; Q the leaf's estimate plus the mean TD error on
-%   that side).
-split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
+%   s(Weight, Q, MeanTDError) each (today's weights; Q the leaf's estimate plus the mean TD
+%   error on that side). Their statistics start from the leaf's kept examples (its ring):
+%   each is sorted to its side and counted in the child's own sums and in those of the
+%   child's candidates that succeed on it, with its TD error less the side's mean (the
+%   child's Q has taken that in) and its weight of today. The rest of what the leaf
+%   counted cannot be sorted (it kept only sums), so a child's statistics cover at most
+%   the kept examples.
+split(KB, D, LeafId, I, s(M1, QYes, DYes), s(M2, QNo, DNo)) :-
     tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
     replace_leaf(Root0, LeafId, Leaf, Node, Root),
@@ -445,9 +467,12 @@ split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     Node = node(LeafId, Lits, New, Yes, No),
     length(YesCands, KY), length(NoCands, KN),
     arg(5, D, Clock),
+    arg(1, D, Params), arg(8, Params, Half), arg(10, Params, Keep),
     NYes is max(1, round(M1)), NNo is max(1, round(M2)),
-    tg_new_stats(QYes, NYes, KY, Clock, LYes),
-    tg_new_stats(QNo, NNo, KN, Clock, LNo),
+    tg_new_stats(QYes, NYes, KY, Clock, Keep, LYes),
+    tg_new_stats(QNo, NNo, KN, Clock, Keep, LNo),
+    arg(2, D, Leaves0), arg(LeafId, Leaves0, L0), arg(9, L0, Ring0),
+    kept_sides(KB, LeafId, I, Ring0, YesEx, NoEx),
     put_leaf(D, LeafId, free),
     put_leaf(D, YesId, LYes),
     put_leaf(D, NoId, LNo),
@@ -458,7 +483,40 @@ split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     tg_forget_leaf(KB, LeafId),
     tg_compile_leaf(KB, Yes),
     tg_compile_leaf(KB, No),
-    tg_compile_tree(KB, Root).
+    tg_compile_tree(KB, Root),
+    arg(2, D, Leaves),                  % the live leaf terms (put_leaf/3 copied them)
+    arg(YesId, Leaves, LYes1), arg(NoId, Leaves, LNo1),
+    replay(YesEx, KB, YesId, LYes1, DYes, Half, Clock),
+    replay(NoEx, KB, NoId, LNo1, DNo, Half, Clock).
+
+%   The leaf's kept examples on the yes-side (candidate I succeeds) and on the no-side.
+kept_sides(KB, LeafId, I, Ring, YesEx, NoEx) :-
+    Ring =.. [ring, _|Slots],
+    exclude(==(none), Slots, Kept),
+    partition(on_yes_side(KB, LeafId, I), Kept, YesEx, NoEx).
+
+on_yes_side(KB, LeafId, I, ex(Facts, A, N, _, _)) :-
+    once(tg_cands_(KB, LeafId, Facts, A, N, Hits)),
+    memberchk(I, Hits).
+
+%   Count the kept examples Exs in the new leaf Id (l/9 term L, sums in units of Clock's
+%   weight, so an example of time T weighs 2^((T - Clock) / Half)) and keep them there.
+replay([], _, _, _, _, _, _).
+replay([ex(Facts, A, N, E0, T)|Exs], KB, Id, L, Shift, Half, Clock) :-
+    E is E0 - Shift,
+    (   Half =:= 0
+    ->  W = 1.0
+    ;   W is 2 ** ((T - Clock) / Half)
+    ),
+    arg(3, L, M0), arg(4, L, S0), arg(5, L, SS0),
+    M is M0 + W, S is S0 + W * E, SS is SS0 + W * E * E,
+    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
+    arg(6, L, C),
+    once(tg_cands_(KB, Id, Facts, A, N, Hits)),
+    count_hits(Hits, C, W, E),
+    arg(9, L, Ring),
+    keep_example(Ring, ex(Facts, A, N, E, T)),
+    replay(Exs, KB, Id, L, Shift, Half, Clock).
 
 %   The no-branch of a test never needs the test again.
 same_cand(Lits, cand(Lits1, _)) :-

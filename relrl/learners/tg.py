@@ -46,7 +46,7 @@ class TGLearner(Learner):
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "temperature": 1.0,
                 "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
                 "stale_bonus": 1.0, "half_life": 1000.0, "novelty_bonus": 20.0,
-                "novelty_confidence": 2.0}
+                "novelty_confidence": 2.0, "keep_examples": 32.0}
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -56,6 +56,9 @@ class TGLearner(Learner):
         if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
             raise ConfigError(f"min_examples must be a whole number >= 3, not "
                               f"{p['min_examples']}")
+        if p["keep_examples"] < 0 or p["keep_examples"] != int(p["keep_examples"]):
+            raise ConfigError(f"keep_examples must be a whole number >= 0, not "
+                              f"{p['keep_examples']}")
         for key in ("temperature", "stale_bonus", "half_life", "novelty_bonus"):
             if p[key] < 0:
                 raise ConfigError(f"{key} must be >= 0, not {p[key]}")
