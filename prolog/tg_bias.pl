@@ -7,6 +7,8 @@
             literal_holds/4,      % +Literal, +Facts, +Action, +Necessity
             bias_problem/2,       % +KB, -Problem
             bias_warning/2,       % +KB, -Warning
+            bias_constants/2,     % +Bias, -Constants
+            term_constant/2,      % +Term, ?Constant
             name_variables/2,     % +Vars, -Names
             conj_text/3           % +Literals, +Names, -Text
           ]).
@@ -345,8 +347,7 @@ bias_warning(KB, problem(File, Line, Msg)) :-
     findall(C, declared(KB, rconst(T, C)), Cs0),
     sort(Cs0, Cs),
     length(Cs, K),
-    findall(C, ( member(C, Cs), once(( kb_response(KB, R), response_argument(R, C) )) ),
-            Used),
+    findall(C, ( member(C, Cs), once(( kb_response(KB, R), term_constant(R, C) )) ), Used),
     length(Used, U),
     (   U >= 3
     ->  Used = [E1, E2|_],
@@ -363,13 +364,39 @@ bias_warning(KB, problem(File, Line, Msg)) :-
     once(( declaration(KB, rmode(M), Ref), mode_type(M, #, T) )),
     clause_where(Ref, File, Line).
 
-response_argument(R, C) :-
-    compound(R),
-    R =.. [_|Args],
+%!  bias_constants(+Bias, -Constants:list) is det.
+%
+%   Constants are the constants Bias (tg_bias/2) names: those of rconst/2 and of the
+%   necessities, and every atomic argument written in an rmode template. A test sees no
+%   other constant of the world than these and those of the example's state.
+
+bias_constants(bias(Modes, Consts), All) :-
+    findall(C, ( member(_-Cs, Consts), member(C, Cs), atomic(C) ), C1),
+    findall(C, ( member(M, Modes), template_constant(M, C) ), C2),
+    append(C1, C2, All).
+
+template_constant(M, C) :-
+    compound(M),
+    \+ mode_spec(M),
+    M =.. [_|Args],
     member(A, Args),
-    (   A == C
-    ->  true
-    ;   response_argument(A, C)
+    (   atomic(A)
+    ->  C = A
+    ;   template_constant(A, C)
+    ).
+
+%!  term_constant(+Term, ?Constant) is nondet.
+%
+%   Constant is an atomic argument of Term, at any depth (not its principal functor):
+%   left_3 of look(left_3), of gaze(face, left_3).
+
+term_constant(T, C) :-
+    compound(T),
+    T =.. [_|Args],
+    member(X, Args),
+    (   atomic(X)
+    ->  C = X
+    ;   term_constant(X, C)
     ).
 
 %   A mode written with relrl's operators (#agent, not #(agent)).

@@ -11,6 +11,7 @@
 :- use_module(library(pairs)).
 :- use_module(library(assoc)).
 :- use_module(library(random)).
+:- use_module(tg_bias, [bias_constants/2, term_constant/2]).
 
 /** <module> Classes of responses the TG learner cannot tell apart
 
@@ -62,7 +63,7 @@ tg_response_index(Bias, Responses, rindex(Rs, Known, Groups, GroupOf, Atoms)) :-
     functor(GroupOf, go, N),
     foldl(fill_group(GroupOf), GroupLists, GroupTerms, 1, _),
     Groups =.. [g|GroupTerms],
-    findall(A-I, ( nth1(I, Responses, R), response_atom(R, A),
+    findall(A-I, ( nth1(I, Responses, R), term_constant(R, A),
                    \+ get_assoc(A, Known, _) ), AIs0),
     sort(AIs0, AIs),
     group_pairs_by_key(AIs, ByAtom),
@@ -89,37 +90,6 @@ group_in_order(Pairs, Groups) :-
               findall(I, ( member(S2-I, Pairs), S2 =@= Sig0 ), Is) ),
             Keyed),
     findall(Is, member(_-(_-Is), Keyed), Groups).
-
-%   The constants the bias names: those of rconst/2 and of the necessities (Consts of
-%   bias(Modes, Consts)) and every atomic argument written in an rmode template.
-bias_constants(bias(Modes, Consts), All) :-
-    findall(C, ( member(_-Cs, Consts), member(C, Cs), atomic(C) ), C1),
-    findall(C, ( member(M, Modes), template_constant(M, C) ), C2),
-    append(C1, C2, All).
-
-template_constant(M, C) :-
-    compound(M),
-    \+ mode_spec(M),
-    M =.. [_|Args],
-    member(A, Args),
-    (   atomic(A)
-    ->  C = A
-    ;   template_constant(A, C)
-    ).
-
-mode_spec(+(_)).
-mode_spec(-(_)).
-mode_spec(#(_)).
-
-%   A constant at an argument position of response R (at any depth).
-response_atom(R, A) :-
-    compound(R),
-    R =.. [_|Args],
-    member(X, Args),
-    (   atomic(X)
-    ->  A = X
-    ;   response_atom(X, A)
-    ).
 
 %!  tg_signature(+Response, +Known, -Signature) is det.
 %
@@ -183,7 +153,7 @@ tg_classes(rindex(Rs, Known, Groups, GroupOf, Atoms), Facts, Allowed, All, Class
 
 %   The constants of the state the bias does not name, sorted.
 state_atoms(Facts, Known, Atoms) :-
-    findall(A, ( member(F, Facts), response_atom(F, A), \+ get_assoc(A, Known, _) ), As),
+    findall(A, ( member(F, Facts), term_constant(F, A), \+ get_assoc(A, Known, _) ), As),
     sort(As, Atoms).
 
 %   The positions of the responses a constant of the state occurs in, sorted.
