@@ -49,8 +49,11 @@ drift the leaf's own Q follows is not in the TD errors, so a split answers "is t
 estimate wrong on one side of this test?" rather than "were the targets on that side from
 another time?".
 
-Q(s, a) for each allowed response comes from sorting (s, a) down the tree; each step one
-example with Q-target r + gamma * max_a' Q(s', a') is inserted (no table of examples).
+Q(s, a) comes from sorting (s, a) down the tree. Choices and Q-targets are over classes of
+responses that no test of the bias tells apart in the state (tg_classes.pl), each scored by
+one representative: their number does not grow with the world. Each step one example with
+Q-target r + gamma * max_a' Q(s', a') is inserted; no table of examples is kept, only each
+leaf's last keep_examples examples, so that the children of a split start with statistics.
 
 The learner's state and the compiled tree are kept by tg_tree.pl; explanations, drawings,
 rules and policy files are tg_knowledge.pl's (re-exported here).
@@ -64,8 +67,8 @@ live in a global term per knowledge base and are updated in place (nb_setarg/3).
 Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise the rate
 is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
 epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus,
-half_life, novelty_bonus and novelty_confidence (see tg_choose/6); the engine's
-reward_positive and reward_negative.
+half_life, novelty_bonus and novelty_confidence (see tg_choose/6), keep_examples; the
+engine's reward_positive and reward_negative.
 */
 
 % ---- starting ------------------------------------------------------------------------------

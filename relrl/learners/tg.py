@@ -2,8 +2,10 @@
 
 In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001): one regression tree over
 (relational state, action, necessity) examples whose tests are conjunctions of literals
-from the domain's language bias (``rmode/1``), split by an F-test on incremental statistics
-of the Q-targets. See docs/tg.md.
+from the domain's language bias (``rmode/1``: typed variables, constants only where the
+task needs them), split by an F-test on incremental statistics of the TD errors; choices
+and Q-targets over classes of responses the bias cannot tell apart, so its work and memory
+do not grow with the world. See docs/tg.md.
 """
 
 from __future__ import annotations
@@ -37,8 +39,11 @@ class TGLearner(Learner):
     novelty_confidence standard errors, of the regions (s, a) falls in — its leaf and the
     yes-side of each candidate test of the leaf that succeeds on it — capped at
     novelty_bonus, which is also the bound of a region fewer than two examples reached;
-    novelty_bonus 0 turns it off). Explore and greedy choices and the Q-targets never
-    include the bonuses.
+    novelty_bonus 0 turns it off), keep_examples (each leaf keeps its last examples so
+    that a split's children start with statistics; 0: they start empty). Explore and greedy
+    choices and the Q-targets never include the bonuses. Choices are over classes of
+    responses no test of the bias tells apart in the state (scored by one representative,
+    uniform within a class).
     """
 
     name = "tg"
