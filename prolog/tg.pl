@@ -21,6 +21,7 @@
 :- use_module(tg_tree).
 :- use_module(tg_classes).
 :- reexport(tg_knowledge).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> TG: a first-order incremental regression-tree Q-learner
 
@@ -161,7 +162,7 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     tg_data(KB, D),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
            Version, Clock, Index),
-    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version), F1 == Facts, N1 == N,
+    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
     ;   classes(KB, Index, Facts, Allowed, Classes),
@@ -169,22 +170,45 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  random_member(Class, Classes)
+    ->  random_member(Class, Classes),
+        Noted = none
     ;   (   Mode == learn, Beta > 0
         ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)),
-                    Classes, Ids, Qs)
+                    Classes, Ids, Qs, Items)
         ;   Mode == learn, Kappa > 0
-        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
-        ;   maplist(leaf_q(Leaves), Ids, Qs)
+        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs),
+            Items = Classes
+        ;   maplist(leaf_q(Leaves), Ids, Qs),
+            Items = Classes
         ),
         max_list(Qs, Best),
         (   Mode \== greedy, Tau > 0
-        ->  softmax_member(Qs, Classes, Best, Tau, Class)
-        ;   ties(Qs, Classes, Best, Ties),
-            random_member(Class, Ties)
+        ->  softmax_member(Qs, Items, Best, Tau, Item)
+        ;   ties(Qs, Items, Best, Ties),
+            random_member(Item, Ties)
+        ),
+        (   Item = hits(Class, Leaf, Hits)
+        ->  Noted = chose(Action, Leaf, Hits)
+        ;   Class = Item,
+            Noted = none
         )
     ),
-    tg_class_member(Index, Class, Action).
+    tg_class_member(Index, Class, Action),
+    (   Noted == none
+    ->  true
+    ;   note_choice(Cache, Facts, N, Version, Noted)
+    ).
+
+%   The chosen action with the leaf and candidate hits of its class, found for its bonus,
+%   noted in the cache the update of this step made (Cache, for the same state and tree):
+%   the next update inserts this step's example — if the action emitted is the one chosen —
+%   which sorts to that leaf and succeeds on those candidates (every member of a class
+%   does), without testing them again.
+note_choice(Cache, Facts, N, Version, Noted) :-
+    (   Cache = last(F1, N1, _, _, _, Version, _), F1 == Facts, N1 == N
+    ->  nb_setarg(7, Cache, Noted)
+    ;   true
+    ).
 
 %   The classes of the Allowed responses in the state Facts; when no constraint rule
 %   forbids a response (Allowed is the engine's own list of every response) they come from
@@ -208,11 +232,13 @@ bonus_q(Leaves, Kappa, Clock, Id, Q) :-
     arg(7, L, Last),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
 
-novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), cls(A, _), Id, Q) :-
+novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), Class, Id, Q,
+        hits(Class, Id, Hits)) :-
+    Class = cls(A, _),
     arg(Id, Leaves, L),
     arg(1, L, Q0),
     arg(7, L, Last),
-    novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus),
+    novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Hits, Bonus),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)) + Bonus.
 
 %!  tg_bonus(+KB, +Facts, +Action, +Necessity, -Bonus:number) is det.
@@ -226,7 +252,7 @@ tg_bonus(KB, Facts, A, N, Bonus) :-
     (   Beta > 0
     ->  tg_sort_(KB, Facts, A, N, Id),
         arg(Id, Leaves, L),
-        novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus)
+        novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), _, Bonus)
     ;   Bonus = 0
     ).
 
@@ -234,8 +260,9 @@ tg_bonus(KB, Facts, A, N, Bonus) :-
 %   yes-side of every candidate test that succeeds on it. For each, the counts, sums and
 %   sums of squares the leaf keeps give n (today's weights), Mean and Var of its TD errors;
 %   its upper confidence bound is Mean + Conf * sqrt(Var / n), capped at Beta, and Beta
-%   when n < 2. The bonus is the largest bound, and 0 when all are below 0.
-novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus) :-
+%   when n < 2. The bonus is the largest bound, and 0 when all are below 0. Hits are the
+%   candidates that succeed on the example.
+novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Hits, Bonus) :-
     L = l(_, _, M, S, SS, C, _, Base, _),
     (   Half =:= 0
     ->  W = 1
@@ -300,7 +327,12 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, _, Version, _, Index),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, Cache0, Version, _, Index),
+    (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
+        M0 == N0, B0 == A0
+    ->  Known = sorted(Leaf0, Hits0)            % the choice sorted this example already
+    ;   Known = none
+    ),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
@@ -310,8 +342,8 @@ tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version)),
-    insert(KB, D, S0, A0, N0, Target).
+    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none)),
+    insert(KB, D, S0, A0, N0, Known, Target).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
@@ -322,13 +354,19 @@ tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
 
 tg_insert(KB, Facts, A, N, Target) :-
     tg_data(KB, D),
-    insert(KB, D, Facts, A, N, Target).
+    insert(KB, D, Facts, A, N, none, Target).
 
-insert(KB, D, Facts, A, N, Target) :-
+%   Known is sorted(Leaf, Hits) when the choice of this example's action found its leaf and
+%   candidate hits (note_choice/5), else none.
+insert(KB, D, Facts, A, N, Known, Target) :-
     D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
-    tg_sort_(KB, Facts, A, N, Leaf),
+    (   Known = sorted(Leaf, Hits)
+    ->  true
+    ;   tg_sort_(KB, Facts, A, N, Leaf),
+        tg_cands_(KB, Leaf, Facts, A, N, Hits)
+    ),
     arg(Leaf, Leaves, L),
     L = l(Q0, N0, _, _, _, C, _, _, Ring),
     N1 is N0 + 1,
@@ -341,7 +379,6 @@ insert(KB, D, Facts, A, N, Target) :-
     S is S0 + W * E,
     SS is SS0 + W * E * E,
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
-    tg_cands_(KB, Leaf, Facts, A, N, Hits),
     count_hits(Hits, C, W, E),
     keep_example(Ring, ex(Facts, A, N, E, Clock)),
     (   N1 /\ 3 =:= 0,                              % every fourth example

@@ -53,10 +53,13 @@ explains, draws, saves and restores them.
 %                  numbers are updated with nb_setarg/3. Params = p(Alpha, Gamma, Epsilon,
 %                  Tau, Level, MinExamples, Kappa, HalfLife, novelty(Beta, Confidence),
 %                  Keep) (Kappa the stale bonus, Beta the novelty bonus). Cache =
-%                  last(Facts, N, Allowed, Classes, LeafIds, Version): the classes of the
-%                  next state's allowed responses (tg_classes.pl) and their leaves, found by
-%                  the last update and reused by the choice that follows in the same step
-%                  while the tree is unchanged (Version). Index is the response index
+%                  last(Facts, N, Allowed, Classes, LeafIds, Version, Chose): the classes
+%                  of the next state's allowed responses (tg_classes.pl) and their leaves,
+%                  found by the last update and reused by the choice that follows in the
+%                  same step while the tree is unchanged (Version); Chose is
+%                  chose(Action, Leaf, Hits) once that choice has found the chosen class's
+%                  leaf and candidate hits (reused by the next update's insertion), or
+%                  none. Index is the response index
 %                  (tg_classes:tg_response_index/3).
 
 %!  tg_data(+KB, -Data) is det.
