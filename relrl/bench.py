@@ -8,6 +8,8 @@
   called directly and through the gateway's time-limited call;
 * the simulator's own step rate;
 * ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
+* a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
+  (relrl.recording.bench; skipped without the ``mcap`` extra);
 * the perception pipeline's frames per second (perception.bench), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
@@ -124,6 +126,12 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     from relrl.monitor.bench import bench_monitor
 
     out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
+    try:  # a session's time units/s recording MCAP / with the trace alone
+        from relrl.recording.bench import bench_recording
+
+        out["recording"] = bench_recording(min(steps, 3000), pairs=6 if steps >= 1000 else 2)
+    except ImportError as exc:  # pragma: no cover - the mcap extra missing
+        out["recording"] = {"skipped": str(exc)}
     if perception:
         try:
             import perception as perception_pkg
@@ -141,6 +149,8 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
         "tg_step_P129<=1.5x_P5": out["tg_step_by_size"]["ratio"]["129"] <= 1.5,
         "monitor_steps_ratio>=0.9": out["monitor"]["ratio"] >= 0.9,
     }
+    if "ratio" in out["recording"]:
+        out["targets"]["recording_units_ratio>=0.9"] = out["recording"]["ratio"] >= 0.9
     photos = out.get("perception", {}).get("fps_photos_320x240_cold")
     if photos is not None:  # issue 13: real photos, full search, one OpenCV thread
         out["targets"]["perception_photos_320x240_fps>=60"] = photos >= 60

@@ -37,6 +37,10 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
     assert set(by_size["sizes"]) == {"5", "129"} and by_size["ratio"]["5"] == 1.0
     assert by_size["ratio"]["129"] > 0 and by_size["sizes"]["129"]["positions"] > 0
     assert "tg_step_P129<=1.5x_P5" in figures["targets"]
+    rec = figures["recording"]
+    assert rec["units_per_second_out"] > 0 and rec["units_per_second_record"] > 0
+    assert rec["mcap_bytes_per_unit"] > 0
+    assert "recording_units_ratio>=0.9" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
 
 
