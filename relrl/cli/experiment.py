@@ -134,10 +134,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     sc.add_argument("--threshold", type=float, default=0.9, help="the CGI to reach (0.9)")
     sc.add_argument("--patience", type=int, default=2, help="stop after this many "
                     "evaluations at or above the threshold (0: learn the whole budget)")
-    sc.add_argument("--transfer", choices=["places", "kinds", "none"], default="places",
-                    help="hold out places (default), toy kinds, or no transfer jobs")
+    sc.add_argument("--transfer", choices=["places", "kinds", "sizes", "none"],
+                    default="places",
+                    help="hold out places (default) or toy kinds; sizes: learn at "
+                         "--transfer-from places, then act with no learning in the worlds of "
+                         "--transfer-sizes; none: no transfer jobs")
     sc.add_argument("--transfer-sizes", default=None,
-                    help="sizes with transfer jobs (default: all; --quick: 5,9)")
+                    help="sizes with transfer jobs, or with --transfer sizes the worlds the "
+                         "policy is evaluated in (default: all; --quick: 5,9)")
+    sc.add_argument("--transfer-from", type=int, default=5,
+                    help="with --transfer sizes: the world size learned in (default 5)")
     sc.add_argument("--holdout", type=float, default=0.4,
                     help="share of places (or kinds) held out (default 0.4)")
     add_out_options(sc, default="runs/scaling",
@@ -267,6 +273,17 @@ def build_scaling_config(args: argparse.Namespace):
     if math.isnan(args.holdout) or not 0 < args.holdout < 1:
         raise ConfigError(f"--holdout must be between 0 and 1, not {args.holdout}")
     config.holdout = args.holdout
+    if config.transfer == "sizes":
+        from relrl.errors import UserError
+
+        for flag, size in [("--transfer-from", args.transfer_from),
+                           *(("--transfer-sizes", s) for s in config.transfer_sizes)]:
+            try:
+                config.world_of(size).caregiver_params(config.caregiver_params,
+                                                       config.caregiver)
+            except UserError as exc:
+                raise ConfigError(f"{flag} {size}: {exc}") from None
+    config.transfer_from = args.transfer_from
     if config.transfer == "kinds" and world.kinds < 2:
         raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
     return config

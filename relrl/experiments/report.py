@@ -67,13 +67,19 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
             "memory_after_first_run": memory_first,
-            "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
+            "states_met": _mean_or_none([j["states_met"]["learning"] for j in mine]),
             "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
             "partial": any(j.get("partial", False) for j in mine),
         }
         if "cgi_places" in mine[0]["curve"][0]:
             out[name]["cgi_places"] = _places_curve(mine, points)
     return out
+
+
+def _mean_or_none(xs: list[float | None]) -> float | None:
+    """The mean of the values that are not None (None when there are none)."""
+    values = [x for x in xs if x is not None]
+    return float(np.mean(values)) if values else None
 
 
 def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any]]:
@@ -104,7 +110,8 @@ def summary_table(summary: dict[str, Any]) -> str:
         line = (f"{name:<12} {first if first is not None else nan:>9.3f} "
                 f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
                 f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
-                f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+                f"{s['memory']['positions']:>8.0f} "
+                + (f"{s['states_met']:>7.0f}" if s["states_met"] is not None else f"{'-':>7}"))
         if places:
             for group in ("trained", "held_out"):
                 v = s.get("cgi_places", {}).get(group, [None])[-1]
@@ -146,7 +153,8 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
         w.writerow(["learner", "positions", "detail", "states_met"])
         for name, s in summary.items():
             detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
-            w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
+            w.writerow([name, f"{s['memory']['positions']:g}", detail,
+                        "" if s["states_met"] is None else f"{s['states_met']:g}"])
     written += [fig5, fig4, memory]
     if any("cgi_places" in s for s in summary.values()):
         places = out_dir / "cgi_places.csv"

@@ -57,7 +57,7 @@ class World:
     """The size of a Social Interactive Simulator world.
 
     Attributes:
-        places: ``P``, the toy places (gaze directions besides the caregiver's face), 2 to 99.
+        places: ``P``, the toy places (gaze directions besides the caregiver's face), 2 to 257.
         colours: ``C``, toy colours (0: toys have no colour and no colour percept).
         kinds: ``K``, toy kinds (0: toys have no kind, as in the paper).
         toys: toys per trial: the target and ``toys - 1`` distractors the caregiver does not

@@ -274,9 +274,10 @@ tree_nodes(KB, Nodes) :-
 % ---------------------------------------------------------------------------------------
 :- begin_tests(engine_step).
 
-%   tiny.pl: light 1, dark 2, food 4; hunger always active; food is the reinforcer.
+%   tiny.pl: light 1, dark 2, food 4; hunger always active; food is the reinforcer; no
+%   constraint rules, so every response is allowed (mask -1).
 test(step_reports_code_reward_and_mask,
-     [true((Code == 5, N == hunger, Reward =:= 10, R == true, Mask == 7,
+     [true((Code == 5, N == hunger, Reward =:= 10, R == true, Mask == -1,
             between(0, 2, A)))]) :-
     kb_with('tests/data/tiny.pl', KB),
     etg_params(P),
