@@ -7,7 +7,7 @@
             engine_graph/2,           % +KB, -Graph
             engine_knowledge/2,       % +KB, -Terms
             engine_size/2,            % +KB, -Size
-            engine_save/3,            % +KB, +File, +Header
+            engine_policy/3,          % +KB, +Header, -Text
             engine_snapshot/2,        % +KB, -Snapshot
             engine_restore/2,         % +KB, +Snapshot
             engine_keep/2,            % +KB, +Slot
@@ -609,21 +609,20 @@ engine_resume(KB, Slot) :-
 slot_key(KB, Slot, Key) :-
     atomic_list_concat(['$relrl_snap:', KB, ':', Slot], Key).
 
-%!  engine_save(+KB, +File, +Header:string) is det.
+%!  engine_policy(+KB, +Header:text, -Text:string) is det.
 %
-%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with the
-%   domain's features and responses, then the learner's own clauses. Plain swipl consults
-%   the file; relrl reads it back as data (policy.pl). The file is written next to File
-%   and renamed into place, so a reader never sees half a policy.
+%   Text is KB's learned knowledge as a policy file: a comment, relrl_policy(Learner, Info)
+%   with the domain's features and responses, then the learner's own clauses. Plain swipl
+%   consults the file; relrl reads it back as data (policy.pl). Python writes Text to disk
+%   through relrl's one writer (atomic, never through a link).
 
-engine_save(KB, File, Header) :-
+engine_policy(KB, Header, Text) :-
+    must_be(text, Header),
     run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
-    atom_concat(File, '.tmp', Tmp),
-    setup_call_cleanup(
-        open(Tmp, write, S, [encoding(utf8)]),
-        write_policy(S, KB, Learner, Features, Responses, Header),
-        close(S)),
-    rename_file(Tmp, File).
+    with_output_to(string(Text),
+                   (   current_output(S),
+                       write_policy(S, KB, Learner, Features, Responses, Header)
+                   )).
 
 write_policy(S, KB, Learner, Features, Responses, Header) :-
     split_string(Header, "\n", "", Lines),

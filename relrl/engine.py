@@ -47,7 +47,7 @@ GOALS: dict[str, str] = {
     "graph": "relrl_engine:engine_graph",
     "knowledge": "relrl_engine:engine_knowledge",
     "size": "relrl_engine:engine_size",
-    "save": "relrl_engine:engine_save",
+    "policy": "relrl_engine:engine_policy",
     "keep": "relrl_engine:engine_keep",
     "resume": "relrl_engine:engine_resume",
     "reseed": "relrl_engine:engine_reseed",
@@ -250,10 +250,16 @@ class Engine:
 
     # -- files ------------------------------------------------------------------------------
 
+    def policy_text(self, header: str) -> str:
+        """The learned knowledge as the text of a policy file (``header`` as its comment)."""
+        return one(self.kb, "policy", self.module, header)
+
     def save(self, path: str | Path, header: str) -> Path:
-        """Write the learned knowledge as a readable policy file (atomic)."""
-        call(self.kb, "save", self.module, str(path), header)
-        return Path(path)
+        """Write the learned knowledge as a readable policy file (:mod:`relrl.outdir`: atomic,
+        never through a link)."""
+        from relrl.outdir import write_atomic
+
+        return write_atomic(path, self.policy_text(header))
 
     def load_policy(self, path: str | Path) -> None:
         """Replace the learned knowledge by the policy at ``path``, read as data.

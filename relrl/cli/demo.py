@@ -21,7 +21,8 @@ def run(args: argparse.Namespace) -> int:
     """Run the quick Experiment 1 and say where everything is."""
     from relrl.errors import ConfigError
     from relrl.experiments.main import run_sis
-    from relrl.experiments.report import summary_table
+    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.runner import command_signals
     from relrl.experiments.sis import SISConfig
     from relrl.outdir import OutDir
 
@@ -32,10 +33,11 @@ def run(args: argparse.Namespace) -> int:
           "Simulator,\n  short version: 3 learners x 5 evaluation points x 5 runs of 500 "
           "time units")
     t0 = time.perf_counter()
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/demo") as out:
+    with command_signals(), \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/demo", outputs=OUTPUTS) as out:
         results, files = run_sis(config, out.path, workers=args.workers)
-        out.status = "complete"
+        out.status = "partial" if results.get("partial") else "complete"
     print()
     print(summary_table(results["summary"]))
     print(f"\n(CGI: correct gaze index, Eq. 5; eye contacts in the first "

@@ -29,16 +29,21 @@ from __future__ import annotations
 import json
 import queue
 import re
-import shutil
 import threading
 import time
 from pathlib import Path
 from typing import Any
 
 from relrl.episodes.provenance import provenance
+from relrl.errors import OutputError
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
+from relrl.outdir import open_stream, write_atomic, write_json_atomic
 
-__all__ = ["FrameRecorder", "SessionTap", "write_manifest"]
+__all__ = ["FrameRecorder", "RECORDED", "SessionTap", "write_manifest"]
+
+#: the files and folders a recorded session writes besides the summary's (``--record``).
+RECORDED = ("session.json", "episode.toml", "domain.pl", "trees.jsonl", "events.jsonl",
+            "frames.jsonl", "frames/")
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")
@@ -49,6 +54,10 @@ TREE_PERIOD = 1.0
 class FrameRecorder:
     """JPEG frames written by a thread of their own (the control loop only queues them).
 
+    Every frame is a whole file written through :func:`relrl.outdir.write_atomic` (never
+    through a link: a ``frames`` that is a link is refused). A frame that cannot be written
+    (a full disk) stops the session at its next frame.
+
     Args:
         folder: the session folder (frames go to ``folder/frames``).
         rate: frames per second at most; 0 records every frame given.
@@ -57,12 +66,11 @@ class FrameRecorder:
 
     def __init__(self, folder: Path, rate: float = 10.0, quality: int = 85) -> None:
         self.folder = folder
-        (folder / "frames").mkdir(parents=True, exist_ok=True)
         self.rate, self.quality = float(rate), int(quality)
         self.count = 0
         self.bytes = 0
         self._next = 0.0
-        self._index = open(folder / "frames.jsonl", "w", encoding="utf-8")  # noqa: SIM115
+        self._index = open_stream(folder / "frames.jsonl")
         self._queue: queue.Queue[tuple[Path, Any] | None] = queue.Queue(maxsize=64)
         self._thread = threading.Thread(target=self._write, name="relrl-frames", daemon=True)
         self._thread.start()
@@ -74,8 +82,7 @@ class FrameRecorder:
 
     def add(self, frame: Any, t: int, looking_at: str | None) -> int:
         """Queue a frame of time unit ``t``; returns its index (from 1)."""
-        if self._error is not None:
-            raise self._error
+        self.check()
         self.count += 1
         name = f"{self.count:06d}.jpg"
         self._queue.put((self.folder / "frames" / name, frame))  # waits when 64 are queued
@@ -90,12 +97,19 @@ class FrameRecorder:
 
         while (item := self._queue.get()) is not None:
             path, frame = item
+            if self._error is not None:
+                continue  # the loop stops at its next frame; the rest are dropped
             try:
                 data = encode_jpeg(frame, self.quality)
-                path.write_bytes(data)
+                write_atomic(path, data, spare=False)
                 self.bytes += len(data)
-            except (OSError, ValueError) as exc:  # disk full, ...: raised in the loop
-                self._error = exc
+            except (OutputError, OSError, ValueError) as exc:  # disk full, ...: raised in
+                self._error = exc                               # the loop
+
+    def check(self) -> None:
+        """Raise the error that stopped a frame from being written, if one did."""
+        if self._error is not None:
+            raise self._error
 
     def close(self) -> None:
         """Write every queued frame and close the index (safe twice)."""
@@ -110,7 +124,7 @@ def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
     files = {}
     domain = Path(episode.domain)
     if domain.is_file():
-        shutil.copyfile(domain, folder / "domain.pl")
+        write_atomic(folder / "domain.pl", domain.read_bytes())
         files["domain"] = "domain.pl"
     script = Path(episode.path) if getattr(episode, "path", None) else None
     if script is not None and script.is_file():
@@ -118,15 +132,13 @@ def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
         if "domain" in files:
             text = re.sub(r'(?m)^(\s*domain\s*=\s*)(["\']).*?\2', r'\g<1>"domain.pl"', text,
                           count=1)
-        (folder / "episode.toml").write_text(text, encoding="utf-8")
+        write_atomic(folder / "episode.toml", text)
         files["script"] = "episode.toml"
     return files
 
 
 def write_manifest(folder: Path, data: dict[str, Any]) -> None:
     """Write ``session.json`` (atomic)."""
-    from relrl.experiments.report import write_json_atomic
-
     write_json_atomic(folder / "session.json", data)
 
 
@@ -148,22 +160,23 @@ class SessionTap:
                  hub: Any = None, record: bool = False, record_rate: float = 10.0,
                  record_quality: int = 85) -> None:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
-        self.trace = open(out / "trace.jsonl", "w", encoding="utf-8") \
-            if out is not None else None  # noqa: SIM115
-        self.frames = FrameRecorder(out, record_rate, record_quality) \
-            if record and out is not None else None
-        self._trees = open(out / "trees.jsonl", "w", encoding="utf-8") \
-            if record and out is not None else None  # noqa: SIM115
-        self._events = open(out / "events.jsonl", "w", encoding="utf-8") \
-            if record and out is not None else None  # noqa: SIM115
+        recording = record and out is not None
+        self.trace = self.frames = self._trees = self._events = None
+        try:
+            self.trace = open_stream(out / "trace.jsonl") if out is not None else None
+            self.frames = FrameRecorder(out, record_rate, record_quality) if recording \
+                else None
+            self._trees = open_stream(out / "trees.jsonl") if recording else None
+            self._events = open_stream(out / "events.jsonl") if recording else None
+            self.files: dict[str, str] = _copy_script(run.episode, out) if recording else {}
+        except BaseException:
+            self.close()
+            raise
         self._tree_key: Any = None
         self._tree_graph: dict[str, Any] | None = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
-        self.files: dict[str, str] = {}
-        if record and out is not None:
-            self.files = _copy_script(run.episode, out)
         if hub is not None:
             from relrl.terms import format_term
 
@@ -268,7 +281,10 @@ class SessionTap:
             self.frames.add(frame, self.run.t + 1, looked)
         if self.hub is not None:
             self.hub.finish()
-        return self.close()
+        stats = self.close()
+        if self.frames is not None:
+            self.frames.check()  # the last frames were written, or the run says why not
+        return stats
 
     def close(self) -> dict[str, Any]:
         """Flush and close every file (safe twice); returns the recording's figures."""

@@ -25,7 +25,6 @@ default, so one that lands later is measured too.
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 import platform
 import sys
@@ -101,32 +100,24 @@ def summarise(jobs: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def _write_csv(path: Path, header: list[str], rows: list[list[Any]]) -> None:
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
-
-
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """CSV tables, plots, ``results.json`` and ``timing.json``."""
-    from relrl.experiments.report import write_json_atomic
+    from relrl.experiments.report import write_csv, write_json_atomic
 
-    out.mkdir(parents=True, exist_ok=True)
     jobs, summary = results["jobs"], results["summary"]
     files = [out / n for n in ("fig6.csv", "fig6_summary.csv", "table1.csv",
                                "table1_summary.csv", "confusion.csv")]
-    _write_csv(files[0], ["learner", "time_unit", "seed", "units", "cgi_mean", "cgi_sd_runs",
+    write_csv(files[0], ["learner", "time_unit", "seed", "units", "cgi_mean", "cgi_sd_runs",
                           "no_shift_runs"],
                [[j["learner"], j["time_unit"], j["seed"], p["units"], round(p["cgi_mean"], 4),
                  round(p["cgi_std"], 4), p.get("no_shift_runs", 0)]
                 for j in jobs for p in j["evaluation"]])
-    _write_csv(files[1], ["learner", "time_unit", "units", "cgi_mean_over_seeds",
+    write_csv(files[1], ["learner", "time_unit", "units", "cgi_mean_over_seeds",
                           "cgi_sd_over_seeds", "seeds"],
                [[s["learner"], s["time_unit"], p["units"], round(p["cgi_mean"], 4),
                  round(p["cgi_sd_over_seeds"], 4), p["seeds"]]
                 for s in summary.values() for p in s["fig6"]])
-    _write_csv(files[2], ["learner", "time_unit", "seed", "execution", "presentations",
+    write_csv(files[2], ["learner", "time_unit", "seed", "execution", "presentations",
                           "missed", "control_steps", "categories", *OUTCOMES],
                [[j["learner"], j["time_unit"], j["seed"], k, e["presentations"], e["missed"],
                  e["steps"], e["categories"], *(e["counts"][o] for o in OUTCOMES)]
@@ -140,8 +131,8 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                         + ([f"{r[o][0]:.2f} +- {r[o][1]:.2f}" for o in OUTCOMES] if r else
                            [("no presentation" if t1["executions"] else "not run")]
                            * len(OUTCOMES)))
-    _write_csv(files[3], ["learner", "time_unit", "seed", *OUTCOMES], rows)
-    _write_csv(files[4], ["learner", "time_unit", "shown", "said", "count", "percent_of_shown"],
+    write_csv(files[3], ["learner", "time_unit", "seed", *OUTCOMES], rows)
+    write_csv(files[4], ["learner", "time_unit", "shown", "said", "count", "percent_of_shown"],
                [[s["learner"], s["time_unit"], shown, said, n,
                  round(100.0 * n / sum(row.values()), 2)]
                 for s in summary.values() for shown, row in s["confusion"].items()
@@ -160,6 +151,8 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         import matplotlib.pyplot as plt
     except ImportError:
         return []
+    from relrl.experiments.report import save_figure
+
     units = sorted({s["time_unit"] for s in summary.values()})
     fig, axes = plt.subplots(1, len(units), figsize=(5.5 * len(units), 3.8), squeeze=False)
     for ax, unit in zip(axes[0], units, strict=True):
@@ -178,9 +171,7 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
     fig.text(0.5, 0.005, "paper (text only): a fast rise until the second evaluation, then a "
              "slow rise to a plateau; no values are given", ha="center", fontsize=8)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    files = [out / "fig6.png"]
-    fig.savefig(files[0], dpi=100)
-    plt.close(fig)
+    files = [save_figure(fig, out / "fig6.png", dpi=100)]
 
     keys = [k for k, s in summary.items() if s["table1"]["all_executions"]]
     if keys:
@@ -199,10 +190,9 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         ax.set_title("Table 1: declarative pointing")
         ax.legend(fontsize=7)
         fig.tight_layout()
-        files.append(out / "table1.png")
-        fig.savefig(files[-1], dpi=100)
-        plt.close(fig)
+        files.append(save_figure(fig, out / "table1.png", dpi=100))
     return files
+
 
 
 def _seeds(text: str) -> list[int]:
