@@ -32,19 +32,21 @@ def write_json_atomic(path: Path, data: Any) -> None:
 
 
 def write_csv(path: Path, header: list[str], rows: Any) -> Path:
-    """Write a CSV file whole (:func:`relrl.outdir.write_atomic`); returns ``path``."""
+    """Write a CSV file whole (:func:`relrl.outdir.write_atomic`; on a full disk it does not
+    take the space held back for the results); returns ``path``."""
     from relrl.outdir import write_atomic
 
     buf = io.StringIO(newline="")
     w = csv.writer(buf)
     w.writerow(header)
     w.writerows(rows)
-    return write_atomic(path, buf.getvalue())
+    return write_atomic(path, buf.getvalue(), spare=False)
 
 
 def save_figure(fig: Any, path: Path, **kwargs: Any) -> Path:
-    """Save a matplotlib figure whole (:func:`relrl.outdir.write_atomic`), in the format its
-    suffix names, and close it; ``kwargs`` go to ``savefig`` (``dpi``). Returns ``path``."""
+    """Save a matplotlib figure whole (:func:`relrl.outdir.write_atomic`; on a full disk it
+    does not take the space held back for the results), in the format its suffix names, and
+    close it; ``kwargs`` go to ``savefig`` (``dpi``). Returns ``path``."""
     import matplotlib.pyplot as plt
 
     from relrl.outdir import write_atomic
@@ -54,7 +56,7 @@ def save_figure(fig: Any, path: Path, **kwargs: Any) -> Path:
         fig.savefig(buf, format=Path(path).suffix.lstrip(".") or "png", **kwargs)
     finally:
         plt.close(fig)
-    return write_atomic(path, buf.getvalue())
+    return write_atomic(path, buf.getvalue(), spare=False)
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
@@ -191,7 +193,8 @@ def skip_plots(out_dir: Path) -> list[Path]:
 
     return [write_atomic(out_dir / "PLOTS.txt",
                          "The run was interrupted, so no figures were drawn (to stop at once); "
-                         "every finished point is in results.json and the CSV files.\n")]
+                         "every finished point is in results.json and the CSV files.\n",
+                         spare=False)]
 
 
 def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
@@ -208,7 +211,7 @@ def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
         return None, [write_atomic(out_dir / "PLOTS.txt",
                                    "matplotlib is not installed, so no PNG plots were drawn; "
                                    "the numbers are in the CSV files.\nInstall the extra to "
-                                   "get plots:  pip install 'relrl[plots]'\n")]
+                                   "get plots:  pip install 'relrl[plots]'\n", spare=False)]
     return plt, []
 
 

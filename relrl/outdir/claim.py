@@ -44,6 +44,8 @@ JOURNAL = ".relrl-run.files"
 #: space held back for the last writes of a command.
 SPARE = ".relrl-run.spare"
 SPARE_BYTES = 64 * 1024
+#: bytes the first record takes (padding), so that the last one fits on a full disk.
+RECORD_ROOM = 16 * 1024
 _INTERNAL = (MANIFEST, JOURNAL, SPARE)
 
 _CLAIMS: list[OutDir] = []
@@ -202,11 +204,11 @@ class OutDir:
                 try:
                     st = os.stat(part, dir_fd=fd, follow_symlinks=False)
                     if stat.S_ISLNK(st.st_mode):
-                        raise OutputError(f"{self.path / sub}: is a symbolic link; relrl "
+                        raise OutputError(f"{self.path / sub} is a symbolic link; relrl "
                                           "writes nothing through a link (remove it, or "
                                           "choose another folder)")
                     if not stat.S_ISDIR(st.st_mode):
-                        raise OutputError(f"{self.path / sub}: is a file, not a folder; "
+                        raise OutputError(f"{self.path / sub} is a file, not a folder; "
                                           f"cannot write {shown}")
                     nfd = os.open(part, O_DIR | os.O_NOFOLLOW, dir_fd=fd)
                 except OSError as exc:
@@ -274,7 +276,10 @@ class OutDir:
 
     # -- the record ---------------------------------------------------------------------------
 
-    def _record(self, ended: str | None = None) -> None:
+    def _record(self, ended: str | None = None) -> bool:
+        """Write the record (atomic; the first one padded to :data:`RECORD_ROOM` bytes so
+        that the last one has room on a full disk). Returns whether it lists the files
+        (when it had to be written in that room without them, the journal stays)."""
         from relrl import __version__
 
         files = sorted(n for n in self._written if not n.endswith("/")
@@ -284,23 +289,45 @@ class OutDir:
                 "started": self._started, "ended": ended, "status": self.status,
                 "files": files, "folders": folders, "kept": sorted(self._foreign - set(files)),
                 "pid": os.getpid(), "host": socket.gethostname()}
-        raw = json.dumps(data, indent=1, sort_keys=True) + "\n"
+        raw = (json.dumps(data, indent=1, sort_keys=True) + "\n").encode("utf-8")
+        if ended is None:
+            raw += b" " * (RECORD_ROOM - len(raw)) + b"\n" if len(raw) < RECORD_ROOM else b""
         try:
-            write_in(self._fd, MANIFEST, raw.encode("utf-8"), self.path / MANIFEST)
+            write_in(self._fd, MANIFEST, raw, self.path / MANIFEST)
+            return True
         except OSError as exc:
-            if exc.errno == errno.ENOSPC and self._give_back():
-                write_in(self._fd, MANIFEST, raw.encode("utf-8"), self.path / MANIFEST)
-            else:
+            if exc.errno != errno.ENOSPC or ended is None:
                 raise
+        # a full disk: rewrite the record in the room the first one took (not atomic, but a
+        # torn record only makes a later --overwrite keep every file)
+        listed = True
+        if len(raw) > self._room():
+            data.update(files=[], folders=[], journal=JOURNAL)
+            raw, listed = (json.dumps(data, indent=1, sort_keys=True) + "\n").encode(), False
+        fd = os.open(MANIFEST, os.O_WRONLY | os.O_NOFOLLOW | os.O_CLOEXEC, dir_fd=self._fd)
+        try:
+            os.pwrite(fd, raw, 0)
+            os.ftruncate(fd, len(raw))
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        return listed
+
+    def _room(self) -> int:
+        try:
+            return os.stat(MANIFEST, dir_fd=self._fd, follow_symlinks=False).st_size
+        except OSError:
+            return 0
 
     def _finish(self, status: str) -> None:
         self.status = status
         with deferred_signals():
             self._give_back()
             with contextlib.suppress(OSError, OutputError):  # a vanished folder says more
-                self._record(_dt.datetime.now().isoformat(timespec="seconds"))
+                listed = self._record(_dt.datetime.now().isoformat(timespec="seconds"))
                 self._journal.close()
-                os.unlink(JOURNAL, dir_fd=self._fd)
+                if listed:
+                    os.unlink(JOURNAL, dir_fd=self._fd)
             self._journal.close()
             with _CLAIMS_LOCK:
                 if self in _CLAIMS:
@@ -398,10 +425,10 @@ def _prepare(fd: int, path: Path, overwrite: bool, what: str,
         raise OutputError(f"{what} {path}: the folder is not empty (it holds {by}); "
                           "pass --overwrite to replace them, or choose a new folder")
     _check_outputs(fd, path, outputs, what)
-    if earlier.get("ended"):
+    if earlier.get("ended") and not earlier.get("journal"):
         ours = {n for n in earlier.get("files", []) if isinstance(n, str)} & present
         made = [n for n in earlier.get("folders", []) if isinstance(n, str)]
-    else:  # killed before its record was finished: its journal says what it wrote
+    else:  # killed before its record was finished (or out of room): the journal lists
         journal = _read_journal(fd)
         ours = {n for n in journal if not n.endswith("/")} & present
         made = [n[:-1] for n in journal if n.endswith("/")]

@@ -105,10 +105,10 @@ def refuse_link(dir_fd: int, name: str, shown: Path) -> None:
     except FileNotFoundError:
         return
     if stat.S_ISLNK(st.st_mode):
-        raise OutputError(f"{shown}: is a symbolic link; relrl writes nothing through a link "
+        raise OutputError(f"{shown} is a symbolic link; relrl writes nothing through a link "
                           "(remove it, or choose another folder)")
     if stat.S_ISDIR(st.st_mode):
-        raise OutputError(f"{shown}: is a folder; cannot write a file there")
+        raise OutputError(f"{shown} is a folder; cannot write a file there")
 
 
 def write_all(fd: int, raw: bytes | memoryview) -> None:

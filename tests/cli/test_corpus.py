@@ -1,14 +1,21 @@
-"""The bad-input corpus of issue 14, every subcommand: one line naming the value, exit 2.
+"""The bad-input corpus, every subcommand: one line naming the value, exit 2.
 
 Each case is ``relrl ARGV`` run in this process (an escaping exception fails the test with its
 traceback) and the words the one line must contain. ``{d}`` is the corpus folder
 (``conftest.corpus``), ``{fruits}`` the fruits domain. Outputs that must *not* be written are
-checked in ``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
+checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
+``test_nothing_lost.py``.
+
+The corpus holds 159 cases: 107 bad inputs in ``CASES`` and 12 more tests here, 23 in
+``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
+:func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
 
 from __future__ import annotations
 
+import importlib
 import io
+import re
 import sys
 
 import pytest
@@ -238,3 +245,29 @@ def test_an_image_path_that_is_a_device(capsys, tmp_path):
     (tmp_path / "zero.png").symlink_to("/dev/zero")
     one_line_exit_2(capsys, ["perceive", str(tmp_path / "zero.png")], "zero.png",
                     "not a regular file")
+
+
+def _cases(module: str) -> int:
+    """The test cases of a module: its test functions, each parametrization counted."""
+    n = 0
+    for name, fn in vars(importlib.import_module(module)).items():
+        if name.startswith("test_") and callable(fn):
+            k = 1
+            for mark in getattr(fn, "pytestmark", []):
+                if mark.name == "parametrize":
+                    k *= len(mark.args[1])
+            n += k
+    return n
+
+
+def test_the_corpus_says_how_many_cases_it_holds():
+    said = re.search(r"holds (\d+) cases: (\d+) bad inputs in ``CASES`` and (\d+) more tests "
+                     r"here, (\d+) in\s+``test_outputs.py``, (\d+) in ``test_nothing_lost.py``",
+                     __doc__)
+    assert said, "the docstring no longer says how many cases the corpus holds"
+    total, cases, here, outputs, lost = map(int, said.groups())
+    counted = {"cases": len(CASES), "here": _cases(__name__) - len(CASES),
+               "outputs": _cases("tests.cli.test_outputs"),
+               "lost": _cases("tests.cli.test_nothing_lost")}
+    assert counted == {"cases": cases, "here": here, "outputs": outputs, "lost": lost}
+    assert total == sum(counted.values())
