@@ -147,7 +147,7 @@ def policy_save_problem(name: str) -> str | None:
                     f"file name has at most {NAME_MAX}")
     if not parts:
         return None
-    if name in RUN_FILES or f"{parts[0]}/" in RUN_FILES or parts[0].startswith(".relrl-run"):
+    if {parts[0], f"{parts[0]}/"} & set(RUN_FILES) or parts[0].startswith(".relrl-run"):
         return (f"policy_save {name!r} is a file of the run itself; choose another name (e.g. "
                 "policy.pl)")
     return None
