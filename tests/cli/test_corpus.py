@@ -6,7 +6,7 @@ traceback) and the words the one line must contain. ``{d}`` is the corpus folder
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 159 cases: 107 bad inputs in ``CASES`` and 12 more tests here, 23 in
+The corpus holds 161 cases: 107 bad inputs in ``CASES`` and 12 more tests here, 25 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """

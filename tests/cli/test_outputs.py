@@ -106,6 +106,59 @@ def test_overwrite_after_kill_9_keeps_a_file_added_after_the_crash(tmp_path):
         ".relrl-run.json"]
 
 
+def test_overwrite_deletes_nothing_through_a_link(tmp_path):
+    """The journal of a killed run names frames/000001.jpg; frames/ is now a link: the file
+    it leads to is not the run's, and stays."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "000001.jpg").write_bytes(b"someone else's")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / ".relrl-run.json").write_text(json.dumps(
+        {"command": "relrl run x.toml", "started": "2025-01-01T00:00:00", "ended": None,
+         "status": "running", "files": [], "kept": []}))
+    (out / ".relrl-run.files").write_text('"frames/"\n"frames/000001.jpg"\n"trace.jsonl"\n')
+    (out / "frames").symlink_to(elsewhere)
+    (out / "trace.jsonl").write_text("{}\n")
+    script = tmp_path / "e.toml"
+    script.write_text(episode_text())
+    assert main(["run", str(script), "--out", str(out), "--no-plots", "--overwrite"]) == 0
+    assert (elsewhere / "000001.jpg").read_bytes() == b"someone else's"
+    assert (out / "trace.jsonl").read_text().count("\n") == 6
+
+
+def test_a_policy_that_cannot_be_saved_at_the_end_is_not_a_success(capsys, tmp_path):
+    """A link planted in the policy's path during the run: the policy is not written through
+    it, summary.json says why, and the run ends in one line and exit 2."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    script = tmp_path / "e.toml"
+    script.write_text(episode_text(steps=400, head='policy_save = "sub/p.pl"'))
+    out = tmp_path / "out"
+
+    def plant() -> None:
+        (out / "sub").symlink_to(elsewhere)
+
+    watcher = threading.Thread(target=lambda: (_wait_for(out / "trace.jsonl"), plant()),
+                               daemon=True)
+    watcher.start()
+    code = main(["run", str(script), "--out", str(out), "--no-plots"])
+    watcher.join()
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip()]
+    assert code == 2 and len(err) == 1 and "the policy was not saved" in err[0], err
+    assert "sub is a symbolic link" in err[0]
+    assert list(elsewhere.iterdir()) == []
+    summary = json.loads((out / "summary.json").read_text())
+    assert "policy" not in summary and "symbolic link" in summary["policy_error"]
+    assert json.loads((out / ".relrl-run.json").read_text())["status"] == "partial"
+
+
+def _wait_for(path: Path, timeout: float = 60) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not path.exists():
+        time.sleep(0.005)
+
+
 def test_a_second_command_on_a_folder_in_use_is_refused(capsys, tmp_path):
     """One command per folder: an experiment cannot start in the folder of a running one
     (whose folder holds only its record), nor can --overwrite take it from under it."""
