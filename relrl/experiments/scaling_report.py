@@ -22,6 +22,7 @@ from relrl.experiments.report import (
 )
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
+from relrl.machine import machine_info
 
 __all__ = ["OUTPUTS", "run_scaling", "scaling_table"]
 
@@ -84,7 +85,7 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
         results["error"] = outcome.error
     timing = {"wall_seconds": outcome.seconds, "workers": workers, "engine": engine,
               "python": platform.python_version(), "machine": platform.machine(),
-              "jobs": timings}
+              "machine_info": machine_info(), "jobs": timings}
     files = write_outputs(out, results, timing)
     if outcome.error:
         raise_kept(outcome.error, out)
