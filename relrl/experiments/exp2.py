@@ -43,6 +43,10 @@ ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SCRIPT = ROOT / "examples" / "episodes" / "experiment2.toml"
 
 
+#: the files the sweep writes into its folder (checked for links before it runs).
+OUTPUTS = ("fig6.csv", "fig6_summary.csv", "table1.csv", "table1_summary.csv",
+           "confusion.csv", "fig6.png", "table1.png", "results.json", "timing.json")
+
 def run_job(script: str, learner: str, seed: int, time_unit: str,
             overrides: dict[str, Any], *, report: Any = None) -> dict[str, Any]:
     """Run the script for one learner, time unit and seed; the parts of its summary the
@@ -234,7 +238,10 @@ def _options(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
                         help="seconds one control step may run before the job stops, naming "
                              "the rule (default 60: a loaded machine; the robot's own is 10)")
-    parser.add_argument("--out", default="runs/exp2-sweep", help="output folder")
+    from relrl.outdir import add_out_options
+
+    add_out_options(parser, default="runs/exp2-sweep",
+                    what="output folder: results.json, CSVs, figures")
     return parser.parse_args(argv)
 
 
@@ -269,16 +276,33 @@ def _check(args: argparse.Namespace) -> tuple[list[str], list[str], list[int]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the sweep and write the outputs; exit status 2 for a bad option or script."""
+    """Run the sweep and write the outputs; exit status 2 for a bad option, script or output
+    folder (relrl's output policy: refused when it holds files, unless --overwrite; locked
+    while the sweep runs)."""
     from relrl.errors import UserError
-    from relrl.experiments.runner import run_jobs
+    from relrl.experiments.runner import command_signals
+    from relrl.outdir import OutDir
 
     args = _options(argv)
+    command = " ".join(["python -m relrl.experiments.exp2",
+                        *(argv if argv is not None else sys.argv[1:])])
     try:
         learners, units, seeds = _check(args)
+        with command_signals(), \
+                OutDir.claim(args.out, command=command, overwrite=args.overwrite,
+                             default="runs/exp2-sweep", outputs=OUTPUTS) as out:
+            code = _sweep(args, out.path, command, learners, units, seeds)
+            out.status = "complete" if code == 0 else "partial"
     except UserError as exc:
         print(f"exp2: {exc}", file=sys.stderr)
         return 2
+    return code
+
+
+def _sweep(args: argparse.Namespace, out: Path, command: str, learners: list[str],
+           units: list[str], seeds: list[int]) -> int:
+    from relrl.experiments.runner import run_jobs
+
     table1_units = units if args.table1_units == "all" else \
         [u.strip() for u in args.table1_units.split(",") if u.strip()]
     overrides = {"every": args.every, "perception": args.perception,
@@ -293,22 +317,20 @@ def main(argv: list[str] | None = None) -> int:
         why = outcome.error or f"stopped by {outcome.interrupted}"
         if not jobs:
             print(f"exp2: {why}; no job finished, nothing written", file=sys.stderr)
-            return 2 if outcome.error else 130
+            return 2 if outcome.error else _stopped(outcome.interrupted)
     wall = outcome.seconds
     timing = {"wall_seconds": wall, "workers": args.workers,
               "python": platform.python_version(), "machine_info": machine_info(),
               "jobs": [{"learner": j["learner"], "time_unit": j["time_unit"], "seed": j["seed"],
                         "seconds": j.pop("seconds")} for j in jobs]}
     script = Path(args.script).resolve()
-    results = {"experiment": "exp2",
-               "command": " ".join(["python -m relrl.experiments.exp2",
-                                    *(argv if argv is not None else sys.argv[1:])]),
+    results = {"experiment": "exp2", "command": command,
                "script": str(script.relative_to(ROOT)) if script.is_relative_to(ROOT)
                else str(script),
                "learners": learners, "time_units": units, "seeds": seeds,
                "overrides": overrides, "summary": summarise(jobs), "jobs": jobs,
                "partial": not outcome.complete, "paper": PAPER}
-    files = write_outputs(Path(args.out), results, timing)
+    files = write_outputs(out, results, timing)
     for key, s in results["summary"].items():
         line = f"{key:28s}"
         if s["fig6"]:
@@ -320,12 +342,20 @@ def main(argv: list[str] | None = None) -> int:
                  "; Table 1: no presentation" if s["table1"]["executions"] else
                  "; Table 1 not run for this time unit (--table1-units)")
         print(line)
-    print(f"wrote {len(files)} files to {args.out}/ in {wall:.0f} s")
+    print(f"wrote {len(files)} files to {out}/ in {wall:.0f} s")
     if not outcome.complete:
         print(f"exp2: {why}; the {len(jobs)} finished jobs of {len(tasks)} are written "
               "(results.json marked partial)", file=sys.stderr)
-        return 2 if outcome.error else 130
+        return 2 if outcome.error else _stopped(outcome.interrupted)
     return 0
+
+
+def _stopped(name: str | None) -> int:
+    """128 + the number of the signal that stopped the sweep (SIGINT when unknown)."""
+    import signal
+
+    return 128 + (signal.Signals[name].value if name in signal.Signals.__members__
+                  else signal.SIGINT)
 
 
 if __name__ == "__main__":
