@@ -34,7 +34,7 @@ import numpy as np
 from relrl.episodes.provenance import provenance, session_manifest
 from relrl.episodes.recording import RECORDED, SessionTap, write_manifest
 from relrl.episodes.script import Episode
-from relrl.outdir import deferred_signals, write_json_atomic
+from relrl.outdir import check_inside, deferred_signals, write_json_atomic
 from relrl.progress import progress
 from relrl.terms import format_term
 
@@ -198,7 +198,7 @@ class _Run:
         self.units = 0  # learning time units finished
         self.in_view = None
         self.tap: Any = None
-        self.saved: dict[str, Any] | None = None  # the summary, once it and the policy are
+        self.saved: dict[str, Any] | None = None  # the summary, once it is written
 
     def close(self) -> None:
         self.kb.close()
@@ -526,6 +526,7 @@ def _write_outputs(run: _Run, out: Path, summary: dict[str, Any], timing: dict[s
         write_json_atomic(out / "summary.json", summary)
         if ep.policy_save:
             try:
+                check_inside(out, ep.policy_save)  # (a claimed folder checks it again)
                 run.learner.save(out / ep.policy_save,
                                  f"relrl policy: {ep.learner} learner, episode {ep.name}, "
                                  f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "

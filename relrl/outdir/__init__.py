@@ -57,10 +57,11 @@ from relrl.outdir.fs import (
     open_folder,
     reason,
     refuse_nul,
+    way_problem,
     write_in,
 )
 
-__all__ = ["MANIFEST", "OutDir", "Stream", "add_out_options", "check_out_file",
+__all__ = ["MANIFEST", "OutDir", "Stream", "add_out_options", "check_inside", "check_out_file",
            "deferred_signals", "file_mode", "open_stream", "timestamped",
            "write_atomic", "write_json_atomic"]
 
@@ -138,6 +139,27 @@ def open_stream(path: str | Path, *, binary: bool = False) -> Stream:
         raise OutputError(f"cannot write {p}: {reason(exc)}") from None
     finally:
         os.close(dir_fd)
+
+
+def check_inside(folder: str | Path, rel: str) -> None:
+    """Refuse ``rel`` (a path inside ``folder``) when writing it would follow a link or meet
+    a file or folder in the way -- for writes outside a claimed folder, which the writer
+    cannot walk itself (a claimed folder's writes are checked as they go).
+
+    Raises:
+        OutputError: naming the part in the way.
+    """
+    folder = Path(folder)
+    try:
+        fd = os.open(folder, O_DIR)
+    except OSError as exc:
+        raise OutputError(f"cannot write into {folder}: {reason(exc)}") from None
+    try:
+        problem = way_problem(fd, rel)
+    finally:
+        os.close(fd)
+    if problem:
+        raise OutputError(f"{folder}: {problem}")
 
 
 def check_out_file(path: str | Path, what: str, *, suffixes: tuple[str, ...] = (),

@@ -31,6 +31,7 @@ from relrl.outdir.fs import (
     reason,
     refuse_nul,
     subfolder,
+    way_problem,
     write_all,
     write_in,
 )
@@ -349,32 +350,11 @@ def _exists(dir_fd: int, rel: str) -> bool:
 def _check_outputs(fd: int, path: Path, outputs: Iterable[str], what: str) -> None:
     """Refuse, before the work, an output that is a link, lies under a link or a file, or
     has a name longer than the folder's file system takes."""
-    longest = os.fpathconf(fd, "PC_NAME_MAX")
     for name in outputs:
-        parts = _parts(name, f"{what} {path}: {name!r}")
-        for i, part in enumerate(parts):
-            if len(os.fsencode(part)) > longest:
-                raise OutputError(f"{what} {path}: cannot write {name[:60]}...: a file name "
-                                  f"here has at most {longest} bytes")
-            here = "/".join(parts[:i + 1])
-            with subfolder(fd, parts[:i]) as sub:
-                if sub is None:
-                    break  # a folder above is missing: created by the writer, not a link
-                try:
-                    mode = os.stat(part, dir_fd=sub, follow_symlinks=False).st_mode
-                except FileNotFoundError:
-                    break
-            if stat.S_ISLNK(mode):
-                raise OutputError(f"{what} {path}: {here} is a symbolic link; relrl writes "
-                                  "nothing through a link (remove it, or choose another "
-                                  "folder)")
-            last = i == len(parts) - 1
-            if not last and not stat.S_ISDIR(mode):
-                raise OutputError(f"{what} {path}: {here} is a file; {name} cannot be "
-                                  "written under it")
-            if last and stat.S_ISDIR(mode) and not name.endswith("/"):
-                raise OutputError(f"{what} {path}: {here} is a folder; {name} cannot be "
-                                  "written there")
+        _parts(name, f"{what} {path}: {name!r}")
+        problem = way_problem(fd, name)
+        if problem:
+            raise OutputError(f"{what} {path}: {problem}")
 
 
 def _lock(fd: int, path: Path, what: str) -> None:

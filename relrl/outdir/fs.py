@@ -23,7 +23,7 @@ from relrl.errors import OutputError
 
 __all__ = ["O_DIR", "O_NEW", "Stream", "deferred_signals", "file_mode", "is_special",
            "make_folder", "new_file_in", "open_folder", "reason", "refuse_link", "refuse_nul",
-           "subfolder", "temp_name", "write_all", "write_in"]
+           "subfolder", "temp_name", "way_problem", "write_all", "write_in"]
 
 #: open a folder (for a descriptor to work from).
 O_DIR = os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC
@@ -233,6 +233,35 @@ def subfolder(fd: int, parts: tuple[str, ...] | list[str]) -> Iterator[int | Non
     finally:
         for f in opened:
             os.close(f)
+
+
+def way_problem(dir_fd: int, rel: str) -> str | None:
+    """What stops ``rel`` (``name``, ``sub/name``, or a folder ``name/``) from being written
+    under ``dir_fd`` without following a link: a part that is a link, a file where a folder
+    must be, a folder where the file goes, a name longer than the file system takes. None
+    when nothing does (missing folders are created by the writer)."""
+    longest = os.fpathconf(dir_fd, "PC_NAME_MAX")
+    parts = rel.rstrip("/").split("/")
+    for i, part in enumerate(parts):
+        here = "/".join(parts[:i + 1])
+        if len(os.fsencode(part)) > longest:
+            return f"cannot write {rel[:60]}...: a file name here has at most {longest} bytes"
+        with subfolder(dir_fd, parts[:i]) as sub:
+            if sub is None:
+                return None  # a folder above is missing: the writer creates it
+            try:
+                mode = os.stat(part, dir_fd=sub, follow_symlinks=False).st_mode
+            except FileNotFoundError:
+                return None
+        if stat.S_ISLNK(mode):
+            return (f"{here} is a symbolic link; relrl writes nothing through a link (remove "
+                    "it, or choose another folder)")
+        last = i == len(parts) - 1
+        if not last and not stat.S_ISDIR(mode):
+            return f"{here} is a file; {rel} cannot be written under it"
+        if last and stat.S_ISDIR(mode) and not rel.endswith("/"):
+            return f"{here} is a folder; {rel} cannot be written there"
+    return None
 
 
 @contextlib.contextmanager

@@ -250,6 +250,20 @@ def test_a_policy_folder_that_leads_outside_out_is_refused_before_the_run(tmp_pa
     assert list(elsewhere.iterdir()) == [] and not (out / "trace.jsonl").exists()
 
 
+def test_a_policy_folder_link_is_not_followed_by_run_episode_either(tmp_path):
+    """Without a claimed folder (a script calling run_episode) the policy's path is checked
+    all the same: the summary says why it was not saved."""
+    from relrl.episodes import RunOptions, parse_episode, run_episode
+
+    out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
+    out.mkdir()
+    elsewhere.mkdir()
+    (out / "link").symlink_to(elsewhere)
+    ep = parse_episode(episode_text(head='policy_save = "link/p.pl"'), tmp_path / "e.toml")
+    summary = run_episode(ep, RunOptions(out=out, plots=False))
+    assert list(elsewhere.iterdir()) == [] and "symbolic link" in summary["policy_error"]
+
+
 # ---- every file through one writer: no link followed, nothing written in place ------------
 
 OUTSIDE = "not relrl's: must never change\n"
