@@ -9,11 +9,13 @@ The policy (``docs/outputs.md``):
   the new ones; every other file is kept. A folder without a record is never emptied.
 * One command at a time: a claimed folder is locked (``flock`` on the folder itself, let go
   by the kernel even after ``kill -9``); a second command on it is refused (exit 2).
-* Without ``--out``, ``relrl experiment`` and ``relrl demo`` write a fresh folder
-  ``runs/NAME-YYYYMMDD-HHMMSS`` (``-2``, ``-3``... when taken): re-running never mixes runs.
+* Without ``--out``, ``relrl experiment``, ``relrl demo`` and the Experiment 2 sweep write a
+  fresh folder ``runs/NAME-YYYYMMDD-HHMMSS`` (``-2``, ``-3``... when taken): re-running
+  never mixes runs.
 * Everything is checked before any work starts: a path that is a file or a device, lies
-  under a file, or cannot be created or written is one line and exit 2, not a traceback
-  after an hour of experiment.
+  under a file, or cannot be created or written -- and an output of the command that is a
+  link or lies under one (``OutDir.claim(outputs=...)``) -- is one line and exit 2, not a
+  traceback after an hour of experiment.
 * Every file goes through this module. Inside a claimed folder nothing is written through a
   symbolic link -- neither a link at the file's name nor a linked subfolder (``frames/``):
   the folder is walked with ``O_NOFOLLOW`` from a descriptor held since the claim, so a folder
@@ -24,8 +26,9 @@ The policy (``docs/outputs.md``):
   new files (never a file or link that was there) written a whole record at a time; a record
   that does not fit is cut off, so the file ends at the last whole record.
 * 64 KiB are held back in the folder while the command works (``.relrl-run.spare``) and given
-  back when a whole file meets a full disk, so the last writes -- the summary, the policy,
-  the record -- still go where they fit.
+  back when a result (not a figure, a table or a frame: those pass ``spare=False``) meets a
+  full disk, so the summary and the policy still go where they fit; the first record takes
+  room for the last, so a full disk never leaves it saying ``running``.
 * ``.relrl-run.json`` records the command, when it started and ended, whether it finished
   (``complete``) or stopped early (``partial``), and the files it wrote; while the command
   works ``.relrl-run.files`` journals each name before the file is created.
@@ -77,7 +80,8 @@ def write_atomic(path: str | Path, data: bytes | str, *, spare: bool = True) -> 
     Args:
         path: the file.
         data: its content (``str`` is written as UTF-8).
-        spare: inside a claimed folder, whether a full disk may use the space held back.
+        spare: inside a claimed folder, whether a full disk may use the space held back
+            (``False`` for bulk: frames, figures, tables).
     """
     p = Path(path)
     refuse_nul(p, "cannot write")

@@ -22,6 +22,7 @@ from typing import Any
 
 from relrl.errors import OutputError
 from relrl.outdir.fs import (
+    LINK,
     O_DIR,
     Stream,
     deferred_signals,
@@ -195,19 +196,13 @@ class OutDir:
             for i, part in enumerate(parts):
                 sub = "/".join(parts[:i + 1])
                 try:
-                    os.stat(part, dir_fd=fd, follow_symlinks=False)
-                except FileNotFoundError:
-                    self._note_name(sub + "/", shown)  # made by this command
-                    with contextlib.suppress(FileExistsError):
-                        os.mkdir(part, dir_fd=fd)
-                except OSError as exc:
-                    raise self._error(shown, exc) from None
-                try:
+                    if not _there(fd, part):
+                        self._note_name(sub + "/", shown)  # made by this command
+                        with contextlib.suppress(FileExistsError):
+                            os.mkdir(part, dir_fd=fd)
                     st = os.stat(part, dir_fd=fd, follow_symlinks=False)
                     if stat.S_ISLNK(st.st_mode):
-                        raise OutputError(f"{self.path / sub} is a symbolic link; relrl "
-                                          "writes nothing through a link (remove it, or "
-                                          "choose another folder)")
+                        raise OutputError(f"{self.path / sub} {LINK}")
                     if not stat.S_ISDIR(st.st_mode):
                         raise OutputError(f"{self.path / sub} is a file, not a folder; "
                                           f"cannot write {shown}")
@@ -334,6 +329,15 @@ class OutDir:
                 if self in _CLAIMS:
                     _CLAIMS.remove(self)
             os.close(self._fd)  # lets go of the lock
+
+
+def _there(dir_fd: int, name: str) -> bool:
+    """Whether anything (a link included) is at ``name`` in ``dir_fd``."""
+    try:
+        os.stat(name, dir_fd=dir_fd, follow_symlinks=False)
+    except FileNotFoundError:
+        return False
+    return True
 
 
 def _exists(dir_fd: int, rel: str) -> bool:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from relrl.errors import OutputError
 
-__all__ = ["O_DIR", "O_NEW", "Stream", "deferred_signals", "file_mode", "is_special",
+__all__ = ["LINK", "O_DIR", "O_NEW", "Stream", "deferred_signals", "file_mode", "is_special",
            "make_folder", "new_file_in", "open_folder", "reason", "refuse_link", "refuse_nul",
            "subfolder", "temp_name", "way_problem", "write_all", "write_in"]
 
@@ -29,6 +29,9 @@ __all__ = ["O_DIR", "O_NEW", "Stream", "deferred_signals", "file_mode", "is_spec
 O_DIR = os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC
 #: create a new file, never through a link, never one that is there.
 O_NEW = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
+#: what relrl says of a link in the way (after its path).
+LINK = ("is a symbolic link; relrl writes nothing through a link (remove it, or choose another "
+        "folder)")
 
 
 def file_mode() -> int:
@@ -105,8 +108,7 @@ def refuse_link(dir_fd: int, name: str, shown: Path) -> None:
     except FileNotFoundError:
         return
     if stat.S_ISLNK(st.st_mode):
-        raise OutputError(f"{shown} is a symbolic link; relrl writes nothing through a link "
-                          "(remove it, or choose another folder)")
+        raise OutputError(f"{shown} {LINK}")
     if stat.S_ISDIR(st.st_mode):
         raise OutputError(f"{shown} is a folder; cannot write a file there")
 
@@ -254,8 +256,7 @@ def way_problem(dir_fd: int, rel: str) -> str | None:
             except FileNotFoundError:
                 return None
         if stat.S_ISLNK(mode):
-            return (f"{here} is a symbolic link; relrl writes nothing through a link (remove "
-                    "it, or choose another folder)")
+            return f"{here} {LINK}"
         last = i == len(parts) - 1
         if not last and not stat.S_ISDIR(mode):
             return f"{here} is a file; {rel} cannot be written under it"
