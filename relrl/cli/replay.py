@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 HELP = "replay a recorded session in the browser: scrub through its time line"
@@ -18,14 +19,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="where to serve (default 127.0.0.1 and a free port; off "
                              "localhost a token is required)")
     parser.add_argument("--seconds", type=float, default=None,
-                        help="serve this long, then stop (default: until Ctrl-C)")
+                        help="serve this many seconds (a number > 0), then stop (default: "
+                             "until Ctrl-C)")
 
 
 def run(args: argparse.Namespace) -> int:
-    """Serve the recording until Ctrl-C."""
+    """Serve the recording until Ctrl-C (or ``--seconds``)."""
+    from relrl.errors import ConfigError
     from relrl.monitor import start_replay
     from relrl.monitor.replay import Recording
 
+    if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds > 0):
+        raise ConfigError(f"--seconds must be a number of seconds > 0, not {args.seconds}")
     rec = Recording(args.folder)  # errors before the server starts
     server = start_replay(rec, args.address)
     try:

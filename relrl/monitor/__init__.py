@@ -23,11 +23,11 @@ __all__ = ["Hub", "StepView", "start_live", "start_replay"]
 
 
 def start_live(hub: Hub, address: str | None = None, token: str | None = None) -> Any:
-    """Serve the live page over ``hub``; returns the started
-    :class:`~relrl.monitor.server.MonitorServer`."""
-    from relrl.monitor.server import LiveSource, MonitorServer
+    """Serve the live page over ``hub`` from a process of its own; returns the started
+    :class:`~relrl.monitor.live.LiveServer`."""
+    from relrl.monitor.live import LiveServer
 
-    return MonitorServer(LiveSource(hub), address, token=token).start()
+    return LiveServer(hub, address, token=token).start()
 
 
 def start_replay(folder: Any, address: str | None = None, token: str | None = None) -> Any:

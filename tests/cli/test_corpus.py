@@ -187,6 +187,13 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
     ("demo-out-proc", ["demo", "--out", "/proc/foo"], ["/proc/foo"]),
     ("demo-workers", ["demo", "--workers", "0"], ["--workers", "0"]),
+    # ---- report ----------------------------------------------------------------------------
+    ("report-nothing", ["report"], ["run folders", "--update"]),
+    ("report-missing-run", ["report", "{d}/nope"], ["nope", "run folder"]),
+    ("report-not-a-run", ["report", "{d}/adir"], ["results.json", "no such file"]),
+    ("report-random-bytes", ["report", "{d}/random.toml"], ["random.toml", "run folder"]),
+    ("report-missing-markdown", ["report", "--check", "{d}/nope.md"], ["nope.md"]),
+    ("report-out-dir", ["report", "{d}/adir", "--out", "{d}/adir"], ["adir"]),
 ]
 
 
