@@ -363,6 +363,7 @@ _WRITES = re.compile(r"open\([^)]*['\"][wax]b?\+?['\"]|\.write_text\(|\.write_by
 #: the writes left alone, and why.
 _ELSEWHERE = {
     "relrl/speech.py": "the recogniser's grammar, in a private temporary folder",
+    "relrl/monitor/live.py": "the monitor process's OOM score (/proc/self/oom_score_adj)",
 }
 
 
