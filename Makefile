@@ -42,7 +42,7 @@ test: setup
 	$(BIN)/python -m pytest
 
 lint: setup
-	$(BIN)/ruff check relrl perception head tests
+	$(BIN)/ruff check relrl perception head tests bench
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -28,11 +28,14 @@ import itertools
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from relrl.bridge.marshal import Cached
 from relrl.errors import RelrlError
-from relrl.kb import Cached, KnowledgeBase
 from relrl.terms import Term, Var
+
+if TYPE_CHECKING:
+    from relrl.kb import KnowledgeBase
 
 __all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult", "mask_indices"]
 
@@ -176,7 +179,7 @@ class Engine:
 
     def step(self, percepts: Sequence[Term] | Cached, emitted: int = -1, mode: str = "learn",
              want: Iterable[str] = ()) -> StepResult:
-        """One control step: one gateway call (``relrl_gateway:gw_step/15``, the gateway's
+        """One control step: one gateway call (``relrl_gateway:gw_step/14``, the gateway's
         form of ``engine_step/6`` whose result Python reads field by field).
 
         Args:
