@@ -24,14 +24,15 @@ Example:
 
 from __future__ import annotations
 
+import contextlib
 import itertools
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from relrl.bridge.marshal import Cached
-from relrl.errors import RelrlError
+from relrl.errors import PolicyError, PrologError, RelrlError
 from relrl.terms import Term, Var
 
 if TYPE_CHECKING:
@@ -262,9 +263,11 @@ class Engine:
         """Replace the learned knowledge by the policy at ``path``, read as data.
 
         Raises:
-            PolicyError: the file is not this learner's policy for this domain (file:line).
+            PolicyError: the file is not this learner's policy for this domain (file:line),
+                or holds a term nested too deep to read.
         """
-        call(self.kb, "policy_load", self.module, str(path))
+        with _readable(path):
+            call(self.kb, "policy_load", self.module, str(path))
 
     # -- evaluation without side effects ----------------------------------------------------
 
@@ -288,9 +291,25 @@ def policy_learner(kb: KnowledgeBase, path: str | Path) -> str:
     """The learner named by a saved policy's first term (read as data).
 
     Raises:
-        PolicyError: not a relrl policy (file:line).
+        PolicyError: not a relrl policy (file:line), or a term nested too deep to read.
     """
-    return one(kb, "policy_learner", str(path))
+    with _readable(path):
+        return one(kb, "policy_learner", str(path))
+
+
+@contextlib.contextmanager
+def _readable(path: str | Path) -> Iterator[None]:
+    """Within the block, a term of the file at ``path`` nested too deep for the C stack
+    (reading it raised, as it does in plain swipl) is a :class:`PolicyError` naming it."""
+    try:
+        yield
+    except PrologError as exc:
+        term = exc.term
+        if isinstance(term, tuple) and len(term) > 1 and term[1] == ("resource_error",
+                                                                      "c_stack"):
+            raise PolicyError(f"{path}: a term nested too deep to read (the C stack ran "
+                              "out: some 10,000 levels)") from None
+        raise
 
 
 def _node_id(i: Term) -> str:
