@@ -174,20 +174,18 @@ class Prolog:
             finally:
                 self._flush_pending |= watchdog.disarm()
             v = io.tolist()
-            if status == k.DONE:
-                necessity = marshal.held(v[k.NECESSITY])
-                if necessity is not None:
-                    values = fo[:k.FIRST_OUTPUT + v[k.OUTPUTS]].tolist()
-                    return (v[k.CODE], necessity, values[k.FIRST_OUTPUT:], values[k.REWARD],
-                            v[k.REINFORCED] == self._true_atom, v[k.MASK], v[k.ACTION], None)
+            if status == k.DONE and (necessity := marshal.held(v[k.NECESSITY])):
+                values = fo[:k.FIRST_OUTPUT + v[k.OUTPUTS]].tolist()
+                return (v[k.CODE], necessity, values[k.FIRST_OUTPUT:], values[k.REWARD],
+                        v[k.REINFORCED] == self._true_atom, v[k.MASK], v[k.ACTION], None)
             mark = c_size_t()
             self.lib.mark_string_buffers(byref(mark))
             if status == k.RAISED:
                 self._raise_exception()
-            if status == k.DONE:      # every field read, but the necessity is not held
-                fields = [v[k.CODE], marshal.atom_name(v[k.NECESSITY])]
+            if status == k.DONE:                  # a necessity not held (Engine holds them)
                 values = fo[:k.FIRST_OUTPUT + v[k.OUTPUTS]].tolist()
-                return (*fields, values[k.FIRST_OUTPUT:], values[k.REWARD],
+                return (v[k.CODE], marshal.atom_name(v[k.NECESSITY]),
+                        values[k.FIRST_OUTPUT:], values[k.REWARD],
                         v[k.REINFORCED] == self._true_atom, v[k.MASK], v[k.ACTION], None)
             return self._step_rest(v[k.ARGS], timeout)
         finally:

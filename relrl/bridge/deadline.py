@@ -66,10 +66,10 @@ class Watchdog:
             os.set_blocking(fd, False)
         threading.Thread(target=self._watch, name="relrl-watchdog", daemon=True).start()
 
-    def arm(self, limit: float) -> None:
-        """A call with a time limit of ``limit`` seconds (0: none) starts."""
+    def arm(self, limit: float | None) -> None:
+        """A call with a time limit of ``limit`` seconds (0 or None: none) starts."""
         now = time.monotonic()
-        deadline = now + limit if limit > 0 else math.inf
+        deadline = now + limit if limit and limit > 0 else math.inf
         with self._lock:
             self._deadline = deadline
             self._raised = False

@@ -243,3 +243,29 @@ def test_compiled_calls_load_with_the_first_step_only() -> None:
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          timeout=120, check=True).stdout.split("\n")
     assert out[0] == "False" and out[1] == "True ('f', 'a', ['b'])"
+
+
+@pytest.mark.parametrize("module, above", [
+    ("relrl.bridge.lib", {"relrl.bridge.marshal", "relrl.bridge.calls"}),
+    ("relrl.bridge.marshal", {"relrl.bridge.calls"}),
+    ("relrl.bridge.calls", set()),
+    ("relrl.query", set()),
+    ("relrl.engine", set()),
+])
+def test_the_transport_imports_no_layer_above_it(module: str, above: set[str]) -> None:
+    """Layers import only the ones below them: bindings < terms < calls < the facade (kb)
+    and its typed front (engine) and user queries (query); none imports pyswip."""
+    import subprocess
+    import sys
+
+    code = f"import sys, {module}; print(sorted(m for m in sys.modules if m.startswith(" \
+           "('relrl.kb', 'relrl.loop', 'relrl.engine', 'relrl.query', 'relrl.bridge', 'pyswip'))))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = set(eval(out))
+    upper = {"relrl.kb", "relrl.loop", "pyswip"} | above
+    if module != "relrl.engine":
+        upper.add("relrl.engine")
+    if module != "relrl.query":
+        upper.add("relrl.query")
+    assert not loaded & upper, f"import {module} imported {sorted(loaded & upper)}"
