@@ -74,3 +74,19 @@ def test_cli_bad_flags(argv: list[str], message: str, capsys: pytest.CaptureFixt
                        ) -> None:
     assert main(["bench", *argv]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_harness_is_not_installed_with_the_package(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]
+                                                       ) -> None:
+    """bench/ is outside every package (pyproject's packages: relrl, perception, head; the
+    package data: relrl/prolog/*.pl); without it, --prolog-step says where it lives."""
+    import relrl.bench
+
+    root = Path(relrl.bench.__file__).resolve().parents[1]
+    assert not list((root / "prolog").glob("stepbench*")) and not (root / "relrl" /
+                                                                   "stepbench.py").exists()
+    monkeypatch.setattr(relrl.bench, "STEPBENCH", tmp_path / "stepbench.py")
+    assert main(["bench", "--prolog-step"]) == 2
+    assert "source tree" in capsys.readouterr().err
