@@ -1,22 +1,38 @@
 # Two commands do everything on a fresh Debian machine (Python 3.11, root):
-#   make demo   set up what is missing, then run the main job on the simulator
-#   make test   set up what is missing, then run the whole test suite
+#   make demo   set up what the demo needs, then run the main job on the simulator
+#   make test   set up what the tests need too, then run the whole test suite
+# Each installs only what is missing; both are quick the second time.
 PYTHON ?= python3.11
 VENV   := .venv
 BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.installed
 
-.PHONY: demo test setup swipl lint clean
+# What each job needs. Debian packages are installed only when missing, without their
+# recommended packages (swi-prolog-nox recommends a build tool chain relrl does not need).
+#   demo: SWI-Prolog (the knowledge layer) and the runtime with its plots.
+#   test: also espeak-ng (the synthetic caregiver words the speech tests recognise), graphviz
+#         (`dot`: the learned tree as a picture), libportaudio2 (the microphone, through
+#         sounddevice), chromium (the headless browser the monitor's tests drive; nothing
+#         downloads a browser) and the extras: speech, monitor, Ray, the test tools.
+DEMO_EXTRAS := plots
+TEST_EXTRAS := dev,speech,monitor,ray
 
-setup: swipl $(STAMP)
+.PHONY: demo test setup setup-demo setup-test debs-demo debs-test lint clean
 
-# Debian packages: SWI-Prolog (the knowledge layer), espeak-ng (the robot's voice, and
-# the synthetic caregiver words the speech tests recognise), graphviz (`dot`: the learned tree
-# as a picture), libportaudio2 (the microphone, through sounddevice) and chromium (the headless
-# browser the monitor's tests drive; nothing downloads a browser). Installed only when missing,
-# without recommended packages (swi-prolog-nox recommends a build tool chain relrl does not
-# need).
-swipl:
+setup: setup-test
+setup-demo: debs-demo $(VENV)/.installed-demo
+setup-test: debs-test $(VENV)/.installed-test
+
+# debs-demo / debs-test: `command -v` (or dpkg for a library) decides what is missing.
+debs-demo:
+	@missing=""; \
+	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing$$missing from Debian's packages"; \
+	  apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+	    apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+debs-test:
 	@missing=""; \
 	command -v swipl >/dev/null 2>&1 || missing="$$missing swi-prolog-nox"; \
 	command -v espeak-ng >/dev/null 2>&1 || missing="$$missing espeak-ng"; \
@@ -29,19 +45,26 @@ swipl:
 	    apt-get install -y -qq --no-install-recommends $$missing; \
 	fi
 
-$(STAMP): pyproject.toml Makefile
-	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+# One virtual environment; each job's stamp records that its extras are in it.
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
-	$(BIN)/pip install -q -e '.[dev,speech,monitor,ray]'
-	@touch $(STAMP)
 
-demo: setup
+$(VENV)/.installed-demo: pyproject.toml Makefile | $(BIN)/python
+	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS)]'
+	@touch $@
+
+$(VENV)/.installed-test: pyproject.toml Makefile | $(BIN)/python
+	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),$(TEST_EXTRAS)]'
+	@touch $@ $(VENV)/.installed-demo
+
+demo: setup-demo
 	$(BIN)/relrl demo
 
-test: setup
+test: setup-test
 	$(BIN)/python -m pytest
 
-lint: setup
+lint: setup-test
 	$(BIN)/ruff check relrl perception head tests bench
 
 clean:

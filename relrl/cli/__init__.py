@@ -33,6 +33,7 @@ SUBCOMMANDS: dict[str, str] = {
     "examples": "relrl.cli.examples",
     "replay": "relrl.cli.replay",
     "tree": "relrl.cli.tree",
+    "report": "relrl.cli.report",
 }
 
 

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from relrl.experiments.fruits import OUTCOMES, PAPER, merge_confusions, rates
+from relrl.machine import machine_info
 
 __all__ = ["main", "run_job", "summarise"]
 
@@ -305,7 +306,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2 if outcome.error else 130
     wall = outcome.seconds
     timing = {"wall_seconds": wall, "workers": args.workers,
-              "python": platform.python_version(),
+              "python": platform.python_version(), "machine_info": machine_info(),
               "jobs": [{"learner": j["learner"], "time_unit": j["time_unit"], "seed": j["seed"],
                         "seconds": j.pop("seconds")} for j in jobs]}
     script = Path(args.script).resolve()

@@ -9,6 +9,7 @@ from typing import Any
 from relrl.experiments.report import aggregate, write_outputs
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.sis import PAPER, SISConfig, job_from_curve, run_job
+from relrl.machine import machine_info
 
 __all__ = ["run_sis"]
 
@@ -62,7 +63,7 @@ def run_sis(config: SISConfig, out_dir: str | Path, *, workers: int = 1,
         t["steps_per_second"] = t["steps"] / t["seconds"] if t["seconds"] else 0.0
     timing = {"wall_seconds": outcome.seconds, "workers": workers, "engine": engine,
               "python": platform.python_version(), "machine": platform.machine(),
-              "jobs": timings}
+              "machine_info": machine_info(), "jobs": timings}
     results = {
         "experiment": "sis",
         "relrl_version": __version__,

@@ -17,6 +17,7 @@ from typing import Any
 from relrl.experiments.report import pyplot_or_note, skip_plots, write_json_atomic
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
+from relrl.machine import machine_info
 
 __all__ = ["run_scaling", "scaling_table"]
 
@@ -75,7 +76,7 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
         results["error"] = outcome.error
     timing = {"wall_seconds": outcome.seconds, "workers": workers, "engine": engine,
               "python": platform.python_version(), "machine": platform.machine(),
-              "jobs": timings}
+              "machine_info": machine_info(), "jobs": timings}
     files = write_outputs(out, results, timing)
     if outcome.error:
         raise_kept(outcome.error, out)

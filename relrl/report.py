@@ -1,0 +1,312 @@
+"""Results tables generated from the runs that produced them, never pasted.
+
+A run folder (what ``relrl experiment ...`` writes) holds ``results.json`` (every number and
+the configuration), ``timing.json`` (the machine and wall clock) and ``.relrl-run.json`` (the
+command and when it ran). :func:`render` turns a run into Markdown: a provenance line and the
+tables of one *view* (``summary``, ``short``, ...) of that experiment.
+
+In a Markdown file, a generated table sits between two comments naming its source::
+
+    <!-- relrl-report results/exp1 summary -->
+    ...
+    <!-- /relrl-report -->
+
+The path is relative to the Markdown file's folder. :func:`update_file` re-renders every such
+block in place (``relrl report --update README.md``); :func:`stale_blocks` lists the blocks
+that no longer match their source (``relrl report --check``; the test suite runs it on the
+shipped docs). Views are looked up in :data:`VIEWS` by (experiment, view); adding an
+experiment's tables touches its own renderer only.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from relrl.errors import UserError
+
+__all__ = ["Run", "VIEWS", "load_run", "render", "render_report", "stale_blocks",
+           "update_file", "view"]
+
+BLOCK = re.compile(r"<!-- relrl-report (?P<path>\S+) (?P<view>[\w-]+) -->\n"
+                   r"(?P<body>.*?)<!-- /relrl-report -->", re.S)
+
+
+@dataclass
+class Run:
+    """One run folder's records."""
+
+    path: Path
+    results: dict[str, Any]
+    timing: dict[str, Any] = field(default_factory=dict)
+    manifest: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def experiment(self) -> str:
+        """The experiment's name as results.json records it (``sis``, ``scaling``, ...)."""
+        return str(self.results.get("experiment", "?"))
+
+
+def _read_json(path: Path, *, required: bool) -> dict[str, Any]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        if required:
+            raise UserError(f"{path}: no such file (is this a run folder?)") from None
+        return {}
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserError(f"{path}: cannot read it ({exc})") from None
+    try:
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        where = f":{exc.lineno}" if isinstance(exc, json.JSONDecodeError) else ""
+        raise UserError(f"{path}{where}: not valid JSON ({exc})") from None
+    if not isinstance(data, dict):
+        raise UserError(f"{path}: expected a JSON object, found {type(data).__name__}")
+    return data
+
+
+def load_run(path: str | Path) -> Run:
+    """Read a run folder (or its ``results.json``)."""
+    folder = Path(path)
+    if folder.name == "results.json":
+        folder = folder.parent
+    if not folder.is_dir():
+        raise UserError(f"{folder}: not a run folder (no such folder)")
+    results = _read_json(folder / "results.json", required=True)
+    if "experiment" not in results:
+        raise UserError(f"{folder / 'results.json'}: no \"experiment\" key; "
+                        "not the results of a relrl experiment")
+    return Run(folder, results, _read_json(folder / "timing.json", required=False),
+               _read_json(folder / ".relrl-run.json", required=False))
+
+
+# ---- formatting helpers ---------------------------------------------------------------------
+
+
+def _f(x: Any, digits: int = 2) -> str:
+    if x is None:
+        return "—"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int):
+        return f"{x:,}"
+    if isinstance(x, float):
+        return f"{x:,.{digits}f}"
+    return str(x)
+
+
+def table(header: list[str], rows: list[list[Any]]) -> str:
+    """A Markdown table (values formatted by their type)."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(_f(v) if not isinstance(v, str) else v for v in row) + " |"
+              for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+def provenance(run: Run, label: str) -> str:
+    """The line that says where the numbers come from."""
+    from relrl.machine import describe
+
+    command = run.manifest.get("command") or run.results.get("command")
+    machine = run.timing.get("machine_info") or {"machine": run.timing.get("machine"),
+                                                  "python": run.timing.get("python")}
+    when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
+    line = f"*From `{label}/results.json`"
+    if command:
+        line += f", made by `{command}`"
+    line += f" on {describe(machine)}" + (f", {when}" if when else "")
+    if run.results.get("partial"):
+        line += " (**a partial run**: stopped before the end)"
+    return line + ".*\n"
+
+
+# ---- views ---------------------------------------------------------------------------------
+
+View = Callable[[Run], str]
+#: (experiment, view name) -> renderer. Each renderer returns the Markdown of its tables.
+VIEWS: dict[tuple[str, str], View] = {}
+
+
+def view(experiment: str, name: str) -> Callable[[View], View]:
+    """Register a renderer for ``(experiment, name)``."""
+    def register(fn: View) -> View:
+        VIEWS[(experiment, name)] = fn
+        return fn
+    return register
+
+
+def render(run: Run, name: str, label: str | None = None) -> str:
+    """The Markdown of one view of a run, with its provenance line."""
+    fn = VIEWS.get((run.experiment, name))
+    if fn is None:
+        known = sorted(v for e, v in VIEWS if e == run.experiment)
+        raise UserError(f"{run.path}: no view {name!r} of a {run.experiment!r} run "
+                        f"(known: {', '.join(known) or 'none'})")
+    return fn(run) + "\n" + provenance(run, label or str(run.path))
+
+
+def render_report(paths: list[str | Path], out: Path) -> str:
+    """A whole results page: every view of every run, each in its block (links relative to
+    ``out``'s folder), figures linked from the run folders."""
+    import os
+
+    parts = ["# Results\n\n",
+             "Generated by `relrl report` from the runs named in each block; "
+             "re-render with `relrl report --update` after new runs.\n"]
+    for p in paths:
+        run = load_run(p)
+        rel = Path(os.path.relpath(run.path.resolve(), out.resolve().parent)).as_posix()
+        names = [v for e, v in VIEWS if e == run.experiment and v != "short"]
+        parts.append(f"\n## {TITLES.get(run.experiment, run.experiment)} (`{rel}`)\n")
+        for name in names:
+            parts.append(f"\n<!-- relrl-report {rel} {name} -->\n"
+                         f"{render(run, name, rel)}<!-- /relrl-report -->\n")
+        for png in sorted(run.path.glob("*.png")):
+            parts.append(f"\n![{png.stem}]({rel}/{png.name})\n")
+    return "".join(parts)
+
+
+TITLES = {"sis": "Experiment 1: the learners in the Social Interactive Simulator",
+          "exp2": "Experiment 2: gaze following and declarative pointing with fruits",
+          "scaling": "Worlds that grow: the scaling benchmark"}
+
+
+def _blocks(md: Path) -> list[tuple[re.Match[str], str]]:
+    text = md.read_text(encoding="utf-8")
+    out = []
+    for m in BLOCK.finditer(text):
+        run = load_run(md.parent / m["path"])
+        out.append((m, render(run, m["view"], m["path"])))
+    return out
+
+
+def stale_blocks(md: str | Path) -> list[str]:
+    """The blocks of a Markdown file that differ from what their source renders now."""
+    md = Path(md)
+    return [f"{md}:{m.string.count(chr(10), 0, m.start()) + 1}: {m['path']} {m['view']}"
+            for m, fresh in _blocks(md) if m["body"] != fresh]
+
+
+def update_file(md: str | Path) -> int:
+    """Re-render every block of a Markdown file in place; the number of blocks changed."""
+    md = Path(md)
+    text = md.read_text(encoding="utf-8")
+    changed = 0
+    pieces, last = [], 0
+    for m, fresh in _blocks(md):
+        pieces.append(text[last:m.start("body")])
+        pieces.append(fresh)
+        changed += m["body"] != fresh
+        last = m.end("body")
+    pieces.append(text[last:])
+    if changed:
+        from relrl.outdir import write_atomic
+
+        write_atomic(md, "".join(pieces))
+    return changed
+
+
+# ---- Experiment 1 --------------------------------------------------------------------------
+
+
+def _pm(mean: float | None, std: float | None) -> str:
+    return "—" if mean is None else f"{mean:.2f} ± {std or 0:.2f}"
+
+
+def _run1(s: dict[str, Any]) -> tuple[float | None, float | None]:
+    c = s["curve"]
+    return (c[1]["cgi_mean"], c[1]["cgi_std"]) if len(c) > 1 else (None, None)
+
+
+@view("sis", "summary")
+def _sis_summary(run: Run) -> str:
+    r = run.results
+    cfg, summary = r["config"], r["summary"]
+    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), {cfg['points']} "
+            f"evaluation points of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
+            f"{cfg['block']} learning units between points; caregiver `{cfg['caregiver']}`"
+            + (f", preset `{cfg['preset']}`" if cfg.get("preset") else "") + ".\n\n")
+    rows = []
+    for name, s in summary.items():
+        m1, s1 = _run1(s)
+        last = s["curve"][-1]
+        rows.append([name, _pm(m1, s1), _pm(last["cgi_mean"], last["cgi_std"]),
+                     _f(s["cgi_literal_final"]),
+                     f"{s['eye_contacts']['mean']:.1f} / {s['eye_contacts']['opportunities']}",
+                     _f(round(s["memory"].get("positions", 0))), _f(s.get("states_met"), 0)])
+    return head + table(["learner", "CGI after run 1", "CGI final", "final, Eq. 5 literally",
+                         "eye contacts (first opportunities)", "memory (positions)",
+                         "states met"], rows)
+
+
+@view("sis", "short")
+def _sis_short(run: Run) -> str:
+    paper = run.results.get("paper", {})
+    rows = []
+    for name, s in run.results["summary"].items():
+        m1, _ = _run1(s)
+        rows.append([name, _f(m1), _f(s["cgi_final"]), f"{s['eye_contacts']['mean']:.0f}",
+                     _f(round(s["memory"].get("positions", 0)))])
+    mem = paper.get("memory_positions", {})
+    rows.append(["*paper (2012)*", "≈ 0.8 (all)", "C flat; Q, ETG rise", "C most, Q fewest",
+                 f"Q {mem.get('qlearning', '—'):,}; ETG {mem.get('etg', '—')}"
+                 if mem else "—"])
+    return table(["learner", "CGI after run 1", "CGI final", "eye contacts", "positions"], rows)
+
+
+# ---- Experiment 2 --------------------------------------------------------------------------
+
+
+@view("exp2", "table1")
+def _exp2_table1(run: Run) -> str:
+    r = run.results
+    paper = r.get("paper", {}).get("table1", {})
+    keys = sorted(r["summary"])
+    outcomes = list(paper) or sorted({o for k in keys
+                                      for o in r["summary"][k]["table1"]["all_executions"]})
+    header = ["measure (%)", "paper"] + keys
+    rows = []
+    for o in outcomes:
+        p = paper.get(o)
+        row = [o.replace("_", " "), f"{p[0]} ± {p[1]}" if p else "—"]
+        for k in keys:
+            v = r["summary"][k]["table1"]["all_executions"].get(o)
+            row.append(f"{v[0]:.2f} ± {v[1]:.2f}" if v else "—")
+        rows.append(row)
+    return table(header, rows)
+
+
+@view("exp2", "fig6")
+def _exp2_fig6(run: Run) -> str:
+    keys = sorted(run.results["summary"])
+    units = sorted({p["units"] for k in keys for p in run.results["summary"][k]["fig6"]})
+    rows = []
+    for u in units:
+        row: list[Any] = [u]
+        for k in keys:
+            pt = next((p for p in run.results["summary"][k]["fig6"] if p["units"] == u), None)
+            row.append(_pm(pt["cgi_mean"], pt["cgi_sd_over_seeds"]) if pt else "—")
+        rows.append(row)
+    return table(["learning units"] + [f"CGI {k}" for k in keys], rows)
+
+
+@view("exp2", "short")
+def _exp2_short(run: Run) -> str:
+    r = run.results
+    paper = r.get("paper", {}).get("table1", {})
+    rows = []
+    for k in sorted(r["summary"]):
+        s = r["summary"][k]
+        fig6 = s["fig6"]
+        t1 = s["table1"]["all_executions"]
+        rows.append([k, _f(fig6[-1]["cgi_mean"]) if fig6 else "—",
+                     f"{t1['success'][0]:.1f}" if "success" in t1 else "—"])
+    if "success" in paper:
+        rows.append(["*paper (2012)*", "rises, then flat", f"{paper['success'][0]}"])
+    return table(["learner / time unit", "final CGI (Fig. 6)", "success rate % (Table 1)"],
+                 rows)

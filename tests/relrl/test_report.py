@@ -1,0 +1,94 @@
+"""``relrl report``: tables rendered from the runs that made them; generated blocks in a
+Markdown file re-rendered in place and checked for staleness; the shipped docs' blocks match
+the results.json files they cite."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from relrl.cli import main
+from relrl.errors import UserError
+from relrl.report import load_run, render, stale_blocks, update_file
+from tests.conftest import ROOT
+
+
+@pytest.fixture(scope="module")
+def sis_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("report") / "exp1"
+    assert main(["-q", "experiment", "sis", "--learners", "etg,tg", "--points", "2",
+                 "--eval-runs", "1", "--eval-steps", "50", "--block", "50", "--workers", "1",
+                 "--out", str(out)]) == 0
+    return out
+
+
+def test_a_run_renders_its_numbers_and_where_they_come_from(sis_run: Path) -> None:
+    run = load_run(sis_run)
+    text = render(run, "summary", "exp1")
+    results = json.loads((sis_run / "results.json").read_text())
+    for name, s in results["summary"].items():
+        row = next(line for line in text.splitlines() if line.startswith(f"| {name} |"))
+        assert f"{s['cgi_final']:.2f}" in row
+    assert "`exp1/results.json`" in text
+    assert "relrl -q experiment sis" in text          # the command, from the run record
+    assert "cores" in text                             # the machine, from timing.json
+    short = render(run, "short", "exp1")
+    assert "paper (2012)" in short and "3,150" in short
+
+
+def test_blocks_are_rerendered_in_place_and_staleness_is_found(sis_run: Path,
+                                                               tmp_path: Path) -> None:
+    shutil.copytree(sis_run, tmp_path / "exp1")
+    md = tmp_path / "doc.md"
+    md.write_text("# Doc\n\nbefore\n<!-- relrl-report exp1 short -->\nold table\n"
+                  "<!-- /relrl-report -->\nafter\n", encoding="utf-8")
+    assert stale_blocks(md) == [f"{md}:4: exp1 short"]
+    assert update_file(md) == 1
+    text = md.read_text()
+    assert text.startswith("# Doc\n\nbefore\n") and text.endswith("after\n")
+    assert "old table" not in text and stale_blocks(md) == [] and update_file(md) == 0
+    # a new number in the run makes the block stale again
+    results = json.loads((tmp_path / "exp1" / "results.json").read_text())
+    first = next(iter(results["summary"]))
+    results["summary"][first]["cgi_final"] = 0.123
+    (tmp_path / "exp1" / "results.json").write_text(json.dumps(results))
+    assert len(stale_blocks(md)) == 1
+    assert main(["report", "--check", str(md)]) == 1
+    assert main(["report", "--update", str(md)]) == 0
+    assert "0.12" in md.read_text() and main(["report", "--check", str(md)]) == 0
+
+
+def test_a_results_page_holds_every_view(sis_run: Path, tmp_path: Path) -> None:
+    out = tmp_path / "docs" / "results.md"
+    assert main(["report", str(sis_run), "--out", str(out)]) == 0
+    assert stale_blocks(out) == []
+    assert "<!-- relrl-report" in out.read_text() and "fig5_cgi.png" in out.read_text()
+
+
+@pytest.mark.parametrize("content, words", [
+    (None, ["results.json", "no such file"]),
+    ("{not json", ["results.json:1", "not valid JSON"]),
+    ("[1, 2]", ["JSON object"]),
+    ('{"a": 1}', ["experiment"]),
+])
+def test_bad_run_folders_are_one_line(tmp_path: Path, content: str | None,
+                                      words: list[str]) -> None:
+    if content is not None:
+        (tmp_path / "results.json").write_text(content)
+    with pytest.raises(UserError) as err:
+        load_run(tmp_path)
+    assert all(w in str(err.value) for w in words) and "\n" not in str(err.value)
+
+
+def test_an_unknown_view_names_the_known_ones(sis_run: Path) -> None:
+    with pytest.raises(UserError, match="summary"):
+        render(load_run(sis_run), "nope")
+
+
+def test_shipped_docs_match_the_runs_they_cite() -> None:
+    docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    stale = [line for md in docs for line in stale_blocks(md)]
+    assert stale == [], "re-render with `relrl report --update FILE.md`:\n" + "\n".join(stale)
