@@ -137,7 +137,7 @@ def start(boot: Callable[[Lib], None]) -> Lib:
         if _lib is None:
             path, home = _find()
             cdll = ctypes.CDLL(path, mode=os.RTLD_GLOBAL)   # foreign packages link to it
-            argv = [b"relrl", f"--home={home}".encode(), b"--quiet"] + ([b"--no-signals"] if os.environ.get("XNOSIG") else []) + [
+            argv = [b"relrl", f"--home={home}".encode(), b"--quiet",
                     f"--stack-limit={STACK_LIMIT}".encode()]
             cdll.PL_initialise.argtypes = [c_int, POINTER(c_char_p)]
             lib = Lib(cdll, path)
