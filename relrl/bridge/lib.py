@@ -33,7 +33,6 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from ctypes import POINTER, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
-from typing import Any
 
 from relrl.errors import RelrlError
 
@@ -98,9 +97,6 @@ class Lib:
                 f = getattr(view, name)
                 f.restype, f.argtypes = restype, argtypes
                 setattr(self, name[3:], f)
-
-    def __getattr__(self, name: str) -> Any:   # for the type checker: set in __init__
-        raise AttributeError(name)
 
 
 def _find() -> tuple[str, str]:
