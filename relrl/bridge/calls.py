@@ -78,6 +78,7 @@ class Prolog:
         """
         self._check_thread()
         lib, marshal = self.lib, self.marshal
+        lib.keep_c_stack_guard()
         mark = c_size_t()
         lib.mark_string_buffers(byref(mark))
         fid = lib.open_foreign_frame()
@@ -241,6 +242,7 @@ class Query:
                  arguments: Sequence[Term]) -> None:
         module, name = predicate
         lib = self._lib = prolog.lib
+        lib.keep_c_stack_guard()
         self._prolog = prolog
         self._fid = lib.open_foreign_frame()
         n = len(arguments) + 1

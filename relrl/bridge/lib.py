@@ -85,18 +85,25 @@ class Lib:
 
     Attributes:
         path: the shared library; ``thread``: the Python thread that started Prolog (the
-            only one that may call it).
+            only one that may call it); ``segv``: SWI-Prolog's SIGSEGV handler.
     """
 
     def __init__(self, cdll: ctypes.CDLL, path: str) -> None:
         self.path = path
         self.thread = threading.get_ident()
+        self.segv: ctypes.Array[ctypes.c_char] | None = None
         quick = ctypes.PyDLL(path, handle=cdll._handle)
         for table, view in ((_QUICK, quick), (_RUNS_PROLOG, cdll)):
             for name, (restype, *argtypes) in table.items():
                 f = getattr(view, name)
                 f.restype, f.argtypes = restype, argtypes
                 setattr(self, name[3:], f)
+
+    def keep_c_stack_guard(self) -> None:
+        """Put SWI-Prolog's C-stack guard back in SIGSEGV if a library installed another
+        handler since (Ray does): before a call that may read text from outside."""
+        if self.segv is not None and _sigaction(signal.SIGSEGV).raw[:8] != self.segv.raw[:8]:
+            _LIBC.sigaction(signal.SIGSEGV, self.segv, None)
 
 
 def _find() -> tuple[str, str]:
@@ -141,6 +148,7 @@ def start(boot: Callable[[Lib], None]) -> Lib:
                 if not cdll.PL_initialise(len(argv), (c_char_p * len(argv))(*argv)):
                     raise RelrlError(f"SWI-Prolog ({path}) did not start")
                 boot(lib)
+            lib.segv = _sigaction(signal.SIGSEGV)
             _lib = lib
     return _lib
 
@@ -150,20 +158,25 @@ def start(boot: Callable[[Lib], None]) -> Lib:
 PROLOG_SIGNALS = (signal.SIGSEGV, signal.SIGUSR2)
 
 
+_LIBC = ctypes.CDLL(None)
+
+
+def _sigaction(sig: int) -> ctypes.Array[ctypes.c_char]:
+    """The handler of ``sig`` as the bytes of a ``struct sigaction`` (the handler first)."""
+    action = ctypes.create_string_buffer(512)          # with room to spare
+    _LIBC.sigaction(sig, None, action)
+    return action
+
+
 @contextmanager
 def _python_signals() -> Iterator[None]:
     """Every signal but :data:`PROLOG_SIGNALS` keeps the handler it had before the block
     (Python's, faulthandler's, the default), whatever SWI-Prolog installs in it."""
-    libc = ctypes.CDLL(None, use_errno=True)
-    saved = {}
-    for sig in range(1, signal.NSIG):
-        if sig not in PROLOG_SIGNALS and sig not in (signal.SIGKILL, signal.SIGSTOP):
-            old = ctypes.create_string_buffer(512)        # struct sigaction, copied whole
-            if libc.sigaction(sig, None, old) == 0:
-                saved[sig] = old
+    saved = {sig: _sigaction(sig) for sig in range(1, signal.NSIG)
+             if sig not in (*PROLOG_SIGNALS, signal.SIGKILL, signal.SIGSTOP)}
     try:
         yield
     finally:
-        for sig, old in saved.items():
-            libc.sigaction(sig, old, None)
+        for sig, action in saved.items():
+            _LIBC.sigaction(sig, action, None)
 
