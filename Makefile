@@ -66,7 +66,7 @@ test: setup-test
 	$(BIN)/python -m pytest
 
 lint: setup-test
-	$(BIN)/ruff check relrl perception head tests
+	$(BIN)/ruff check relrl perception head tests bench
 
 clean:
 	rm -rf $(VENV) build *.egg-info

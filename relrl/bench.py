@@ -4,8 +4,9 @@
 * steps per second of each learner driving the Social Interactive Simulator (a fixed,
   seeded synthetic environment), learning on, and the gateway calls per step;
 * the Prolog side of an ETG step alone: the same seeded run recorded and replayed in plain
-  swipl, every decision checked (relrl.stepbench), CPU microseconds and inferences per step,
-  called directly and through the gateway's time-limited call;
+  swipl, every decision checked (``bench/stepbench.py``, a harness of the source tree: from an
+  installed package without it this figure is skipped), CPU microseconds and inferences per
+  step, called directly and through the gateway's guarded call;
 * the simulator's own step rate;
 * ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
 * a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
@@ -30,11 +31,51 @@ search), with one thread and with two (wall clock, and on two free cores).
 
 from __future__ import annotations
 
+import importlib.util
 import statistics
 import time
+from pathlib import Path
+from types import ModuleType
 from typing import Any
 
-__all__ = ["bench_engine", "bench_all"]
+from relrl.errors import ConfigError
+
+__all__ = ["bench_engine", "bench_all", "measure_call_cost", "stepbench"]
+
+#: The harness that replays a step's Prolog side in plain swipl: source tree only.
+STEPBENCH = Path(__file__).resolve().parents[1] / "bench" / "stepbench.py"
+
+
+def stepbench() -> ModuleType:
+    """The source tree's harness of the Prolog side of a step (``bench/stepbench.py``).
+
+    Raises:
+        ConfigError: relrl runs from an installed package, without its source tree.
+    """
+    if not STEPBENCH.is_file():
+        raise ConfigError(f"the Prolog side of a step is measured from relrl's source tree "
+                          f"({STEPBENCH} is not part of the installed package): run relrl "
+                          "from a checkout (pip install -e .)")
+    spec = importlib.util.spec_from_file_location("relrl_stepbench", STEPBENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def measure_call_cost(n: int = 2000) -> float:
+    """Seconds per gateway call with one binding (``relrl_state:state_code``-sized work)."""
+    from relrl.engine import GOALS
+    from relrl.kb import KnowledgeBase
+    from relrl.terms import Var
+
+    with KnowledgeBase() as kb:
+        goal = GOALS["wm_clock"]
+        kb.call(goal, kb.module, Var())
+        t0 = time.perf_counter()
+        for _ in range(n):
+            kb.call(goal, kb.module, Var())
+        return (time.perf_counter() - t0) / n
 
 
 def bench_engine(learner: str, steps: int = 5000, seed: int = 0) -> dict[str, float]:
@@ -86,7 +127,6 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     import platform
 
     from relrl import __version__
-    from relrl.kb import measure_call_cost
     from relrl.sim.policies import bench_step_rate
 
     out: dict[str, Any] = {"relrl_version": __version__, "python": platform.python_version(),
@@ -115,15 +155,17 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
 
     out["tg_step_by_size"] = step_cost_by_size("tg", (5, 129), warmup=min(3000, 10 * steps),
                                                block=max(50, steps // 10), blocks=6)
-    from relrl.stepbench import bench_prolog_step
-
-    replayed = bench_prolog_step("etg", steps=steps)
-    out["etg_prolog_side"] = {
-        "steps": replayed["steps"], "passes": replayed["passes"],
-        "cpu_us_per_step": replayed["direct"]["cpu_us_per_step"],
-        "inferences_per_step": replayed["direct"]["inferences_per_step"],
-        "gateway_cpu_us_per_step": replayed["gateway"]["cpu_us_per_step"],
-        "in_gateway_calls": replayed["direct"]["cpu_us_per_step"] / out["gateway_call_us"]}
+    try:
+        replayed = stepbench().bench_prolog_step("etg", steps=steps)
+    except ConfigError as exc:
+        out["etg_prolog_side"] = {"skipped": str(exc)}
+    else:
+        out["etg_prolog_side"] = {
+            "steps": replayed["steps"], "passes": replayed["passes"],
+            "cpu_us_per_step": replayed["direct"]["cpu_us_per_step"],
+            "inferences_per_step": replayed["direct"]["inferences_per_step"],
+            "gateway_cpu_us_per_step": replayed["gateway"]["cpu_us_per_step"],
+            "in_gateway_calls": replayed["direct"]["cpu_us_per_step"] / out["gateway_call_us"]}
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
     from relrl.monitor.bench import bench_monitor
 

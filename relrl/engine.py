@@ -24,15 +24,19 @@ Example:
 
 from __future__ import annotations
 
+import contextlib
 import itertools
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from relrl.errors import PolicyError, QueryTimeout, RelrlError
-from relrl.kb import Cached, KnowledgeBase
+from relrl.bridge.marshal import Cached
+from relrl.errors import PolicyError, PrologError, QueryTimeout, RelrlError
 from relrl.terms import Term, Var
+
+if TYPE_CHECKING:
+    from relrl.kb import KnowledgeBase
 
 __all__ = ["ALL_ALLOWED", "GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult",
            "mask_indices", "POLICY_BYTES_PER_POSITION", "POLICY_SECONDS_PER_MB"]
@@ -190,7 +194,7 @@ class Engine:
 
     def step(self, percepts: Sequence[Term] | Cached, emitted: int = -1, mode: str = "learn",
              want: Iterable[str] = ()) -> StepResult:
-        """One control step: one gateway call (``relrl_gateway:gw_step/15``, the gateway's
+        """One control step: one gateway call (``relrl_gateway:gw_step/14``, the gateway's
         form of ``engine_step/6`` whose result Python reads field by field).
 
         Args:
@@ -295,7 +299,7 @@ class Engine:
 
         Raises:
             PolicyError: the file is not this learner's policy for this domain (file:line),
-                or reading it took longer than that.
+                or holds a term nested too deep to read, or reading it took longer than that.
         """
         try:
             size = Path(path).stat().st_size
@@ -303,7 +307,8 @@ class Engine:
             size = 0  # policy_load names the missing file
         limit = self.kb.timeout + POLICY_SECONDS_PER_MB * size / 1e6
         try:
-            call(self.kb, "policy_load", self.module, str(path), timeout=limit)
+            with _readable(path):
+                call(self.kb, "policy_load", self.module, str(path), timeout=limit)
         except QueryTimeout as exc:
             if exc.rule is not None:   # a rule of the domain never ended: its message names it
                 raise
@@ -332,9 +337,25 @@ def policy_learner(kb: KnowledgeBase, path: str | Path) -> str:
     """The learner named by a saved policy's first term (read as data).
 
     Raises:
-        PolicyError: not a relrl policy (file:line).
+        PolicyError: not a relrl policy (file:line), or a term nested too deep to read.
     """
-    return one(kb, "policy_learner", str(path))
+    with _readable(path):
+        return one(kb, "policy_learner", str(path))
+
+
+@contextlib.contextmanager
+def _readable(path: str | Path) -> Iterator[None]:
+    """Within the block, a term of the file at ``path`` nested too deep for the C stack
+    (reading it raised, as it does in plain swipl) is a :class:`PolicyError` naming it."""
+    try:
+        yield
+    except PrologError as exc:
+        term = exc.term
+        if isinstance(term, tuple) and len(term) > 1 and term[1] == ("resource_error",
+                                                                      "c_stack"):
+            raise PolicyError(f"{path}: a term nested too deep to read (the C stack ran "
+                              "out: some 10,000 levels)") from None
+        raise
 
 
 def _node_id(i: Term) -> str:

@@ -1,27 +1,23 @@
-"""A user's query, one answer at a time (``relrl shell``): part of the gateway.
+"""A user's query, one answer at a time, as at swipl's toplevel (``relrl shell``).
 
-This module extends :mod:`relrl.kb`, the one transport to Prolog: it keeps a query open in
-Prolog between its answers (PL_open_query / PL_next_solution / PL_close_query) through the
-process's one engine, and imports nothing of pyswip itself.
+Prolog keeps the query open between its answers (``prolog/toplevel.pl``'s ``gw_answer/4``
+through :class:`relrl.bridge.calls.Query`): each :meth:`OpenQuery.next` resumes it for one
+more answer under the time limit, so output the goal writes comes out in order with the
+answers and an endless generator costs nothing until asked. Answers are written by
+Prolog's own writer: no term crosses the bridge.
 """
 
 from __future__ import annotations
 
-import threading
-from ctypes import byref, c_int, c_size_t, c_void_p
 from dataclasses import dataclass
-from typing import Any
 
-from relrl.errors import ConfigError, PrologError, RelrlError
-from relrl.kb import (
-    _PL_Q_CATCH_EXCEPTION,
-    _PL_Q_NODEBUG,
-    Aborted,
-    KnowledgeBase,
-    _raise_result,
-)
+from relrl.bridge.calls import Query, check_result, prolog
+from relrl.errors import ConfigError
+from relrl.terms import Term
 
 __all__ = ["Answer", "OpenQuery"]
+
+_MODES = ("write", "print", "values")
 
 
 @dataclass(frozen=True)
@@ -32,57 +28,43 @@ class Answer:
         text: the bindings as swipl's toplevel writes them (cycles factorized, deep terms
             written to depth 10 unless asked otherwise), ``""`` when there are none.
         last: no further answer can follow (the goal left no choice point).
+        bindings: with mode ``"values"``, ``(name, value, printed)`` for each named
+            variable (a value too deep or cyclic for Python is its printed text).
     """
 
     text: str
     last: bool
+    bindings: tuple[tuple[str, Term, str], ...] = ()
 
 
 class OpenQuery:
-    """A user's query kept open between its answers (see :meth:`KnowledgeBase.open_query`).
+    """A user's query kept open between its answers (see
+    :meth:`relrl.kb.KnowledgeBase.open_query`). Close it, or use it as a context manager.
 
-    Prolog keeps the query (PL_open_query/PL_next_solution/PL_close_query): each
-    :meth:`next` resumes it for one more answer under the time limit, so output the goal
-    writes comes out in order with the answers and an endless generator costs nothing until
-    asked. Answers are written by Prolog's own writer; no term crosses the bridge. Only one
-    query is open at a time; other gateway calls may run while it is open.
+    Args:
+        module: the knowledge base's module.
+        text: the query, with or without its final full stop.
+        timeout: seconds each answer may take (positive: a user's query is always
+            bounded); the clock stops between answers.
+        mode: ``"print"`` writes terms to depth 10 (swipl's default), ``"write"`` whole;
+            ``"values"`` gives the bindings as values instead of text.
     """
 
-    def __init__(self, kb: KnowledgeBase, text: str, timeout: float,
-                 mode: str = "print") -> None:
-        if mode not in ("write", "print"):
-            raise ValueError(f"mode {mode!r}: use 'write' or 'print'")
+    def __init__(self, module: str, text: str, timeout: float, mode: str = "print") -> None:
+        if mode not in _MODES:
+            raise ValueError(f"mode {mode!r}: use one of {', '.join(_MODES)}")
         if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
                 or not 0 < timeout < float("inf"):
             raise ConfigError(f"time limit {timeout!r}: use a positive number of seconds")
-        engine = kb._engine
-        if threading.get_ident() != engine.thread:
-            raise RelrlError("the Prolog engine belongs to the thread that started it")
         self.timeout = float(timeout)
-        self._engine = engine
-        lib = engine.lib
-        self._open = _bind(lib, "PL_open_query", c_void_p, c_void_p, c_int, c_void_p, c_size_t)
-        self._next = _bind(lib, "PL_next_solution", c_int, c_void_p)
-        self._close = _bind(lib, "PL_close_query", c_int, c_void_p)
         text = text.strip()
-        if text.endswith("."):
-            text = text[:-1]
-        self._fid = engine.open_frame()
-        self._args = engine.new_term_refs(5)
-        engine.put(self._args, kb.module, {})
-        engine.put(self._args + 1, text, {})
-        engine.put_float(self._args + 2, self.timeout)
-        engine.put(self._args + 3, mode, {})
-        engine.put_variable(self._args + 4)
-        pred = engine.predicate(b"gw_answer", 5, b"relrl_gateway")
-        engine.calls += 1
-        self._qid: int | None = self._open(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION, pred,
-                                           self._args)
+        self._query: Query = prolog().open(("relrl_gateway", "gw_answer"),
+                                           [module, text.removesuffix("."), mode])
 
     @property
     def closed(self) -> bool:
         """True once the query has no more answers or was closed."""
-        return self._qid is None
+        return self._query.closed
 
     def next(self) -> Answer | None:
         """The next answer, or None when there is none (the query is then closed).
@@ -91,74 +73,35 @@ class OpenQuery:
             QueryTimeout: this answer took longer than the time limit.
             PrologError, RuleError, UserError: the query raised (the query is then closed).
         """
-        if self._qid is None:
+        result = self._query.next(self.timeout)
+        if result is None:
             return None
-        engine = self._engine
-        mark = c_size_t()
-        engine.mark_strings(byref(mark))
-        try:
-            engine.calls += 1
-            engine.busy = True
-            try:
-                more = self._next(self._qid)
-            finally:
-                engine.busy = False
-            if not more:
-                ex = engine.exception(self._qid)
-                detail = engine.get(ex) if ex else None
-                self.close()
-                if detail is None:
-                    return None
-                if detail == "$aborted":
-                    raise Aborted(None, None)
-                raise PrologError(f"query failed: {detail!r}", detail)
-            result = engine.get(self._args + 4)
-        finally:
-            engine.release_strings(mark.value)
-        if isinstance(result, tuple) and result[0] == "error":
+        if result[0] == "error":
             self.close()
-            _raise_result(result, self.timeout)
-        _, text, det = result  # type: ignore[misc]
+            check_result(result, self.timeout)
+        _, text, det, bindings = result
         if det == "true":
             self.close()
-        return Answer(str(text), det == "true")
+        return Answer(str(text), det == "true",
+                      tuple((name, value, printed) for (_, (_, name, value), printed)
+                            in bindings))
 
     def again(self, mode: str) -> Answer | None:
         """The current answer written again: ``"write"`` (whole terms, as swipl's ``w``) or
         ``"print"`` (to depth 10, as ``p``); the mode stays for later answers."""
         if mode not in ("write", "print"):
             raise ValueError(f"mode {mode!r}: use 'write' or 'print'")
-        if self._qid is None:
+        if self.closed:
             return None
-        engine = self._engine
-        fid = engine.open_frame()
-        try:
-            t = engine.new_term_ref()
-            engine.put(t, mode, {})
-            pred = engine.predicate(b"gw_answer_again", 1, b"relrl_gateway")
-            engine.call_predicate(None, _PL_Q_NODEBUG | _PL_Q_CATCH_EXCEPTION, pred, t)
-        finally:
-            engine.discard_frame(fid)
+        prolog().run((":", "relrl_gateway", ("gw_answer_again", mode)), self.timeout)
         return self.next()
 
     def close(self) -> None:
         """Discard the query and its remaining answers. Safe to call twice."""
-        if self._qid is not None:
-            qid, self._qid = self._qid, None
-            self._close(qid)
-            self._engine.discard_frame(self._fid)
+        self._query.close()
 
     def __enter__(self) -> OpenQuery:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _bind(lib: Any, name: str, restype: Any, *argtypes: Any) -> Any:
-    f = getattr(lib, name)
-    f.restype = restype
-    f.argtypes = list(argtypes)
-    return f
-
-

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+from relrl.bridge.calls import display_path as _display_path
 from relrl.errors import ConfigError
-from relrl.kb import KnowledgeBase, _display_path
+from relrl.kb import KnowledgeBase
 from relrl.terms import Term, Var, format_term
 
 __all__ = ["validate", "describe", "world_warnings", "bias_warnings", "unread_percepts",

@@ -32,21 +32,3 @@ def default_signals() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
 
 
-
-@pytest.fixture(params=["kernel", "ctypes"])
-def crossing(request: pytest.FixtureRequest):
-    """Run a test twice: with the gateway's compiled calls (the control step,
-    relrl._step_kernel, and the term reader, relrl._read_kernel) and through ctypes alone
-    (as without numba). Yields the name of the crossing."""
-    from relrl.kb import _get_engine
-
-    engine = _get_engine()
-    kernel = engine._load_kernel()
-    flatten = engine._flatten
-    assert kernel and flatten, "numba is a dependency: the compiled calls must load"
-    on = request.param == "kernel"
-    engine._kernel, engine._flatten = (kernel, flatten) if on else (False, False)
-    try:
-        yield request.param
-    finally:
-        engine._kernel, engine._flatten = kernel, flatten

@@ -4,7 +4,7 @@ the Gymnasium environment work from another folder, with nothing read from the s
 
 Offline and cache-friendly: the wheel is built with ``--no-build-isolation --no-deps
 --no-index`` from a copy of the checkout's files, and the fresh environment sees the test
-suite's site-packages (pyswip, numpy, gymnasium, ...) through a ``.pth`` line, which does not
+suite's site-packages (numpy, numba, gymnasium, ...) through a ``.pth`` line, which does not
 run that environment's editable-install hook: ``relrl``, ``head`` and ``perception``
 come from the wheel alone.
 """

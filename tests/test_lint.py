@@ -12,6 +12,6 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_ruff_clean() -> None:
     ruff = shutil.which("ruff") or str(Path(sys.executable).parent / "ruff")
-    proc = subprocess.run([ruff, "check", "relrl", "perception", "head", "tests"],
+    proc = subprocess.run([ruff, "check", "relrl", "perception", "head", "tests", "bench"],
                           capture_output=True, text=True, cwd=ROOT, check=False)
     assert proc.returncode == 0, proc.stdout + proc.stderr

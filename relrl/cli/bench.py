@@ -68,12 +68,13 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _prolog_step(args: argparse.Namespace) -> dict:
-    """``--prolog-step``: the figures of relrl.stepbench, printed (the profile as a table)."""
+    """``--prolog-step``: the figures of the source tree's bench/stepbench.py, printed (the
+    profile as a table)."""
+    from relrl.bench import stepbench
     from relrl.learners import make_learner
-    from relrl.stepbench import bench_prolog_step
 
     make_learner(args.learner)  # an unknown name is a ConfigError before any work
-    figures = bench_prolog_step(args.learner, steps=args.steps, profile=args.profile,
+    figures = stepbench().bench_prolog_step(args.learner, steps=args.steps, profile=args.profile,
                                 top=args.top)
     profile = figures.pop("profile", None)
     _print(figures)

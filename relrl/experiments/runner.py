@@ -3,7 +3,7 @@
 A *job* is a top-level function called as ``fn(*args, report=report)``; it returns a
 JSON-ready dict and may call ``report(event)`` with small dicts as it goes (``{"kind":
 "point", ...}`` for a finished evaluation point, which also advances the progress bar). Each
-job runs in a process of its own Prolog engine (pyswip allows one per process).
+job runs in a process of its own Prolog engine (SWI-Prolog embedded: one per process).
 
 Engines are looked up by name (:data:`ENGINES`): ``local`` (the default; spawned worker
 processes on this machine) and ``ray`` (:mod:`relrl.experiments.ray_engine`; the same jobs on

@@ -24,7 +24,7 @@ def _term(value: object) -> object:
 
 
 @pytest.mark.parametrize("learner", sorted(GOLDEN["runs"]))
-def test_replayed_stream_gives_the_recorded_decisions(learner: str, crossing: str) -> None:
+def test_replayed_stream_gives_the_recorded_decisions(learner: str) -> None:
     run = GOLDEN["runs"][learner]
     percepts = [_term(p) for p in GOLDEN["percepts"]]
     with KnowledgeBase(ROOT / GOLDEN["domain"]) as kb:

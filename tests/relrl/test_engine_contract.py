@@ -128,7 +128,7 @@ def test_abort_in_a_goal_or_a_step_leaves_no_deadline_behind(tmp_path: Path) -> 
         assert agent.step([("see", "face")]).action is not None
 
 
-def test_deep_and_cyclic_terms(tmp_path: Path, crossing: str) -> None:
+def test_deep_and_cyclic_terms(tmp_path: Path) -> None:
     path = domain(tmp_path, BASE + "cyc(X) :- X = f(X).\n"
                                    "deep(0, z) :- !.\ndeep(N, f(T)) :- M is N-1, deep(M, T).\n")
     with KnowledgeBase(path) as kb:
@@ -234,7 +234,7 @@ def test_preserved_leaves_learning_as_it_was() -> None:
 def test_goal_table_is_the_gateway_api() -> None:
     api = set(re.findall(r"^python_api\((\w+:\w+)/\d+\)\.", GATEWAY.read_text(), re.M))
     transport = {"relrl_gateway:gw_new_kb", "relrl_gateway:gw_drop_kb",
-                 "relrl_gateway:gw_load", "relrl_gateway:gw_query",
+                 "relrl_gateway:gw_load", "relrl_gateway:gw_answer_again",
                  "relrl_gateway:gw_take_abort"}
     assert set(GOALS.values()) == api - transport
 
@@ -248,7 +248,7 @@ def test_private_predicates_are_refused() -> None:
             kb.call("user:shell", "true")
 
 
-def test_step_result_is_decoded(crossing: str) -> None:
+def test_step_result_is_decoded() -> None:
     with KnowledgeBase(TINY) as kb:
         engine = Engine(kb)
         engine.configure("etg", {**make_learner("etg").params}, seed=0)
@@ -261,7 +261,7 @@ def test_step_result_is_decoded(crossing: str) -> None:
         assert r.explanation[0] == "explanation" and r.explanation[1] == "etg"
 
 
-def test_a_response_called_none_is_a_response(tmp_path: Path, crossing: str) -> None:
+def test_a_response_called_none_is_a_response(tmp_path: Path) -> None:
     path = domain(tmp_path, "stimulus(s).\nresponse(none).\n")
     with KnowledgeBase(path) as kb:
         agent = Agent(kb, make_learner("etg"), seed=0)
@@ -271,7 +271,7 @@ def test_a_response_called_none_is_a_response(tmp_path: Path, crossing: str) -> 
         assert kb.memory()[0] == (0, ("emitted", "none"))
 
 
-def test_traced_step_is_one_gateway_call(crossing: str) -> None:
+def test_traced_step_is_one_gateway_call() -> None:
     from relrl.kb import gateway_calls
 
     with KnowledgeBase(SIS) as kb:
@@ -365,7 +365,7 @@ def test_arithmetic_errors_load_the_same_before_and_after_a_save(tmp_path: Path)
         kb.close()
 
 
-def test_query_answers_that_are_cyclic_or_deep_come_as_text(crossing: str) -> None:
+def test_query_answers_that_are_cyclic_or_deep_come_as_text() -> None:
     with KnowledgeBase(TINY) as kb:
         (answer,), _ = kb.query("X = f(X)")
         name, value, printed = answer[0]
@@ -377,7 +377,7 @@ def test_query_answers_that_are_cyclic_or_deep_come_as_text(crossing: str) -> No
         assert answer[0][1] == [1, 2, ("f", "a")]
 
 
-def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path, crossing: str) -> None:
+def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path) -> None:
     """The step's fast read (gw_step/15) falls back to full conversion where a field does
     not fit its one-call read: a state code or a response mask beyond 64 bits."""
     n = 70
@@ -394,8 +394,7 @@ def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path, crossing: str
         assert r.necessity == "none" and r.outputs == () and not r.reinforced
 
 
-def test_every_response_allowed_is_minus_one_and_read_as_all(tmp_path: Path,
-                                                             crossing: str) -> None:
+def test_every_response_allowed_is_minus_one_and_read_as_all(tmp_path: Path) -> None:
     """Without constraint rules the engine reports -1 (every response allowed) instead of a
     mask of as many bits; Engine.step gives the full mask and the loop every response."""
     from relrl.engine import ALL_ALLOWED
@@ -414,7 +413,7 @@ def test_every_response_allowed_is_minus_one_and_read_as_all(tmp_path: Path,
         assert out.action in out.allowed
 
 
-def test_step_failure_and_errors_through_the_fast_read(tmp_path: Path, crossing: str) -> None:
+def test_step_failure_and_errors_through_the_fast_read(tmp_path: Path) -> None:
     with KnowledgeBase(TINY) as kb:
         engine = Engine(kb)
         with pytest.raises(PrologError):        # not configured: an error, never a crash
@@ -438,29 +437,26 @@ def _closed_loop(steps: int) -> list[tuple]:
         return seen
 
 
-def test_compiled_and_ctypes_crossings_agree(monkeypatch: pytest.MonkeyPatch) -> None:
-    """The compiled step (relrl._step_kernel) and the ctypes calls read the same fields;
-    where the kernel cannot read a field (here: no room for the units' outputs), the
-    result is the same, with every record made anew (a table of one)."""
+def test_fields_the_kernel_does_not_read_come_as_terms(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Where the compiled step cannot read a field (here: no room for the units' outputs),
+    the step's fields are read as terms from the frame it leaves open: the same results,
+    with every record made anew (a table of one)."""
     import numpy as np
 
-    import relrl.kb as kb_module
-    from relrl import _step_kernel
+    from relrl.bridge import marshal, stepkernel
+    from relrl.bridge.calls import prolog
 
-    engine = kb_module._get_engine()
-    kernel = engine._load_kernel()
-    assert kernel
+    engine = prolog()
+    plain = _closed_loop(300)
+    k, io, fo = engine._kernel
     statuses: list[int] = []
+    step = stepkernel.step
 
     def counted(io: np.ndarray, fo: np.ndarray) -> int:
-        statuses.append(kernel(io, fo))
+        statuses.append(step(io, fo))
         return statuses[-1]
 
-    monkeypatch.setattr(engine, "_kernel", False)
-    plain = _closed_loop(300)
-    monkeypatch.setattr(engine, "_kernel", counted)
-    assert _closed_loop(300) == plain and set(statuses) == {0}
-    statuses.clear()
-    monkeypatch.setattr(engine, "_fo", np.zeros(_step_kernel.FIRST_OUTPUT, np.float64))
-    monkeypatch.setattr(kb_module, "_MAX_RECORDS", 1)
-    assert _closed_loop(300) == plain and set(statuses) == {_step_kernel.SLOW}
+    monkeypatch.setattr(engine, "_kernel", (k, io, np.zeros(k.FIRST_OUTPUT, np.float64)))
+    monkeypatch.setattr(k, "step", counted)
+    monkeypatch.setattr(marshal, "CACHE_SIZE", 1)
+    assert _closed_loop(300) == plain and set(statuses) == {k.READ_REST}

@@ -25,12 +25,12 @@ def test_declarations_enumerate(fruits: KnowledgeBase) -> None:
     assert len(fruits.declarations("fact")) == 11
 
 
-def test_compound_terms_keep_structure(fruits: KnowledgeBase, crossing: str) -> None:
+def test_compound_terms_keep_structure(fruits: KnowledgeBase) -> None:
     (value,) = fruits.call("=", Var(), ("f", "a", [1, 2.5, "b"], ("g", -3)))
     assert value == ("f", "a", [1, 2.5, "b"], ("g", -3))
 
 
-def test_values_round_trip_unicode_and_big_ints(fruits: KnowledgeBase, crossing: str) -> None:
+def test_values_round_trip_unicode_and_big_ints(fruits: KnowledgeBase) -> None:
     for v in ["maçã", "it's", "Apple", 2**70, -(2**63), 1e-300, [], [[]]]:
         assert fruits.call("=", Var(), v) == [v]
 
@@ -151,9 +151,9 @@ def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
     """Regression: every call pushed a text buffer on Prolog's string stack, which only a
     returning foreign predicate pops; an experiment of ~600k steps died with 'Too many
     stacked strings' (fatal, no exception). The gateway now pops them after each call."""
-    from relrl.kb import _get_engine
+    from relrl.bridge.calls import prolog
 
-    engine = _get_engine()
+    engine = prolog()
     with KnowledgeBase() as kb:
         goal = (":", kb.module, "true")
         for _ in range(1_300_000):
@@ -162,7 +162,7 @@ def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
             ["still alive"]
 
 
-def test_partial_list_keeps_its_tail(fruits: KnowledgeBase, crossing: str) -> None:
+def test_partial_list_keeps_its_tail(fruits: KnowledgeBase) -> None:
     """Regression: [1, 2|T] came back as [1, 2, T], a proper list of three."""
     (value,) = fruits.call("=", Var(), ("[|]", 1, ("[|]", 2, Var("T"))))
     assert value[0] == "[|]" and value[1] == 1
@@ -170,9 +170,8 @@ def test_partial_list_keeps_its_tail(fruits: KnowledgeBase, crossing: str) -> No
 
 
 def test_time_limit_holds_across_many_short_calls() -> None:
-    """The watchdog is armed lazily (once per limit, not per call): calls that end in time
-    never see it fire, however long they run together, and a runaway call after them is
-    still stopped at its own limit."""
+    """Calls that end in time never see the watchdog fire, however long they run
+    together, and a runaway call after them is still stopped at its own limit."""
     import time
 
     with KnowledgeBase(SIS, timeout=0.2) as kb:
@@ -196,7 +195,7 @@ def test_time_limit_holds_across_many_short_calls() -> None:
 def test_cached_keys_are_equal_only_for_equal_terms() -> None:
     """A recorded term is found by its key: terms that Python calls equal but Prolog does
     not (1, 1.0, True; a list and a compound) must have different keys."""
-    from relrl.kb import Cached
+    from relrl.bridge.marshal import Cached
 
     def key(value: object) -> object:
         return Cached(value).key
@@ -210,58 +209,11 @@ def test_cached_keys_are_equal_only_for_equal_terms() -> None:
                 key([("f", [1])]), key([("f", (1,))])}) == 8
 
 
-_TERMS = [
-    'X = f(a, "str", 1.5, [1, 2, 3], g(h(i)))', "X = [a|b]", "X = [a, b|_]",
-    'X = "héllo wörld ☃"', "X = 'a b'", "X = f()", "X = [f(), []]",
-    "X = f(123456789012345678901234567890, -9223372036854775808, 9223372036854775807)",
-    "X = f(1r3)", "X = f(_, Z, Z)", "X = [inf, 1.0Inf, -0.0, 1.5NaN]", "numlist(1, 20000, X)",
-    "length(X, 5)", "X = f(_{a:1})", "X = [[[[[[a]]]]]]", "X = f('[]', [], '', \"\")",
-    'findall(f(I, "lbl", [x, y], 0.5), between(1, 3000, I), X)',
-    "X = f(g(1)-h(2), a:b, (c, d))", "current_output(S), X = f(S)",
-    "numlist(1, 399, L), foldl([_, A, f(A)]>>true, L, z, X)",
-    "length(L, 3000), maplist(=(\"a longer string than the room for text\"), L), X = g(L)",
-]
+def test_long_and_cyclic_lists_are_refused(
+        write_domain, monkeypatch: pytest.MonkeyPatch) -> None:
+    from relrl.bridge import marshal
 
-
-@pytest.mark.parametrize("goal", _TERMS)
-def test_compiled_reader_reads_what_the_node_reader_reads(goal: str) -> None:
-    """relrl._read_kernel gives the same values as the node-by-node reader, growing its
-    arrays when a term does not fit (they start small here)."""
-    import numpy as np
-
-    from relrl.kb import _get_engine
-
-    engine = _get_engine()
-    engine._load_kernel()
-    flatten, arrays = engine._flatten, engine._read_arrays
-    assert flatten
-    with KnowledgeBase() as kb:
-        try:
-            engine._read_arrays = (np.zeros(4, np.int64), np.zeros(1, np.float64),
-                                   np.zeros(2, np.uint8), np.zeros((4, 4), np.int64))
-            compiled = kb.query(goal)
-            engine._flatten = False
-            plain = kb.query(goal)
-        finally:
-            engine._flatten, engine._read_arrays = flatten, arrays
-    assert _named_in_order(compiled) == _named_in_order(plain)   # NaN and -0.0 alike
-
-
-def _named_in_order(value: object) -> str:
-    """``repr(value)`` with Prolog's variable numbers (which differ from query to query)
-    renamed in order of appearance."""
-    import re
-
-    names: dict[str, str] = {}
-    return re.sub(r"_G?\d+", lambda m: names.setdefault(m.group(), f"_V{len(names)}"),
-                  repr(value))
-
-
-def test_long_and_cyclic_lists_are_refused_by_both_readers(
-        write_domain, crossing: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    from relrl import kb as kb_module
-
-    monkeypatch.setattr(kb_module, "MAX_LIST", 1000)
+    monkeypatch.setattr(marshal, "MAX_LIST", 1000)
     path = write_domain("cyclist(X) :- X = [a|X].\n")
     with KnowledgeBase(path) as kb:
         assert len(kb.call("numlist", 1, 1000, Var())[0]) == 1000
@@ -291,3 +243,29 @@ def test_compiled_calls_load_with_the_first_step_only() -> None:
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
                          timeout=120, check=True).stdout.split("\n")
     assert out[0] == "False" and out[1] == "True ('f', 'a', ['b'])"
+
+
+@pytest.mark.parametrize("module, above", [
+    ("relrl.bridge.lib", {"relrl.bridge.marshal", "relrl.bridge.calls"}),
+    ("relrl.bridge.marshal", {"relrl.bridge.calls"}),
+    ("relrl.bridge.calls", set()),
+    ("relrl.query", set()),
+    ("relrl.engine", set()),
+])
+def test_the_transport_imports_no_layer_above_it(module: str, above: set[str]) -> None:
+    """Layers import only the ones below them: bindings < terms < calls < the facade (kb)
+    and its typed front (engine) and user queries (query); none imports pyswip."""
+    import subprocess
+    import sys
+
+    code = f"import sys, {module}; print(sorted(m for m in sys.modules if m.startswith(" \
+           "('relrl.kb', 'relrl.loop', 'relrl.engine', 'relrl.query', 'relrl.bridge', 'pyswip'))))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout
+    loaded = set(eval(out))
+    upper = {"relrl.kb", "relrl.loop", "pyswip"} | above
+    if module != "relrl.engine":
+        upper.add("relrl.engine")
+    if module != "relrl.query":
+        upper.add("relrl.query")
+    assert not loaded & upper, f"import {module} imported {sorted(loaded & upper)}"

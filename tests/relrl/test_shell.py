@@ -191,8 +191,8 @@ def test_trace_prints_the_ports_of_the_domain_rules() -> None:
     proc = _shell_proc("trace.\nlooking_frontal(face).\nnotrace.\nlooking_frontal(face).\n")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines()[0].startswith("% tracing every port")
-    assert proc.stderr.splitlines() == [" T [7] Call: looking_frontal(face)",
-                                        " T [7] Fail: looking_frontal(face)"]
+    assert proc.stderr.splitlines() == [" T [6] Call: looking_frontal(face)",
+                                        " T [6] Fail: looking_frontal(face)"]
 
 
 def test_the_interactive_debugger_says_it_is_not_available(shell) -> None:

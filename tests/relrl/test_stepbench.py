@@ -1,4 +1,4 @@
-"""relrl.stepbench: the Prolog side of a control step recorded from a seeded run and replayed
+"""bench/stepbench.py: the Prolog side of a control step recorded from a seeded run and replayed
 in plain swipl, every decision checked (issue 13, item 4)."""
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from bench.stepbench import record, replay
 from relrl.cli import main
 from relrl.errors import RelrlError
-from relrl.stepbench import record, replay
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +27,7 @@ def test_recording_replays_with_the_same_decisions(etg_recording: Path) -> None:
     for how in ("direct", "gateway"):
         assert figures[how]["cpu_us_per_step"] > 0
         assert figures[how]["inferences_per_step"] > 100
-    # the gateway's time-limited call runs the same step and more
+    # the gateway's guarded call runs the same step and more
     assert figures["gateway"]["inferences_per_step"] > figures["direct"]["inferences_per_step"]
 
 
@@ -74,3 +74,19 @@ def test_cli_bad_flags(argv: list[str], message: str, capsys: pytest.CaptureFixt
                        ) -> None:
     assert main(["bench", *argv]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_harness_is_not_installed_with_the_package(tmp_path: Path,
+                                                       monkeypatch: pytest.MonkeyPatch,
+                                                       capsys: pytest.CaptureFixture[str]
+                                                       ) -> None:
+    """bench/ is outside every package (pyproject's packages: relrl, perception, head; the
+    package data: relrl/prolog/*.pl); without it, --prolog-step says where it lives."""
+    import relrl.bench
+
+    root = Path(relrl.bench.__file__).resolve().parents[1]
+    assert not list((root / "prolog").glob("stepbench*")) and not (root / "relrl" /
+                                                                   "stepbench.py").exists()
+    monkeypatch.setattr(relrl.bench, "STEPBENCH", tmp_path / "stepbench.py")
+    assert main(["bench", "--prolog-step"]) == 2
+    assert "source tree" in capsys.readouterr().err

@@ -10,8 +10,8 @@
 :- use_module(library(pairs)).
 :- use_module(library(statistics)).
 :- use_module(library(http/json)).
-:- use_module(gateway).
-:- use_module(engine).
+:- use_module('../prolog/gateway').
+:- use_module('../prolog/engine').
 
 /** <module> The Prolog side of a control step, measured alone
 
@@ -30,11 +30,11 @@ error. So the figures are of the same decisions the Python run made.
 Figures (per timed step; the warm-up steps are replayed untimed first): wall-clock and CPU
 microseconds and inferences, net of the replay loop's own cost (measured by the same loop
 with engine_step/6 left out), both with engine_step/6 called directly and through the
-gateway's time-limited call (gw_step/15, what Python calls). With profile(true), SWI-Prolog's
+gateway's guarded call (gw_step/14, what Python calls; its time limit is Python's). With profile(true), SWI-Prolog's
 profiler runs over the timed steps and the figures include each predicate's share of the
 time and its calls per step.
 
-    swipl -g relrl_stepbench:stepbench_main -t halt prolog/stepbench.pl -- REC [--passes N]
+    swipl -g relrl_stepbench:stepbench_main -t halt bench/stepbench.pl -- REC [--passes N]
           [--profile] [--top N]
 
 prints the figures as one JSON object (relrl bench --prolog-step runs it).
@@ -134,7 +134,7 @@ stepbench_replay(recording(Domain, Learner, Params, Seed, Warmup, Events), Optio
 
 kb_for(Domain, KB) :-
     relrl_gateway:gw_new_kb(KB),
-    relrl_gateway:gw_load(Domain, KB, 10, Problems),
+    relrl_gateway:gw_load(Domain, KB, Problems),
     (   member(problem(error, F, L, M), Problems)
     ->  throw(error(stepbench_domain(F:L, M), _))
     ;   true
@@ -190,7 +190,7 @@ replay_step(direct, KB, s(Percepts, Emitted, Mode, Expected), I) :-
     relrl_engine:engine_step(KB, Percepts, Emitted, Mode, [], Out),
     same(I, Expected, Out).
 replay_step(gateway, KB, s(Percepts, Emitted, Mode, Expected), I) :-
-    relrl_gateway:gw_step(KB, Percepts, Emitted, Mode, [], 60, Result,
+    relrl_gateway:gw_step(KB, Percepts, Emitted, Mode, [], Result,
                           Code, N, Ys, Reward, Reinforced, Mask, Action, Extras),
     (   Result == true
     ->  same(I, Expected, step(Code, N, Ys, Reward, Reinforced, Mask, Action, Extras))

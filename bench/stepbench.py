@@ -1,18 +1,20 @@
 """The Prolog side of a control step, measured alone (``relrl bench --prolog-step``).
 
+A measuring harness of the source tree, not part of the installed package.
+
 ``relrl bench`` times a whole step: the simulator, Python, one gateway call and the knowledge
 work inside Prolog. To see (and profile) the Prolog part alone, :func:`record` runs the
 bench's seeded interaction (an :class:`~relrl.loop.Agent` on the Social Interactive Simulator
 with Experiment 1's caregiver: 500 warm-up steps, then the timed ones) and writes every
 step's percepts, the index of the response emitted before it, its mode and what
 ``engine_step/6`` returned to a recording — Prolog terms, one a line. :func:`replay` runs
-``prolog/stepbench.pl`` in plain ``swipl`` over it: the same domain, learner, parameters and
+``bench/stepbench.pl`` in plain ``swipl`` over it: the same domain, learner, parameters and
 seed, one ``engine_step/6`` per recorded step, each checked against the recording (a
-difference is an error), timed with and without the gateway's time-limited call, and, on
+difference is an error), timed with and without the gateway's guarded call, and, on
 request, under SWI-Prolog's profiler.
 
 Example:
-    >>> from relrl.stepbench import bench_prolog_step
+    >>> from bench.stepbench import bench_prolog_step
     >>> figures = bench_prolog_step("etg", steps=1000)
     >>> figures["direct"]["us_per_step"], figures["direct"]["inferences_per_step"]
 """
@@ -106,19 +108,17 @@ def record(path: str | Path, learner: str = "etg", *, steps: int = 5000, warmup:
 
 def replay(path: str | Path, *, passes: int = 3, profile: bool = False, top: int = 25,
            timeout: float = 600.0) -> dict[str, Any]:
-    """Replay a recording in plain ``swipl`` (``prolog/stepbench.pl``); return its figures.
+    """Replay a recording in plain ``swipl`` (``bench/stepbench.pl``); return its figures.
 
     Raises:
         RelrlError: swipl is missing, or the replay failed (a step differed from the
             recording: the message says which and how).
     """
-    from relrl.kb import PROLOG_DIR
-
     swipl = shutil.which("swipl")
     if swipl is None:
         raise RelrlError("swipl is not installed (make setup installs it)")
     argv: Sequence[str] = [swipl, "-q", "-g", "relrl_stepbench:stepbench_main", "-t", "halt",
-                           str(PROLOG_DIR / "stepbench.pl"), "--", str(path),
+                           str(Path(__file__).with_name("stepbench.pl")), "--", str(path),
                            f"--passes={passes}", f"--top={top}"]
     if profile:
         argv = [*argv, "--profile"]

@@ -1,0 +1,1 @@
+"""Measuring harnesses of relrl's source tree (not installed with the package)."""

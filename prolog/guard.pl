@@ -1,0 +1,220 @@
+:- module(relrl_guard,
+          [ guarded/2,            % :Goal, -Result
+            error_result/2,       % +Exception, -Result
+            halt_message/2,       % +Where, -Message
+            gw_take_abort/1,      % -Where
+            text_failed/1         % +Error
+          ]).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+
+/** <module> The guard of a gateway call: results instead of exceptions, halt, signals
+
+Every call from Python runs its goal through guarded/2: once, its exceptions turned into a
+result term, so that no Prolog exception escapes into the host. Nothing a loaded file or a
+rule does can end the program: halt/0,1 called during a guarded call is cancelled and
+reported (naming the file and line when it came from a directive); abort/0, which unwinds
+past every catch/3, is noted for gw_take_abort/1 on its way out.
+
+The time limit and Ctrl-C come from the host (relrl/bridge/deadline.py): a watchdog thread
+raises a Prolog signal in this thread while a call runs too long (vtalrm) or the user
+presses Ctrl-C (usr1). The handlers below throw `time_limit_exceeded`, as
+call_with_time_limit/2's alarm does, or `relrl_interrupted`, inside the running goal; a
+signal that arrives when no guarded call runs (it was raised as the call returned) does
+nothing. The host deregisters the OS handlers of both signals: only Prolog's signal table
+knows them.
+*/
+
+:- meta_predicate guarded(0, -), once_result(0, -).
+
+%!  guarded(:Goal, -Result) is det.
+%
+%   Run Goal once. Result is `true` (Goal's bindings are kept), `false`, or
+%   error(Kind, Message) (see error_result/2), also for a halt/0,1 called while Goal ran.
+%
+%   The flag that says a guarded call runs is set and restored inside one catch/3, and its
+%   handler restores it too: an exception at any point — the goal's, the time limit's,
+%   Ctrl-C's, even while the flag is restored — leaves it as it was, and abort/0 runs the
+%   handler before it unwinds on.
+
+guarded(Goal, Result) :-
+    (   nb_current(relrl_active, Was)
+    ->  true
+    ;   Was = false
+    ),
+    catch(guarded_call(Goal, Was, Result0), E, guarded_error(E, Was, Result0)),
+    halt_result(Result0, Result).
+
+guarded_call(Goal, Was, Result) :-
+    nb_setval(relrl_active, true),
+    once_result(Goal, Result),
+    nb_setval(relrl_active, Was).
+
+guarded_error(E, Was, Result) :-
+    call_cleanup(error_result(E, Result), nb_setval(relrl_active, Was)).
+
+once_result(Goal, Result) :-
+    (   call(Goal)
+    ->  Result = true
+    ;   Result = false
+    ).
+
+%   Result0, or the error for a halt/0,1 that was cancelled while the call ran.
+halt_result(Result0, Result) :-
+    (   nb_current(relrl_halt, Where),
+        Where \== none
+    ->  nb_setval(relrl_halt, none),
+        halt_message(Where, Message),
+        Result = error(halt_called(Where), Message)
+    ;   Result = Result0
+    ).
+
+%!  halt_message(+Where, -Message) is det.
+%
+%   Message says that halt/0,1 was called at Where (File:Line of a directive, or `goal`).
+
+halt_message(Where, Message) :-
+    (   Where = File:Line
+    ->  format(string(Message), "~w:~w: halt/0,1 called while loading (a loaded file \c
+                                 cannot end relrl)", [File, Line])
+    ;   format(string(Message), "halt/0,1 called by a goal (a rule cannot end relrl)", [])
+    ).
+
+:- initialization(at_halt(relrl_guard:halt_hook)).
+
+%   at_halt/1 hook: inside a guarded call, cancel the halt and remember where it came from.
+halt_hook :-
+    (   nb_current(relrl_active, true)
+    ->  load_location(Where),
+        nb_setval(relrl_halt, Where),
+        cancel_halt(relrl_guard)
+    ;   true
+    ).
+
+load_location(Where) :-
+    (   prolog_load_context(file, File),
+        prolog_load_context(term_position, Pos),
+        stream_position_data(line_count, Pos, Line)
+    ->  Where = File:Line
+    ;   Where = goal
+    ).
+
+:- initialization(on_signal(vtalrm, _, relrl_guard:time_up)).
+:- initialization(on_signal(usr1, _, relrl_guard:interrupt)).
+
+%   The running call's time limit passed: remember where a file being loaded was (a
+%   directive that never ends), then throw as call_with_time_limit/2 does.
+time_up(_Signal) :-
+    (   nb_current(relrl_active, true)
+    ->  load_location(Where),
+        nb_setval(relrl_timeout_where, Where),
+        throw(time_limit_exceeded)
+    ;   true
+    ).
+
+interrupt(_Signal) :-
+    (   nb_current(relrl_active, true)
+    ->  throw(relrl_interrupted)
+    ;   true
+    ).
+
+%!  error_result(+Exception, -Result) is det.
+%
+%   Result is error(Kind, Message) for Exception: Kind keeps the error's structure for
+%   Python (time_limit_exceeded, time_limit_exceeded(rule(Goal, Where)),
+%   rule_error(Goal, Where, Formal), policy_error(File, Line, Text), interrupted, aborted,
+%   or the error term itself) and Message is one line for a person.
+
+error_result(relrl_interrupted, error(interrupted, "interrupted")) :- !.
+error_result(relrl_rule_error(_, _, relrl_interrupted), Result) :- !,
+    error_result(relrl_interrupted, Result).
+error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
+    where_text(Where0, Where),
+    format(string(GoalText), "~q", [Goal]),
+    (   E == time_limit_exceeded
+    ->  Kind = time_limit_exceeded(rule(GoalText, Where)),
+        format(string(Message), "~w: rule ~w ran longer than the time limit (a rule that \c
+                                 never ends?)", [Where, GoalText])
+    ;   E = error(resource_error(Resource), _)
+    ->  Kind = rule_error(GoalText, Where, resource_error(Resource)),
+        format(string(Message), "~w: rule ~w ran out of ~w (a recursion without end?)",
+               [Where, GoalText, Resource])
+    ;   strip_context(E, E1),
+        message_string(E1, Inner),
+        (   E1 = error(Formal, _)
+        ->  true
+        ;   Formal = E1
+        ),
+        Kind = rule_error(GoalText, Where, Formal),
+        format(string(Message), "~w: rule ~w: ~w", [Where, GoalText, Inner])
+    ).
+error_result(error(relrl_policy_error(File, Line, Text), _),
+             error(policy_error(File, Line, Text1), Message)) :- !,
+    one_line(Text, Text1),
+    (   Line > 0
+    ->  format(string(Message), "~w:~w: ~w", [File, Line, Text1])
+    ;   format(string(Message), "~w: ~w", [File, Text1])
+    ).
+error_result('$aborted', error(aborted, "abort/0 called")) :- !,
+    (   nb_current(relrl_abort, W), W \== none
+    ->  true
+    ;   nb_setval(relrl_abort, goal)
+    ).
+error_result(E0, error(E, Message)) :-
+    strip_context(E0, E),
+    message_string(E, Message).
+
+where_text(File:Line, Where) :- !,
+    format(string(Where), "~w:~w", [File, Line]).
+where_text(_, "(no source)").
+
+one_line(Text, Line) :-
+    split_string(Text, "\n", " \t", Parts0),
+    exclude(==(""), Parts0, Parts),
+    atomic_list_concat(Parts, ' ', A),
+    atom_string(A, Line).
+
+%!  gw_take_abort(-Where) is det.
+%
+%   Where a goal called abort/0 in the last gateway call (File:Line when a file was being
+%   loaded, goal otherwise, none when no abort happened); forgets it.
+
+gw_take_abort(Where) :-
+    (   nb_current(relrl_abort, Where0)
+    ->  Where = Where0
+    ;   Where = none
+    ),
+    nb_setval(relrl_abort, none).
+
+%   The alarm's context is noise for a user; keep the error itself.
+strip_context(error(Formal, context(time:_, _)), error(Formal, _)) :- !.
+strip_context(E, E).
+
+%!  text_failed(+Error) is semidet.
+%
+%   Rendering a message or an answer as text failed with Error: fail, so that the plain
+%   rendering is used instead, unless Error must reach the caller — a time limit, Ctrl-C,
+%   abort or a resource error is never swallowed.
+
+text_failed(Error) :-
+    (   must_pass(Error)
+    ->  throw(Error)
+    ;   fail
+    ).
+
+must_pass(time_limit_exceeded).
+must_pass(relrl_interrupted).
+must_pass('$aborted').
+must_pass(unwind(_)).
+must_pass(error(resource_error(_), _)).
+
+message_string(E, Message) :-
+    (   catch(message_to_codes(E, Codes), Error, text_failed(Error))
+    ->  string_codes(Message0, Codes)
+    ;   format(string(Message0), "~q", [E])
+    ),
+    one_line(Message0, Message).
+
+message_to_codes(E, Codes) :-
+    '$messages':translate_message(E, Lines, []),
+    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).

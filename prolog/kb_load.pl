@@ -1,0 +1,155 @@
+:- module(relrl_kb,
+          [ gw_new_kb/1,          % -Module
+            gw_drop_kb/1,         % +Module
+            gw_load/3,            % +File, +Module, -Problems
+            kb_module/1           % ?Module
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(guard).
+:- use_module(engine, [engine_park/0, engine_forget/1]).
+:- use_module(state, [state_touch/0]).
+:- use_module(memory, [wm_clear/1]).
+
+/** <module> Knowledge bases: their life cycle and loading
+
+A knowledge base is a module of its own (gw_new_kb/1) that sees relrl's predicates, so two
+knowledge bases in one process never see each other's clauses or working memory.
+gw_drop_kb/1 forgets all of it. gw_load/3 consults a domain file into one and collects
+every error and warning with its file and line instead of printing them.
+*/
+
+:- dynamic kb_counter/1, kb_module_/1.
+kb_counter(0).
+
+%!  kb_module(?Module) is nondet.
+%
+%   Module is a knowledge base made by gw_new_kb/1 and not dropped.
+
+kb_module(Module) :-
+    kb_module_(Module).
+
+%!  gw_new_kb(-Module) is det.
+%
+%   Module is a fresh, empty knowledge-base module that sees relrl's predicates.
+
+gw_new_kb(Module) :-
+    retract(kb_counter(N0)),
+    N is N0 + 1,
+    assertz(kb_counter(N)),
+    format(atom(Module), "relrl_kb_~d", [N]),
+    assertz(kb_module_(Module)),
+    set_module(Module:class(user)),
+    add_import_module(Module, relrl, start),
+    set_prolog_flag(Module:unknown, error).
+
+%!  gw_drop_kb(+Module) is det.
+%
+%   Forget the clauses, working memory and engine state of a knowledge-base module.
+
+gw_drop_kb(Module) :-
+    must_be(atom, Module),
+    wm_clear(Module),
+    engine_forget(Module),
+    retractall(kb_module_(Module)),
+    forall(( current_predicate(Module:Name/Arity),
+             functor(Head, Name, Arity),
+             \+ predicate_property(Module:Head, imported_from(_)) ),
+           abolish(Module:Name/Arity)).
+
+%!  gw_load(+File, +Module, -Problems:list) is det.
+%
+%   Consult File into Module. Problems lists every error and warning printed while
+%   loading, as problem(Kind, File, Line, Message), in order; nothing is printed. A file
+%   that does not exist gives one problem with line 0; a directive that runs past the
+%   call's time limit or calls halt/0,1 gives an error at its line.
+
+:- dynamic collecting/1, collected/2.
+
+gw_load(File, Module, Problems) :-
+    must_be(atom, Module),
+    engine_park,                        % a directive may draw random numbers
+    state_touch,                        % or redefine a rule
+    (   exists_file(File)
+    ->  absolute_file_name(File, Abs),
+        atomic_list_concat([Abs, '#', Module], Id),
+        gensym(load_, Key),
+        nb_setval(relrl_timeout_where, none),
+        setup_call_cleanup(
+            asserta(collecting(Key)),
+            guarded(load_stream(Abs, Id, Module), Result),
+            retract(collecting(Key))),
+        note_result(Result, Key, Abs),
+        findall(P, retract(collected(Key, P)), Problems0),
+        exclude(cancelled_halt_warning(Result), Problems0, Problems)
+    ;   exists_directory(File)
+    ->  Problems = [problem(error, File, 0, "a directory, not a Prolog file")]
+    ;   Problems = [problem(error, File, 0, "no such file")]
+    ).
+
+%   The directive whose halt was cancelled also "failed": one problem for it is enough.
+cancelled_halt_warning(error(halt_called(F:L), _), problem(warning, F, L, _)).
+
+load_stream(Abs, Id, Module) :-
+    setup_call_cleanup(
+        open(Abs, read, Stream),
+        load_files(Module:Id, [stream(Stream), if(true)]),
+        close(Stream)).
+
+%   The load's own result as a problem: an exception that ended it, or a halt.
+note_result(true, _, _).
+note_result(false, _, _).
+note_result(error(Kind, Message), Key, File) :-
+    (   Kind == time_limit_exceeded
+    ->  nb_getval(relrl_timeout_where, Where),
+        (   Where = F:L
+        ->  true
+        ;   F = File, L = 0
+        ),
+        Msg = "loading ran longer than the time limit: a directive that never ends?"
+    ;   Kind = halt_called(F:L)
+    ->  Msg = "halt/0,1 called while loading (a loaded file cannot end relrl)"
+    ;   Kind == aborted
+    ->  nb_setval(relrl_abort, File:0),
+        F = File, L = 0, Msg = "abort/0 called while loading"
+    ;   Kind = error(_, Context), nonvar(Context), Context = file(F, L, _, _)
+    ->  Msg = Message
+    ;   F = File, L = 0, Msg = Message
+    ),
+    assertz(collected(Key, problem(error, F, L, Msg))).
+
+:- multifile user:message_hook/3.
+:- dynamic user:message_hook/3.
+
+user:message_hook(Term, Kind, Lines) :-
+    collecting(Key),
+    memberchk(Kind, [error, warning]),
+    message_location(Term, File, Line),
+    lines_string(Lines, Msg0),
+    strip_location(Msg0, Msg),
+    assertz(collected(Key, problem(Kind, File, Line, Msg))).
+
+message_location(error(_, Context), File, Line) :-
+    nonvar(Context),
+    Context = file(File, Line, _, _),
+    !.
+message_location(_, File, Line) :-
+    source_location(File, Line), !.
+message_location(_, '', 0).
+
+lines_string(Lines, String) :-
+    with_output_to(string(S0), print_message_lines(current_output, '', Lines)),
+    split_string(S0, "\n", " \t", Parts0),
+    exclude(==(""), Parts0, Parts),
+    atomic_list_concat(Parts, ' ', A),
+    atom_string(A, String).
+
+%   Syntax errors repeat the location in their text: keep the text after it.
+strip_location(Msg0, Msg) :-
+    (   sub_string(Msg0, B, _, A, ": Syntax error: "),
+        B > 0
+    ->  sub_string(Msg0, _, A, 0, Rest),
+        string_concat("Syntax error: ", Rest, Msg)
+    ;   Msg = Msg0
+    ).
