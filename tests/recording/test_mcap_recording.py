@@ -302,7 +302,7 @@ def test_the_file_is_never_a_link_nor_written_over(tmp_path: Path) -> None:
     (tmp_path / "session.mcap").symlink_to(tmp_path / "elsewhere.txt")
     rec = Recorder()
     try:
-        with pytest.raises(OutputError, match="already there"):
+        with pytest.raises(OutputError, match="a link is there"):
             rec.open(tmp_path / "session.mcap")
         rec.open(tmp_path / "other.mcap")  # the writer is still there for a good path
         assert rec.close_file() > 0
