@@ -178,8 +178,6 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("report-missing", ["report", "{d}/nope"], ["nope", "not a run folder"]),
     ("migrate-a-file", ["migrate", "{d}/afile"], ["afile"]),
     ("tree-missing", ["tree", "{d}/nope.pl", "--domain", "{fruits}"], ["nope.pl"]),
-    # ---- report ----------------------------------------------------------------------------
-    ("report-missing-folder", ["report", "{d}/nope"], ["nope", "not a run folder"]),
     ("tree-no-domain", ["tree", "{d}/afile"], ["domain.pl", "--domain"]),
     ("tree-random-bytes", ["tree", "{d}/random.toml", "--domain", "{fruits}"],
      ["random.toml"]),
