@@ -309,7 +309,7 @@ mode_problem(KB, M, Msg) :-
                              constant or a term of these)", [MT, Bad])
     ;   M = action(A)
     ->  pattern(A, P),
-        \+ ( kb_response(KB, R), \+ R \= P ),
+        \+ ( ( kb_response(KB, R) ; declared(KB, action(R)) ), \+ R \= P ),
         format(string(Msg), "rmode ~w matches no declared response", [MT])
     ;   M = necessity(A)
     ->  \+ ( A = #(necessity) ; A = -(necessity) ; atomic(A) ),
