@@ -8,7 +8,9 @@
             world_bfs/5,          % +KB, +Goal, +State, +Limit, -Steps
             world_info/2,         % +KB, -Info
             world_predicate/2,    % ?Name/Arity, ?Required
-            world_defines/2       % +KB, ?Name/Arity
+            world_defines/2,      % +KB, ?Name/Arity
+            world_task/3,         % +KB, +Spec, -Task
+            world_verify/5        % +KB, +Task, +Size, +Count, -Pairs
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -41,6 +43,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | step_bound(+Goal, +State, -Steps)     | optional: default 100                               |
   | optimal_steps(+Goal, +State, -Steps)  | optional: the optimal number of steps, when known (relrl check verifies it against a search) |
   | sizes(train|test, Sizes)              | optional: the sizes learning and transfer use by default |
+  | discount(Gamma)                       | optional: the task's discount, the learners' gamma (default theirs) |
   | relation/1, rmode/1, rconst/2         | the learner's view and language bias, as in a domain (docs/tg.md) |
 
 The learner's view of a state is the state's facts, the goal's facts and the derived ones
@@ -82,6 +85,7 @@ world_predicate(reward/5, optional).
 world_predicate(step_bound/3, optional).
 world_predicate(optimal_steps/3, optional).
 world_predicate(sizes/2, optional).
+world_predicate(discount/1, optional).
 
 %!  world_defines(+KB, +PI) is semidet.
 %
@@ -407,11 +411,16 @@ expand([A|As], KB, Goal, S, Seen0, Seen, N0, N, Next0, Next, Found) :-
 %!  world_info(+KB, -Info:list) is det.
 %
 %   Info is [tasks(Tasks), actions(Templates), relations(Templates), sizes(Train, Test),
-%   optimal(Known)]: the world's declarations (sizes [] when not declared; Known true when
-%   the world states its optimal number of steps).
+%   optimal(Known), discount(Gamma)]: the world's declarations (sizes [] when not declared;
+%   Known true when the world states its optimal number of steps; Gamma `none` when the
+%   world states no discount).
 
 world_info(KB, [tasks(Tasks), actions(Actions), relations(Relations), sizes(Train, Test),
-                optimal(Known)]) :-
+                optimal(Known), discount(Gamma)]) :-
+    (   declared(KB, discount(G)), number(G)
+    ->  Gamma = G
+    ;   Gamma = none
+    ),
     findall(T, declared(KB, task(T)), Tasks),
     findall(A, declared(KB, action(A)), Actions),
     findall(R, declared(KB, relation(R)), Relations),
@@ -427,3 +436,41 @@ world_info(KB, [tasks(Tasks), actions(Actions), relations(Relations), sizes(Trai
     ->  Known = true
     ;   Known = false
     ).
+
+%!  world_task(+KB, +Spec, -Task) is det.
+%
+%   Task is the world's task Spec names: an atom names the declared task of that name
+%   (on names on(_, _)); a compound must be an instance of a declared task (on(b1, b2)).
+%
+%   @error domain_error(world_task(Tasks), Spec) when the world declares no such task.
+
+world_task(KB, Spec, Task) :-
+    findall(T, declared(KB, task(T)), Tasks),
+    (   atom(Spec),
+        member(T, Tasks),
+        functor(T, Spec, _)
+    ->  Task = T
+    ;   compound(Spec),
+        member(T, Tasks),
+        subsumes_term(T, Spec)
+    ->  Task = Spec
+    ;   domain_error(world_task(Tasks), Spec)
+    ).
+
+%!  world_verify(+KB, +Task, +Size, +Count, -Pairs:list) is det.
+%
+%   Pairs are Declared-Searched for Count random start states of Task at Size: the
+%   optimal number of steps world_optimal/5 gives (the world's optimal_steps/3) and the one
+%   a breadth-first search finds (world_bfs/5, at most 200,000 states; `none` beyond).
+%   Draws from the knowledge base's random stream.
+
+world_verify(KB, Task, Size, Count, Pairs) :-
+    must_be(nonneg, Count),
+    engine_claim_random(KB),
+    length(Pairs, Count),
+    maplist(verify_one(KB, Task, Size), Pairs).
+
+verify_one(KB, Task, Size, Declared-Searched) :-
+    world_start(KB, Task, Size, S, Goal),
+    world_optimal(KB, Goal, S, 0, Declared),
+    world_bfs(KB, Goal, S, 200000, Searched).

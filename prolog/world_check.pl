@@ -83,6 +83,11 @@ static_problem(KB, problem(File, Line, Msg)) :-
     clause_location(Ref, File, Line),
     format(string(Msg), "sizes(~q, ~q): use sizes(train, [3, 4, 5]) or sizes(test, [...]) \c
                          with positive integers", [K, L]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, discount(G), true, Ref),
+    \+ ( number(G), G > 0, G =< 1 ),
+    clause_location(Ref, File, Line),
+    format(string(Msg), "discount(~q): the discount must be a number in (0, 1]", [G]).
 static_problem(KB, P) :-
     bias_problem(KB, P).
 

@@ -134,21 +134,15 @@ relation(highest(_)).
 % The language bias: blocks are variables (a test speaks of *a* block, never of b3), the
 % floor the one constant.
 rmode(action(move(-block, -block))).
-rmode(action(move(+block, -block))).
-rmode(action(move(-block, +block))).
-rmode(action(move(+block, +block))).
 rmode(action(move(-block, floor))).
-rmode(action(move(+block, floor))).
-rmode(clear(+block)).
 rmode(on(+block, -block)).
 rmode(on(+block, +block)).
 rmode(on(+block, floor)).
-rmode(goal_on(-block, -block)).
 rmode(goal_on(+block, -block)).
 rmode(goal_on(-block, +block)).
 rmode(goal_on(+block, +block)).
-rmode(top_of(+block, -block)).
 rmode(top_of(-block, +block)).
+rmode(top_of(+block, -block)).
 rmode(top_of(+block, +block)).
 rmode(highest(+block)).
 

@@ -34,6 +34,7 @@ SUBCOMMANDS: dict[str, str] = {
     "replay": "relrl.cli.replay",
     "tree": "relrl.cli.tree",
     "report": "relrl.cli.report",
+    "learn": "relrl.cli.learn",
 }
 
 
