@@ -163,8 +163,11 @@ world_legal(KB, State, Actions) :-
     (   ground(As0)
     ->  list_to_set(As0, Actions)
     ;   member(A, As0), \+ ground(A)
-    ->  contract(KB, precondition(A, State), "precondition/2 left the action ~q unbound (it \c
-                 must bind every argument of the template)", [A])
+    ->  copy_term(A, Shown),
+        numbervars(Shown, 0, _, [singletons(true)]),
+        contract(KB, precondition(A, State), "precondition/2 left the action ~W unbound (it \c
+                 must bind every argument of the template)",
+                 [Shown, [quoted(true), numbervars(true)]])
     ).
 
 %!  world_next(+KB, +Goal, +State0, +Action, -State, -Outcome) is det.
