@@ -440,12 +440,11 @@ world_info(KB, [tasks(Tasks), actions(Actions), relations(Relations), sizes(Trai
     ;   Known = false
     ).
 
-%!  world_task(+KB, +Spec, -Task) is det.
+%!  world_task(+KB, +Spec, -Task) is semidet.
 %
 %   Task is the world's task Spec names: an atom names the declared task of that name
 %   (on names on(_, _)); a compound must be an instance of a declared task (on(b1, b2)).
-%
-%   @error domain_error(world_task(Tasks), Spec) when the world declares no such task.
+%   Fails when the world declares no such task.
 
 world_task(KB, Spec, Task) :-
     findall(T, declared(KB, task(T)), Tasks),
@@ -457,7 +456,6 @@ world_task(KB, Spec, Task) :-
         member(T, Tasks),
         subsumes_term(T, Spec)
     ->  Task = Spec
-    ;   domain_error(world_task(Tasks), Spec)
     ).
 
 %!  world_verify(+KB, +Task, +Size, +Count, -Pairs:list) is det.

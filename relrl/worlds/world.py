@@ -174,7 +174,9 @@ class World:
             spec = terms[0]
         out = self.kb.call("relrl_world:world_task", self.kb.module, spec, Var())
         if out is None:
-            raise ConfigError(f"--task {text!r}: no such task")
+            raise ConfigError(f"--task {text!r}: no such task in "
+                              f"{_display_path(str(self.path))} (tasks: "
+                              f"{', '.join(self.task_names())})")
         return out[0]
 
     def _task(self, task: Term | str) -> Term:
