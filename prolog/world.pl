@@ -38,7 +38,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | goal(+Goal, +State)                   | State satisfies Goal                                |
   | task_goal(+Task, +State, -Goal)       | optional: the goal of an episode of Task starting in State (on(A, B): two given blocks); default Goal = Task |
   | goal_fact(+Goal, -Fact)               | optional: what the learner is told of the goal (goal_on(a, b)) |
-  | derived(-Fact, +State)                | optional: relations computed from the state (above(X, Y)) |
+  | derived(-Fact, +Facts)                | optional: relations computed from the state and the goal's facts (covers(X, A)) |
   | reward(+Goal, +S0, +A, +S, -R)        | optional: default 1 when S satisfies Goal, else 0   |
   | step_bound(+Goal, +State, -Steps)     | optional: default 100                               |
   | optimal_steps(+Goal, +State, -Steps)  | optional: the optimal number of steps, when known (relrl check verifies it against a search) |
@@ -203,18 +203,23 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
 %!  world_view(+KB, +Goal, +State, -View:list) is det.
 %
 %   What a learner reads: State's facts, the goal's facts (goal_fact/2) and the derived
-%   ones (derived/2), an ordered set.
+%   ones (derived/2, given the state's and the goal's facts), an ordered set.
 
 world_view(KB, Goal, State, View) :-
     (   defines(KB, goal_fact/2)
     ->  findall(F, rule_solution(KB, goal_fact(Goal, F)), GFs)
     ;   GFs = []
     ),
+    (   GFs == []
+    ->  SG = State
+    ;   sort(GFs, GFSet),
+        ord_union(State, GFSet, SG)
+    ),
     (   defines(KB, derived/2)
-    ->  findall(F, rule_solution(KB, derived(F, State)), DFs)
+    ->  findall(F, rule_solution(KB, derived(F, SG)), DFs)
     ;   DFs = []
     ),
-    append([State, GFs, DFs], V0),
+    append([SG, DFs], V0),
     (   ground(V0)
     ->  sort(V0, View)
     ;   contract(KB, derived(_, State), "goal_fact/2 or derived/2 gave a fact that is not \c

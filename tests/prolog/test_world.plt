@@ -82,8 +82,8 @@ test(view_tells_the_goal_and_the_tops, [View == Expected]) :-
     blocks(KB),
     towers([[b1, b2], [b3]], S),
     world_view(KB, on(b3, b1), S, View),
-    Expected = [clear(b2), clear(b3), highest(b2), goal_on(b3, b1), on(b1, floor),
-                on(b2, b1), on(b3, floor), top_of(b2, b1)].
+    Expected = [clear(b2), clear(b3), highest(b2), covers(b2, b1), goal_on(b3, b1),
+                on(b1, floor), on(b2, b1), on(b3, floor)].
 
 test(optimal_on_a_below_b, [N == 4]) :-
     % b1 (B) under x under b3 (A) under y: y away, A away, x away, A onto B
