@@ -71,7 +71,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="start from this saved policy (read as data)")
     parser.add_argument("--traces", type=int, default=3,
                         help="with --out: greedy episodes of each evaluation size kept "
-                             "step by step in traces.jsonl, for relrl replay (3)")
+                             "step by step in traces.jsonl and replay/ (relrl replay "
+                             "DIR/replay shows the world's states) (3)")
     parser.add_argument("--no-speed", action="store_true",
                         help="skip the step-cost and crossing measurements")
     add_out_options(parser, default=None,
@@ -141,7 +142,10 @@ def run(args: argparse.Namespace) -> int:
         files = _write(out.path, config, result)
         out.status = "complete"
     _summary(result, timing)
-    print(f"\nwrote {len(files)} files to {out.path}/: {', '.join(f.name for f in files)}")
+    print(f"\nwrote {len(files)} files to {out.path}/: "
+          f"{', '.join(str(f.relative_to(out.path)) for f in files)}")
+    if (out.path / "replay").is_dir():
+        print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
     return 0
 
 
@@ -168,6 +172,7 @@ def _write(out: Path, config, result: dict) -> list[Path]:
     from relrl.outdir import write_atomic, write_json_atomic
 
     traces = result.pop("traces", {})
+    graph = result.pop("graph", None)
     timing = result.pop("timing")
     files = [write_json_atomic(out / "results.json",
                                {"command": "learn", "config": config.to_dict(), **result}),
@@ -182,7 +187,12 @@ def _write(out: Path, config, result: dict) -> list[Path]:
     files.append(write_atomic(out / "curve.csv", buf.getvalue()))
     files.append(out / "policy.pl")
     if traces:
+        from relrl.worlds.replay import write_replay
+
         lines = [json.dumps({"size": int(size), **ep}) for size, eps in traces.items()
                  for ep in eps]
         files.append(write_atomic(out / "traces.jsonl", "\n".join(lines) + "\n"))
+        files += write_replay(out / "replay", traces, learner=config.learner,
+                              world=Path(config.world).name, task=config.task,
+                              seed=config.seed, graph=graph)
     return files

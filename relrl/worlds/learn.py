@@ -132,6 +132,7 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
                "timing": timing}
         if traces:
             out["traces"] = kept
+            out["graph"] = world.engine.graph()
         return out
 
 
