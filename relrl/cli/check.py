@@ -33,7 +33,6 @@ def run(args: argparse.Namespace) -> int:
     and, with ``--world``, facts the world can never make hold count as problems). Warnings
     about the tg learner's language bias are printed and do not count as problems."""
     from perception.vocabulary import WORLDS
-
     from relrl.errors import ConfigError, PrologLoadError
     from relrl.kb import KnowledgeBase
     from relrl.validate import bias_warnings, describe, validate, world_warnings
@@ -102,7 +101,9 @@ def _check_world(args: argparse.Namespace) -> int:
             print(f"relations (the learner's view): "
                   f"{', '.join(_text(r) for r in world.relations) or '(none declared)'}")
             print(f"sizes: train {world.train_sizes}, test {world.test_sizes or '-'}")
-            print(f"optimal steps: {'stated (optimal_steps/3), checked by search' if world.optimal_known else 'by breadth-first search'}")
+            optimal = ("stated (optimal_steps/3), checked by search" if world.optimal_known
+                       else "by breadth-first search")
+            print(f"optimal steps: {optimal}")
             if world.discount is not None:
                 print(f"discount: {world.discount:g}")
         for warning in bias_warnings(world.kb):

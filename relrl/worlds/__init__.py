@@ -10,8 +10,14 @@ Example:
     ...     print(score(world.episodes("stack", [6, 8, 10], 30, "greedy", optimal=True)))
 """
 
-from relrl.worlds.world import (WORLD_DEFAULTS, WORLD_LEARNERS, Episode, World,
-                                make_world_learner, score)
+from relrl.worlds.world import (
+                                WORLD_DEFAULTS,
+                                WORLD_LEARNERS,
+                                Episode,
+                                World,
+                                make_world_learner,
+                                score,
+)
 
 __all__ = ["WORLD_DEFAULTS", "WORLD_LEARNERS", "Episode", "World", "make_world_learner",
            "score"]

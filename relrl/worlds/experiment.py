@@ -302,9 +302,9 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
 def worlds_table(results: dict[str, Any]) -> str:
     """The summary as a Markdown table (what ``relrl report``'s worlds view renders)."""
     sizes = results["config"]["test_sizes"]
-    head = ("| world | task | learner | seeds | of optimal, sizes "
-            f"{'–'.join(map(str, [min(results['config']['train_sizes']), max(results['config']['train_sizes'])]))}"
-            " (worst seed) | " + " | ".join(f"size {s}" for s in sizes)
+    train = results["config"]["train_sizes"]
+    head = (f"| world | task | learner | seeds | of optimal, sizes {min(train)}–{max(train)} "
+            "(worst seed) | " + " | ".join(f"size {s}" for s in sizes)
             + " | episodes to 0.95 | positions |")
     lines = [head, "|" + "---|" * (8 + len(sizes) - 1)]
     for r in results["summary"]:
