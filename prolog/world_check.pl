@@ -143,7 +143,11 @@ sizes(KB, Sizes) :-
 
 %   A problem shown by one episode of random legal actions (fails when it shows none).
 episode_problem(KB, Task, Size, P) :-
-    catch(random_episode(KB, Task, Size, Found), relrl_rule_error(Goal, Where, E),
+    shown(random_episode(KB, Task, Size), P).
+
+%   call(Check, Found) gives found(P) or none; an error of a world goal is found too.
+shown(Check, P) :-
+    catch(call(Check, Found), relrl_rule_error(Goal, Where, E),
           rule_problem(Goal, Where, E, Found)),
     Found = found(P).
 
@@ -222,9 +226,7 @@ where_file_line(Where, File, Line) :-
 
 %   optimal_steps/3 against a breadth-first search on one random start state.
 optimal_problem(KB, Task, Size, P) :-
-    catch(optimal_mismatch(KB, Task, Size, Found), relrl_rule_error(Goal, Where, E),
-          rule_problem(Goal, Where, E, Found)),
-    Found = found(P).
+    shown(optimal_mismatch(KB, Task, Size), P).
 
 optimal_mismatch(KB, Task, Size, Found) :-
     world_start(KB, Task, Size, S, Goal),

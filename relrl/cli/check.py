@@ -53,10 +53,7 @@ def run(args: argparse.Namespace) -> int:
                 for w in kb.load(path, strict=False):
                     problems.append(str(w))
             except PrologLoadError as exc:
-                for path_, line, text in exc.problems:
-                    where = f"{path_}:{line}" if line else path_
-                    problems.append(f"{where}: {text}")
-                _print_problems(problems)
+                _print_problems(problems + _load_problems(exc))
                 return 2
         problems.extend(validate(kb))
         if args.world:
@@ -90,8 +87,7 @@ def _check_world(args: argparse.Namespace) -> int:
     try:
         world = World(path)
     except PrologLoadError as exc:
-        _print_problems([f"{p}:{line}: {text}" if line else f"{p}: {text}"
-                         for p, line, text in exc.problems])
+        _print_problems(_load_problems(exc))
         return 2
     with world:
         problems = world.problems()
@@ -120,6 +116,12 @@ def _text(term) -> str:
     from relrl.worlds.world import _text as text
 
     return text(term)
+
+
+def _load_problems(exc) -> list[str]:
+    """``file:line: problem`` lines of a file that did not load."""
+    return [f"{path}:{line}: {text}" if line else f"{path}: {text}"
+            for path, line, text in exc.problems]
 
 
 def _print_problems(problems: list[str]) -> None:
