@@ -56,7 +56,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eval-sizes", default=None, metavar="N,N,...",
                         help="evaluate on these sizes with no further learning (default: "
                              "the world's sizes(test, ...))")
-    parser.add_argument("--episodes", type=int, default=500, help="learning episodes (500)")
+    parser.add_argument("--episodes", type=int, default=500,
+                        help="learning episodes (500; 0 with --policy: evaluate it only)")
     parser.add_argument("--block", type=int, default=None,
                         help="learning episodes between evaluations (default episodes/10)")
     parser.add_argument("--eval-episodes", type=int, default=100,
@@ -105,10 +106,11 @@ def run(args: argparse.Namespace) -> int:
                 else world.test_sizes)
     if args.size is not None and args.sizes:
         raise ConfigError("give --size or --sizes, not both")
-    for option, value in [("--episodes", args.episodes), ("--eval-episodes",
-                                                          args.eval_episodes)]:
-        if value < 1:
-            raise ConfigError(f"{option} must be at least 1, not {value}")
+    if args.episodes < 0 or (args.episodes == 0 and not args.policy):
+        raise ConfigError(f"--episodes must be at least 1 (0 only with --policy), not "
+                          f"{args.episodes}")
+    if args.eval_episodes < 1:
+        raise ConfigError(f"--eval-episodes must be at least 1, not {args.eval_episodes}")
     block = args.block if args.block is not None else max(1, args.episodes // 10)
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")

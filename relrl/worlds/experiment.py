@@ -11,7 +11,8 @@ Files: ``results.json`` (every number and the configuration; ``"partial": true``
 stopped early), ``timing.json`` (wall clock, steps/s, step cost by size), ``summary.csv``
 (per world, task and learner: the mean over seeds), ``curves.csv``, ``test.csv``,
 ``step_cost.csv``, ``optimal_check.csv``, ``curves.png``, ``transfer.png``,
-``step_cost.png``.
+``step_cost.png`` and ``policies/`` (every job's learned policy, readable Prolog that loads
+into a world of any size: ``relrl learn WORLD --policy FILE``).
 """
 
 from __future__ import annotations
@@ -73,8 +74,16 @@ class WorldsConfig:
 
 def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, seed: int, *,
                    report: Any = None) -> dict[str, Any]:
-    """One job: :func:`learn_task` of (world, task, learner, seed)."""
-    return learn_task(config.learn_config(world, task, learner, seed), report=report)
+    """One job: :func:`learn_task` of (world, task, learner, seed); the learned policy comes
+    back as text (``policy``), for the run folder's ``policies/``."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="relrl-worlds-") as tmp:
+        path = Path(tmp) / "policy.pl"
+        result = learn_task(config.learn_config(world, task, learner, seed), report=report,
+                            policy_out=path)
+        result["policy"] = path.read_text(encoding="utf-8")
+    return result
 
 
 def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = None
@@ -121,6 +130,7 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
     outcome = run_jobs(_job, tasks, workers=workers, engine=engine, address=address,
                        units=config.episodes // config.block + 1, label=_label)
     jobs, timings, verified = [], [], []
+    policies: dict[str, str] = {}
     for task, result in zip(tasks, outcome.results, strict=True):
         if result is None:
             continue
@@ -130,6 +140,7 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
         timings.append({"world": result["world"], "task": result["task"],
                         "learner": result["learner"], "seed": result["seed"],
                         **result.pop("timing")})
+        policies[_policy_name(result)] = result.pop("policy")
         jobs.append(result)
     results = {"experiment": "worlds", "relrl_version": __version__,
                "config": config.to_dict(), "seeds": config.seeds,
@@ -143,9 +154,17 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
               "python": platform.python_version(), "machine_info": machine_info(),
               "jobs": timings}
     files = write_outputs(out, results, timing)
+    (out / "policies").mkdir(exist_ok=True)
+    files += [write_atomic(out / "policies" / name, text) for name, text in policies.items()]
     if outcome.error:
         raise_kept(outcome.error, out)
     return results, files
+
+
+def _policy_name(job: dict[str, Any]) -> str:
+    """``policies/WORLD-TASK-LEARNER-sSEED.pl`` (the task's name without arguments)."""
+    task = job["task"].split("(")[0]
+    return f"{Path(job['world']).stem}-{task}-{job['learner']}-s{job['seed']}.pl"
 
 
 def _mean(xs: list[float | None]) -> float | None:

@@ -45,6 +45,18 @@ def test_task_names_and_instances() -> None:
             world.task("fly")
 
 
+def test_learn_evaluates_a_saved_policy_on_larger_worlds(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "run"
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "150",
+                 "--eval-sizes", "4", "--eval-episodes", "5", "--no-speed", "--out",
+                 str(out)]) == 0
+    capsys.readouterr()
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--episodes", "0", "--policy",
+                 str(out / "policy.pl"), "--eval-sizes", "7", "--eval-episodes", "10",
+                 "--no-speed"]) == 0
+    assert "size   7: of optimal" in capsys.readouterr().out
+
+
 def test_policy_saved_and_loaded_acts_the_same(tmp_path: Path) -> None:
     with World(BLOCKS) as world:
         world.attach(world.learner("tg"), seed=1)
@@ -93,7 +105,7 @@ def test_learn_command_writes_its_folder(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("argv, message", [
     (["--task", "fly"], "no such task"),
-    (["--episodes", "0"], "--episodes must be at least 1"),
+    (["--episodes", "0"], "--episodes must be at least 1 (0 only with --policy)"),
     (["--sizes", "3,x"], "--sizes must be comma-separated"),
     (["--learner", "qtable", "--param", "alpha=2"], "alpha must be in [0, 1]"),
 ])
@@ -114,7 +126,8 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
     assert {r["learner"] for r in results["summary"]} == {"tg", "qtable"}
     assert results["optimal_check"][0]["rows"][0]["agree"] == \
         results["optimal_check"][0]["rows"][0]["searched"] > 0
-    for name in ("summary.csv", "curves.csv", "test.csv", "step_cost.csv", "curves.png"):
+    for name in ("summary.csv", "curves.csv", "test.csv", "step_cost.csv", "curves.png",
+                 "policies/blocks-stack-tg-s0.pl", "policies/blocks-stack-qtable-s0.pl"):
         assert (out / name).is_file(), name
     text = render(load_run(out), "summary")
     assert "| blocks | stack | tg | 1 |" in text
