@@ -12,9 +12,10 @@ BIN    := $(VENV)/bin
 #   test: also espeak-ng (the synthetic caregiver words the speech tests recognise), graphviz
 #         (`dot`: the learned tree as a picture), libportaudio2 (the microphone, through
 #         sounddevice), chromium (the headless browser the monitor's tests drive; nothing
-#         downloads a browser) and the extras: speech, monitor, Ray, the test tools.
+#         downloads a browser) and the extras: speech, monitor, Ray, MCAP and Foxglove, the
+#         test tools.
 DEMO_EXTRAS := plots
-TEST_EXTRAS := dev,speech,monitor,ray
+TEST_EXTRAS := dev,speech,monitor,ray,mcap,foxglove
 
 .PHONY: demo test setup setup-demo setup-test debs-demo debs-test lint clean
 

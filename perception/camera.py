@@ -6,8 +6,11 @@ source                     meaning
 ``0``, ``cam://0``         webcam by index (OpenCV ``VideoCapture``)
 ``video.mp4``              a video file (``file://video.mp4`` also works)
 ``frames/``                a folder of images, read in name order (``dir://frames``)
-``session/``               a session recorded by relrl (``recording://session``): its frames
+``session/``               a session recorded by relrl (``recording://session``): every frame of
+                           its ``session.mcap``, in order
 ``photo.png``              one image, read once (``image://photo.png``)
+``bag.mcap[:TOPIC]``       a ROS 2 bag's images at their recorded times (``mcap://bag.mcap``;
+                           :mod:`perception.bag`; the ``mcap`` extra)
 ``synthetic://``           :func:`perception.render.render` of a :class:`SceneView`
 =========================  ==========================================================
 
@@ -232,9 +235,25 @@ def _webcam(rest: str) -> Camera:
 
 
 def _recording(path: str) -> Camera:
-    from perception.recorded import RecordedCamera
+    """Every frame of a session folder's ``session.mcap``, in order (not paced: perception
+    run again on what the robot saw)."""
+    from perception.bag import BagCamera
 
-    return RecordedCamera(path)
+    folder = Path(path)
+    if (folder / "session.mcap").is_file():
+        return BagCamera(folder / "session.mcap", paced=False)
+    if (folder / "frames.jsonl").is_file():
+        raise CameraError(f"{path}: a session recorded as a folder of frames by an earlier "
+                          f"relrl; convert it once with: relrl migrate {path}")
+    raise CameraError(f"{path}: not a recorded session (no session.mcap); record one with "
+                      "relrl run EPISODE --out DIR --record")
+
+
+def _bag(source: str) -> Camera:
+    from perception.bag import BagCamera, parse_bag_source
+
+    path, topic = parse_bag_source(source)
+    return BagCamera(path, topic)
 
 
 def _video(path: str) -> Camera:
@@ -250,6 +269,7 @@ SOURCES: dict[str, Callable[[str], Camera]] = {
     "dir": _Folder,
     "image": _Image,
     "recording": _recording,
+    "mcap": _bag,
     "synthetic": lambda rest: _synthetic("synthetic://" + rest),
 }
 
@@ -266,8 +286,12 @@ def open_camera(source: str | int) -> Camera:
     elif src.isdigit():
         scheme, rest = "cam", src
     elif Path(src).is_dir():
-        scheme = "recording" if (Path(src) / "frames.jsonl").is_file() else "dir"
+        recorded = any((Path(src) / name).is_file() for name in ("session.mcap",
+                                                                  "frames.jsonl"))
+        scheme = "recording" if recorded else "dir"
         rest = src
+    elif src.lower().endswith(".mcap") or ".mcap:" in src:
+        scheme, rest = "mcap", src
     elif Path(src).suffix.lower() in _IMAGE_EXT:
         scheme, rest = "image", src
     else:

@@ -76,8 +76,9 @@ def _pip_extras(target: str) -> set[str]:
 def test_the_demo_installs_no_test_tools() -> None:
     demo = _pip_extras("setup-demo")
     assert "plots" in demo
-    assert not demo & {"dev", "ray", "monitor", "speech"}
+    assert not demo & {"dev", "ray", "monitor", "speech", "mcap", "foxglove"}
 
 
 def test_the_tests_install_every_extra_they_use() -> None:
-    assert {"plots", "dev", "speech", "monitor", "ray"} <= _pip_extras("setup-test")
+    assert {"plots", "dev", "speech", "monitor", "ray", "mcap", "foxglove"} <= \
+        _pip_extras("setup-test")

@@ -32,6 +32,7 @@ SUBCOMMANDS: dict[str, str] = {
     "demo": "relrl.cli.demo",
     "examples": "relrl.cli.examples",
     "replay": "relrl.cli.replay",
+    "migrate": "relrl.cli.migrate",
     "tree": "relrl.cli.tree",
     "report": "relrl.cli.report",
     "learn": "relrl.cli.learn",

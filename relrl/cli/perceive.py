@@ -12,7 +12,8 @@ IMAGE_OUT = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl perceive``."""
-    parser.add_argument("image", nargs="?", help="an image file (PNG, JPEG, ...)")
+    parser.add_argument("image", nargs="?", help="an image file (PNG, JPEG, ...), or a ROS 2 "
+                                                 "bag BAG.mcap[:TOPIC]: every frame's facts")
     parser.add_argument("--camera", metavar="SRC",
                         help="a camera source instead: 0, cam://0, video.mp4, a folder, "
                              "synthetic://?looking_at=left&objects=left:apple")
@@ -53,28 +54,39 @@ def run(args: argparse.Namespace) -> int:
         if args.annotate else None  # before reading a single frame
     perceiver = Perceiver(threads=args.threads)
 
+    bag = args.image is not None and (args.image.lower().endswith(".mcap")
+                                      or ".mcap:" in args.image)
+
     def frames():  # one at a time: --frames 1000000 holds one frame, not a million
+        if bag:  # every frame of the bag, in order, with its recorded time
+            from perception.bag import BagCamera, parse_bag_source
+
+            with BagCamera(*parse_bag_source(args.image), paced=False) as cam:
+                while (frame := cam.read()) is not None:
+                    yield frame, f" t={cam.stamp / 1e9:.6f}"
+            return
         if args.image is not None:
-            yield read_image(args.image)
+            yield read_image(args.image), ""
             return
         with open_camera(args.camera) as cam:
             for _ in range(args.frames):
                 frame = cam.read()
                 if frame is None:
                     return
-                yield frame
+                yield frame, ""
 
     last = percept = None
     with perceiver:
-        for i, frame in enumerate(frames()):
-            if args.frames > 1:
-                print(f"% frame {i}")
+        for i, (frame, stamp) in enumerate(frames()):
+            if args.frames > 1 or bag:
+                print(f"% frame {i}{stamp}")
             percept = perceiver.analyse(frame, args.looking_at)
             for fact in percept.facts:
                 print(format_fact(fact))
             last = frame
     if last is None:
-        raise PerceptionError(f"camera {args.camera!r} gave no frame")
+        raise PerceptionError(f"{args.image if bag else 'camera ' + repr(args.camera)} gave "
+                              "no frame")
     if annotate_to is not None:
         ext = annotate_to.suffix.lower() if annotate_to.suffix.lower() in IMAGE_OUT else ".png"
         ok, data = cv2.imencode(ext, annotate(last, percept))

@@ -8,6 +8,7 @@ sources, the log file) and stops it again.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import sys
 import time
 from contextlib import contextmanager
@@ -26,12 +27,17 @@ def add_session_arguments(parser: argparse.ArgumentParser) -> None:
                    help="serve a live web page of the session (default 127.0.0.1 and a free "
                         "port, printed at start; off localhost a token is required)")
     g.add_argument("--monitor-rate", type=float, default=10.0, metavar="HZ",
-                   help="views and frames sent to the browser per second, at most (10)")
+                   help="views and frames sent to the browser (and to Foxglove, when not "
+                        "recording) per second, at most (10)")
     g.add_argument("--monitor-hold", action="store_true",
                    help="keep the page up after the session ends, until Ctrl-C")
+    g.add_argument("--foxglove", nargs="?", const="", default=None, metavar="HOST:PORT",
+                   help="serve the session live to Foxglove over its WebSocket protocol "
+                        "(default 127.0.0.1:8765; off localhost a token is required; needs "
+                        "the mcap and foxglove extras)")
     g.add_argument("--record", action="store_true",
-                   help="record frames, the tree and events beside the trace in --out: a "
-                        "self-contained folder for `relrl replay`")
+                   help="record the session into --out DIR/session.mcap (MCAP: Foxglove "
+                        "opens it, `relrl replay` scrubs it; needs the mcap extra)")
     g.add_argument("--record-rate", type=float, default=10.0, metavar="HZ",
                    help="recorded frames per second, at most (10; 0: every time unit, so "
                         "`--camera DIR` can perceive them again)")
@@ -116,6 +122,14 @@ def _check(args: argparse.Namespace) -> None:
         raise ConfigError(f"--record-quality must be in 1..100, not {args.record_quality}")
     if args.monitor_hold and args.monitor is None:
         raise ConfigError("--monitor-hold needs --monitor")
+    if args.record or args.foxglove is not None:
+        missing = [name for name in ("mcap", "mcap_ros2")
+                   + (("websockets",) if args.foxglove is not None else ())
+                   if importlib.util.find_spec(name) is None]
+        if missing:
+            extras = "mcap,foxglove" if args.foxglove is not None else "mcap"
+            raise ConfigError(f"{'--record' if args.record else '--foxglove'} needs "
+                              f"{', '.join(missing)}: pip install 'relrl[{extras}]'")
 
 
 @contextmanager
@@ -137,6 +151,15 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
             session.closers.append(session.server)
             note = " (token required: not bound to localhost)" if session.server.token else ""
             print(f"monitor: {session.server.url}{note}", flush=True)
+        if args.foxglove is not None:
+            from relrl.recording.recorder import Recorder
+
+            opts.recorder = Recorder(foxglove=args.foxglove)
+            opts.live_rate = args.monitor_rate
+            session.closers.append(opts.recorder)
+            note = " (token required: not bound to localhost)" if opts.recorder.token else ""
+            print(f"foxglove: {opts.recorder.url}{note} (in Foxglove: Open connection, "
+                  "Foxglove WebSocket)", flush=True)
         yield session
     finally:
         for thing in reversed(session.closers):

@@ -47,8 +47,7 @@ def session_manifest(run: Any, opts: Any, summary: dict[str, Any], timing: dict[
     from relrl.terms import format_term
 
     ep = run.episode
-    files = {"trace": "trace.jsonl", "frames": "frames.jsonl", "trees": "trees.jsonl",
-             "events": "events.jsonl", "summary": "summary.json", "timing": "timing.json",
+    files = {"trace": "trace.jsonl", "summary": "summary.json", "timing": "timing.json",
              **getattr(run.tap, "files", {})}
     if "policy" in summary:
         files["policy"] = summary["policy"]

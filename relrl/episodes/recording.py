@@ -1,36 +1,37 @@
-"""What a session shows and keeps of every time unit: the extended trace, recorded frames,
-the tree over time, and the live monitor's feed.
+"""What a session shows and keeps of every time unit: the extended trace, the recording, and
+the live monitor's and Foxglove's feeds.
 
 :class:`SessionTap` is the one hook the session calls per time unit. It builds a
 :class:`~relrl.monitor.view.StepView` (percepts, working memory with ages, necessities,
 reward, response and explanation, the head's commanded pose, running CGI and eye contacts,
 what perception found in the frame) when someone needs it -- every unit for the trace
-(``--out``), at the monitor's rate for the browser -- and otherwise only hands the necessity
-outputs to the monitor's plot.
+(``--out``) and the recording, at the monitor's rate for the browser and a live Foxglove --
+and otherwise only hands the necessity outputs to the monitor's plot.
 
-A recorded session (``--out DIR --record``) is a self-contained folder::
+A recorded session (``--out DIR --record``) is one MCAP file beside the run's outputs::
 
-    session.json     what was run: episode, learner, devices, rates, the files below
+    session.mcap     every channel of the session (relrl.recording.channels): the camera as
+                     ROS 2 CompressedImage with Foxglove annotations, the head's joint
+                     states, percepts, working memory, necessities, reward, response and
+                     explanation, the tree whenever it changed, evaluations and naming; the
+                     script and domain attached, session.json and summary.json as metadata
+    session.json     what was run: episode, learner, devices, rates, the files
     episode.toml     the script, its domain path pointing at domain.pl
     domain.pl        the domain
-    trace.jsonl      one StepView per time unit (the frame index when one was recorded)
-    frames/          JPEG frames, 000001.jpg ... (``--record-rate`` per second at most;
-                     0: every time unit, which ``--camera DIR`` can perceive again)
-    frames.jsonl     one line per frame: index, time unit, file, where the head looked
-    trees.jsonl      the learner's tree whenever it changed (checked once a second)
-    events.jsonl     evaluations and naming executions as they happened
+    trace.jsonl      one StepView per time unit (``--out``; the frame index when one was
+                     recorded)
     summary.json, timing.json, policy, plots, run.log
 
-``relrl replay DIR`` serves the monitor's page over it.
+``relrl replay DIR`` (or ``relrl replay DIR/session.mcap``) serves the monitor's page over
+it; Foxglove opens ``session.mcap``. Frames are recorded at ``--record-rate`` per second at
+most (0: every time unit, which ``--camera DIR`` can perceive again).
 """
 
 from __future__ import annotations
 
 import json
-import queue
 import re
 import shutil
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -38,71 +39,29 @@ from typing import Any
 from relrl.episodes.provenance import provenance
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
 
-__all__ = ["FrameRecorder", "SessionTap", "write_manifest"]
+__all__ = ["RECORDING", "SessionTap", "write_manifest"]
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")
 #: seconds between checks of whether the learner's tree changed.
 TREE_PERIOD = 1.0
+#: the recording's file in the session folder.
+RECORDING = "session.mcap"
 
 
-class FrameRecorder:
-    """JPEG frames written by a thread of their own (the control loop only queues them).
+class _Rate:
+    """At most ``rate`` a second (0: every time)."""
 
-    Args:
-        folder: the session folder (frames go to ``folder/frames``).
-        rate: frames per second at most; 0 records every frame given.
-        quality: JPEG quality, 1..100.
-    """
-
-    def __init__(self, folder: Path, rate: float = 10.0, quality: int = 85) -> None:
-        self.folder = folder
-        (folder / "frames").mkdir(parents=True, exist_ok=True)
-        self.rate, self.quality = float(rate), int(quality)
-        self.count = 0
-        self.bytes = 0
+    def __init__(self, rate: float) -> None:
+        self.rate = float(rate)
         self._next = 0.0
-        self._index = open(folder / "frames.jsonl", "w", encoding="utf-8")  # noqa: SIM115
-        self._queue: queue.Queue[tuple[Path, Any] | None] = queue.Queue(maxsize=64)
-        self._thread = threading.Thread(target=self._write, name="relrl-frames", daemon=True)
-        self._thread.start()
-        self._error: BaseException | None = None
 
     def due(self) -> bool:
-        """Whether a frame is to be recorded now."""
         return self.rate <= 0 or time.perf_counter() >= self._next
 
-    def add(self, frame: Any, t: int, looking_at: str | None) -> int:
-        """Queue a frame of time unit ``t``; returns its index (from 1)."""
-        if self._error is not None:
-            raise self._error
-        self.count += 1
-        name = f"{self.count:06d}.jpg"
-        self._queue.put((self.folder / "frames" / name, frame))  # waits when 64 are queued
-        self._index.write(json.dumps({"index": self.count, "t": t, "file": f"frames/{name}",
-                                      "looking_at": looking_at}) + "\n")
+    def took(self) -> None:
         if self.rate > 0:
             self._next = time.perf_counter() + 1.0 / self.rate
-        return self.count
-
-    def _write(self) -> None:
-        from relrl.monitor.frames import encode_jpeg
-
-        while (item := self._queue.get()) is not None:
-            path, frame = item
-            try:
-                data = encode_jpeg(frame, self.quality)
-                path.write_bytes(data)
-                self.bytes += len(data)
-            except (OSError, ValueError) as exc:  # disk full, ...: raised in the loop
-                self._error = exc
-
-    def close(self) -> None:
-        """Write every queued frame and close the index (safe twice)."""
-        if not self._index.closed:
-            self._queue.put(None)
-            self._thread.join()
-            self._index.close()
 
 
 def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
@@ -131,7 +90,7 @@ def write_manifest(folder: Path, data: dict[str, Any]) -> None:
 
 
 class SessionTap:
-    """The per-time-unit hook of a session: trace, frames, trees, events, monitor.
+    """The per-time-unit hook of a session: trace, recording, monitor, Foxglove.
 
     Args:
         run: the session's run state (knowledge base, learner, metrics).
@@ -139,43 +98,60 @@ class SessionTap:
         env: the session's world (its ``last_frame`` / ``last_percept`` when it has them).
         head: the :class:`head.Head` the responses go to, or ``None``.
         hub: the live monitor's :class:`~relrl.monitor.hub.Hub`, or ``None``.
-        record: record frames, trees and events into ``out``.
+        record: record the session into ``out/session.mcap``.
         record_rate: frames per second at most (0: every time unit).
         record_quality: JPEG quality.
+        recorder: a started :class:`~relrl.recording.recorder.Recorder` (serving Foxglove),
+            or ``None`` (one is started when recording).
+        live_rate: time units (and frames) sent to Foxglove per second at most when the
+            session is not recorded (a recorded session sends every unit it records).
     """
 
     def __init__(self, run: Any, out: Path | None, env: Any, head: Any = None, *,
                  hub: Any = None, record: bool = False, record_rate: float = 10.0,
-                 record_quality: int = 85) -> None:
+                 record_quality: int = 85, recorder: Any = None,
+                 live_rate: float = 10.0) -> None:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
         self.trace = open(out / "trace.jsonl", "w", encoding="utf-8") \
             if out is not None else None  # noqa: SIM115
-        self.frames = FrameRecorder(out, record_rate, record_quality) \
-            if record and out is not None else None
-        self._trees = open(out / "trees.jsonl", "w", encoding="utf-8") \
-            if record and out is not None else None  # noqa: SIM115
-        self._events = open(out / "events.jsonl", "w", encoding="utf-8") \
-            if record and out is not None else None  # noqa: SIM115
+        self.recording = record and out is not None
+        self.recorder, self._own = recorder, False
+        self.quality = int(record_quality)
+        self.frames = 0
+        self._frame_rate = _Rate(record_rate if self.recording else live_rate)
+        self._live = _Rate(0 if self.recording else live_rate)  # units sent when live only
+        self.files: dict[str, str] = {}
+        if self.recording:
+            if self.recorder is None:
+                from relrl.recording.recorder import Recorder
+
+                self.recorder, self._own = Recorder(), True
+            self.recorder.open(out / RECORDING)
+            self.files = _copy_script(run.episode, out)
+            self.files["recording"] = RECORDING
+            for name in ("episode.toml", "domain.pl"):
+                if (out / name).is_file():
+                    self.recorder.attach(name, "text/plain", (out / name).read_bytes())
         self._tree_key: Any = None
         self._tree_graph: dict[str, Any] | None = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
-        self.files: dict[str, str] = {}
-        if record and out is not None:
-            self.files = _copy_script(run.episode, out)
-        if hub is not None:
-            from relrl.terms import format_term
+        from relrl.terms import format_term
 
-            ep = run.episode
-            hub.info.update({
-                "episode": ep.name, "learner": ep.learner, "seed": ep.seed,
-                "steps": ep.steps, "perception": ep.perception,
-                "necessities": run.agent.necessities,
-                "responses": [format_term(r) for r in run.agent.responses],
-                "where": {k: v for k, v in provenance(run.opts).items()
-                          if not k.endswith("_label")},
-            })
+        ep = run.episode
+        self.info = {
+            "episode": ep.name, "learner": ep.learner, "seed": ep.seed,
+            "steps": ep.steps, "perception": ep.perception,
+            "necessities": run.agent.necessities,
+            "responses": [format_term(r) for r in run.agent.responses],
+            "where": {k: v for k, v in provenance(run.opts).items()
+                      if not k.endswith("_label")},
+        }
+        if hub is not None:
+            hub.info.update(self.info)
+        if self.recorder is not None:
+            self.recorder.session(self.info)
 
     def start(self) -> None:
         """The world has been reset: remember the first frame it perceived."""
@@ -191,7 +167,8 @@ class SessionTap:
     def want(self) -> tuple[str, ...]:
         """What the next step is to report from its one gateway call: working memory and
         the explanation when this time unit is traced or shown, nothing otherwise."""
-        self._asked = self.trace is not None or (self.hub is not None and self.hub.due())
+        self._asked = (self.trace is not None or (self.hub is not None and self.hub.due())
+                       or (self.recorder is not None and self._live.due()))
         return WANTS if self._asked else ()
 
     def step(self, record: Any, phase: str, *, outcome: str | None = None,
@@ -215,19 +192,33 @@ class SessionTap:
                       "caregiver": info.get("scene"), "focus": info["record"].focus,
                       "heard": info["words"], "naming": outcome, "said": said,
                       "overlay": overlay_of(percept, frame)}
-        if self.frames is not None and frame is not None and self.frames.due():
-            view.extra["frame"] = self.frames.add(frame, run.t, looked)
+        framed = None
+        if self.recorder is not None and frame is not None and self._frame_rate.due():
+            self._frame_rate.took()
+            self.frames += 1
+            view.extra["frame"] = self.frames
+            view.extra["frame_looking_at"] = looked  # where the head was when it was seen
+            framed = frame
         row = view.row()
+        sent = self.recorder is not None and (framed is not None or self._live.due())
+        line = json.dumps(row, sort_keys=True) if self.trace is not None or sent else ""
         if self.trace is not None:
-            self.trace.write(json.dumps(row, sort_keys=True) + "\n")
+            self.trace.write(line + "\n")
             self.trace.flush()
         if publish:
             hub.publish(dict(row), frame)
+        if sent:  # the writer process encodes the channels from the line
+            from relrl.monitor.frames import encode_jpeg
+
+            self._live.took()
+            self.recorder.unit(time.time_ns(), line.encode(),
+                               encode_jpeg(framed, self.quality) if framed is not None
+                               else None)
         self._tree(run.t)
         return row
 
     def _tree(self, t: int, force: bool = False) -> None:
-        if self.hub is None and self._trees is None:
+        if self.hub is None and self.recorder is None:
             return
         now = time.perf_counter()
         if not force and now < self._tree_next:
@@ -243,18 +234,15 @@ class SessionTap:
         self._tree_key = key
         if self.hub is not None:
             self.hub.set_tree(graph)
-        if self._trees is not None:
-            self._trees.write(json.dumps({"t": t, "graph": graph}) + "\n")
-            self._trees.flush()
+        if self.recorder is not None:
+            self.recorder.tree(t, graph)
 
     def event(self, kind: str, **data: Any) -> None:
         """A session event (evaluation, naming execution) for the monitor and the recording."""
         if self.hub is not None:
             self.hub.event(kind, t=self.run.t, **data)
-        if self._events is not None:
-            self._events.write(json.dumps({"kind": kind, "t": self.run.t, **data},
-                                          default=str) + "\n")
-            self._events.flush()
+        if self.recorder is not None:
+            self.recorder.event(kind, self.run.t, **data)
 
     def finish(self) -> dict[str, Any]:
         """The session ended: the last tree, the last frame (when every unit is recorded).
@@ -263,21 +251,32 @@ class SessionTap:
             what was recorded (frames, bytes), for ``session.json``.
         """
         self._tree(self.run.t, force=True)
-        frame, _, looked = self._seen
-        if self.frames is not None and self.frames.rate <= 0 and frame is not None:
-            self.frames.add(frame, self.run.t + 1, looked)
+        frame, percept, looked = self._seen
+        if self.recording and self._frame_rate.rate <= 0 and frame is not None:
+            from relrl.monitor.frames import encode_jpeg
+
+            self.frames += 1
+            self.recorder.last_frame(time.time_ns(), {
+                "t": self.run.t + 1, "overlay": overlay_of(percept, frame),
+                "frame": self.frames, "frame_looking_at": looked},
+                encode_jpeg(frame, self.quality))
         if self.hub is not None:
             self.hub.finish()
-        return self.close()
+        if not self.recording:
+            return {}
+        return {**self.recorder.stats(), "record_rate": self._frame_rate.rate,
+                "jpeg_quality": self.quality, "file": RECORDING}
 
-    def close(self) -> dict[str, Any]:
-        """Flush and close every file (safe twice); returns the recording's figures."""
-        stats: dict[str, Any] = {}
-        if self.frames is not None:
-            self.frames.close()
-            stats = {"frames": self.frames.count, "frame_bytes": self.frames.bytes,
-                     "record_rate": self.frames.rate, "jpeg_quality": self.frames.quality}
-        for fh in (self.trace, self._trees, self._events):
-            if fh is not None and not fh.closed:
-                fh.close()
-        return stats
+    def close(self, manifest: dict[str, Any] | None = None,
+              summary: dict[str, Any] | None = None) -> None:
+        """Close the recording -- with what was run and its summary in it, when given --
+        and the trace (safe twice)."""
+        try:
+            if self.recording and self.recorder is not None:
+                self.recorder.close_file({name: value for name, value in (
+                    ("relrl.session", manifest), ("relrl.summary", summary)) if value})
+        finally:
+            if self._own:
+                self.recorder.close()
+            if self.trace is not None and not self.trace.closed:
+                self.trace.close()

@@ -97,7 +97,9 @@ class RunOptions:
             (``poll()`` once per time unit) or a queue (``get_nowait()``), or ``None``.
         plots: write PNG plots (needs matplotlib).
         monitor: the live monitor's :class:`relrl.monitor.Hub`, or ``None``.
-        record: record frames, trees and events into ``out`` (:mod:`.recording`).
+        recorder: a :class:`relrl.recording.recorder.Recorder` serving Foxglove, or ``None``.
+        live_rate: time units sent to Foxglove per second at most, when not recording.
+        record: record the session into ``out/session.mcap`` (:mod:`.recording`).
         record_rate: recorded frames per second at most (0: every time unit).
         record_quality: JPEG quality of recorded frames.
         timeout: seconds one control step (one gateway call) may run before the run stops
@@ -115,6 +117,8 @@ class RunOptions:
     words: Any = None
     plots: bool = True
     monitor: Any = None
+    recorder: Any = None
+    live_rate: float = 10.0
     record: bool = False
     record_rate: float = 10.0
     record_quality: int = 85
@@ -246,7 +250,8 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         env, actuator = _world(episode, opts)
         run.tap = SessionTap(run, out, env, getattr(actuator, "head", None), hub=opts.monitor,
                              record=opts.record, record_rate=opts.record_rate,
-                             record_quality=opts.record_quality)
+                             record_quality=opts.record_quality, recorder=opts.recorder,
+                             live_rate=opts.live_rate)
         phase_name = episode.phase_at(1).name
         interaction = Interaction(env, run.agent, actuator=actuator,
                                   on_step=lambda r: _on_step(run, r, phase_name))
@@ -331,7 +336,9 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             written = True
             _write_outputs(run, out, summary, timing)
             if opts.record:
-                write_manifest(out, session_manifest(run, opts, summary, timing, recorded))
+                manifest = session_manifest(run, opts, summary, timing, recorded)
+                write_manifest(out, manifest)
+                run.tap.close(manifest, summary)  # both also inside the recording
         return summary
     except BaseException as exc:  # a lost device, a fault, a second Ctrl-C
         failed = True

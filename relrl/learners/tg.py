@@ -51,7 +51,7 @@ class TGLearner(Learner):
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "temperature": 1.0,
                 "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
                 "stale_bonus": 1.0, "half_life": 1000.0, "novelty_bonus": 20.0,
-                "novelty_confidence": 2.0, "keep_examples": 32.0}
+                "novelty_confidence": 2.0, "keep_examples": 0.0}
 
     def _check_params(self) -> None:
         super()._check_params()

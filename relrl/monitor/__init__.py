@@ -23,17 +23,19 @@ __all__ = ["Hub", "StepView", "start_live", "start_replay"]
 
 
 def start_live(hub: Hub, address: str | None = None, token: str | None = None) -> Any:
-    """Serve the live page over ``hub``; returns the started
-    :class:`~relrl.monitor.server.MonitorServer`."""
-    from relrl.monitor.server import LiveSource, MonitorServer
+    """Serve the live page over ``hub`` from a process of its own; returns the started
+    :class:`~relrl.monitor.live.LiveServer`."""
+    from relrl.monitor.live import LiveServer
 
-    return MonitorServer(LiveSource(hub), address, token=token).start()
+    return LiveServer(hub, address, token=token).start()
 
 
 def start_replay(folder: Any, address: str | None = None, token: str | None = None) -> Any:
-    """Serve the replay page of a recorded session folder; returns the started server."""
-    from relrl.monitor.replay import Recording, ReplaySource
+    """Serve the replay page of a recorded session (a folder, an ``.mcap`` file, or one read
+    already); returns the started server."""
+    from relrl.monitor.replay import ReplaySource
     from relrl.monitor.server import MonitorServer
+    from relrl.recording.reader import open_recording
 
-    rec = folder if isinstance(folder, Recording) else Recording(folder)
+    rec = folder if hasattr(folder, "rows") else open_recording(folder)
     return MonitorServer(ReplaySource(rec), address, token=token).start()

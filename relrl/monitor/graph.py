@@ -5,10 +5,18 @@ A tree learner (ETG, tg) gives its tree as ``learner.graph()``: nodes ``{"id", "
 :func:`to_dot` draws it (tests as boxes, leaves as rounded boxes with their ranked actions,
 ``yes`` edges solid, ``no`` edges dashed) and :func:`render` runs Graphviz's ``dot`` (Debian
 package ``graphviz``, Python package ``graphviz`` from the ``monitor`` extra).
+
+Every text that reaches ``dot`` is data, never markup: labels are cut to a bounded size,
+control characters and unpaired surrogates are replaced, backslashes and ``<...>`` lose their
+DOT meaning (no HTML-like labels, so no links in the picture), and node names are generated
+(``n0``, ``n1``, ...), never taken from the graph. What ``dot`` still refuses is a
+:class:`GraphError`.
 """
 
 from __future__ import annotations
 
+import re
+import subprocess
 from typing import Any
 
 from relrl.errors import UserError
@@ -17,8 +25,12 @@ __all__ = ["GraphError", "learner_graph", "render", "to_dot"]
 
 #: the longest label line drawn; longer lines are cut with an ellipsis.
 LABEL_WIDTH = 48
+#: the most lines of one label drawn; more are summarised in a last line.
+LABEL_LINES = 12
 #: leaf entries shown per leaf (the best first).
 LEAF_ENTRIES = 4
+#: control characters (but the line break) and unpaired surrogates: replaced in labels.
+_UNPRINTABLE = re.compile("[\x00-\x09\x0b-\x1f\x7f\ud800-\udfff]")
 
 
 class GraphError(UserError):
@@ -46,9 +58,19 @@ def shown_graph(learner: Any, previous: dict[str, Any] | None) -> dict[str, Any]
         return previous
 
 
-def _cut(text: str) -> str:
-    lines = str(text).splitlines() or [""]
-    return "\n".join(s if len(s) <= LABEL_WIDTH else s[:LABEL_WIDTH - 1] + "…" for s in lines)
+def _cut(text: Any, width: int = LABEL_WIDTH) -> str:
+    """``text`` as at most :data:`LABEL_LINES` lines of ``width`` printable characters."""
+    lines = _UNPRINTABLE.sub("\ufffd", str(text)).splitlines() or [""]
+    if len(lines) > LABEL_LINES:
+        lines = lines[:LABEL_LINES - 1] + [f"… {len(lines) - LABEL_LINES + 1} more lines"]
+    return "\n".join(s if len(s) <= width else s[:width - 1] + "…" for s in lines)
+
+
+def _text(text: Any, width: int = LABEL_WIDTH) -> str:
+    """A label for ``dot``: cut (:func:`_cut`), backslashes and ``<...>`` taken literally."""
+    import graphviz
+
+    return graphviz.escape(_cut(text, width))
 
 
 def to_dot(graph: dict[str, Any], title: str = "") -> Any:
@@ -63,18 +85,23 @@ def to_dot(graph: dict[str, Any], title: str = "") -> Any:
         raise GraphError("drawing the tree needs the optional extra: pip install "
                          "'relrl[monitor]' (the graphviz package)") from None
     dot = graphviz.Digraph("tree", graph_attr={"rankdir": "TB", "fontsize": "10",
-                                               "label": title, "labelloc": "t"},
+                                               "label": _text(title, 160), "labelloc": "t"},
                            node_attr={"fontname": "Helvetica", "fontsize": "9"},
                            edge_attr={"fontname": "Helvetica", "fontsize": "8"})
     styles = {"test": {"shape": "box", "style": "filled", "fillcolor": "#dbe9f6"},
               "leaf": {"shape": "box", "style": "rounded,filled", "fillcolor": "#e6f4e1"},
               "null": {"shape": "plaintext", "fontcolor": "#888888"}}
-    for node in graph.get("nodes", []):
-        dot.node(str(node["id"]), _cut(node.get("label", "")),
-                 **styles.get(node.get("kind", "leaf"), styles["leaf"]))
-    for edge in graph.get("edges", []):
-        branch = edge.get("branch", "")
-        dot.edge(str(edge["from"]), str(edge["to"]), label=str(branch),
+    names: dict[str, str] = {}  # the graph's node ids -> n0, n1, ...: no id reaches dot
+    for node in graph.get("nodes") or ():
+        name = names.setdefault(str(node["id"]), f"n{len(names)}")
+        dot.node(name, _text(node.get("label", "")),
+                 **styles.get(str(node.get("kind", "leaf")), styles["leaf"]))
+    for edge in graph.get("edges") or ():
+        tail, head = names.get(str(edge["from"])), names.get(str(edge["to"]))
+        if tail is None or head is None:  # an edge to no node is not drawn
+            continue
+        branch = str(edge.get("branch", ""))
+        dot.edge(tail, head, label=_text(branch),
                  style="dashed" if branch == "no" else "solid")
     return dot
 
@@ -83,7 +110,8 @@ def render(graph: dict[str, Any], fmt: str = "svg", title: str = "") -> bytes:
     """The tree drawn by Graphviz's ``dot`` in ``fmt`` (svg, png, pdf, dot).
 
     Raises:
-        GraphError: Graphviz (the ``dot`` program) is missing, or ``fmt`` is unknown.
+        GraphError: Graphviz (the ``dot`` program) is missing, ``fmt`` is unknown, or
+            ``dot`` refused the graph (its first error line is said).
     """
     dot = to_dot(graph, title)
     if fmt == "dot":
@@ -97,3 +125,7 @@ def render(graph: dict[str, Any], fmt: str = "svg", title: str = "") -> bytes:
                          "graphviz") from None
     except ValueError as exc:
         raise GraphError(f"cannot draw the tree as {fmt!r}: {exc}") from None
+    except subprocess.CalledProcessError as exc:
+        said = (exc.stderr or b"").decode("utf-8", "replace").strip().splitlines()
+        raise GraphError("Graphviz's dot refused the tree: "
+                         + (said[0] if said else f"exit status {exc.returncode}")) from None

@@ -11,7 +11,10 @@ a thread of its own. They meet here, and the loop never waits for the server:
 * the server reads the newest view when it sends; a browser that is slow only ever gets the
   newest one, so views and frames in between are dropped, never queued.
 
-Frames are JPEG-encoded by the server thread, once per published frame, when a browser asks.
+Frames are JPEG-encoded once per published frame, by the thread that hands them to the web
+server's process (:mod:`relrl.monitor.live`). There a second hub, fed with
+:meth:`Hub.changes` and :meth:`Hub.apply`, answers the browsers; the robot's process holds
+none of their connections.
 """
 
 from __future__ import annotations
@@ -106,8 +109,10 @@ class Hub:
 
     # -- the server's side ----------------------------------------------------------------
 
-    def message(self, version: int, series_count: int) -> tuple[dict[str, Any] | None, int, int]:
-        """What is new since ``version`` and ``series_count`` (``None`` when nothing).
+    def message(self, version: int, series_count: int, *, keep: int = SERIES_SEND
+                ) -> tuple[dict[str, Any] | None, int, int]:
+        """What is new since ``version`` and ``series_count`` (``None`` when nothing), with at
+        most the ``keep`` newest points of the series.
 
         Returns:
             the message, the version and the series count it brings the reader to.
@@ -117,7 +122,7 @@ class Hub:
                 return None, version, series_count
             points = list(self._series)  # one atomic copy
             count = points[-1][0] if points else 0
-            series = [[t, ys, r] for n, t, ys, r in points[-SERIES_SEND:] if n > series_count]
+            series = [[t, ys, r] for n, t, ys, r in points[-keep:] if n > series_count]
             msg = {"info": {"rate": self.rate, **self.info}, "view": self.view,
                    "series": series, "tree_version": self.tree_version,
                    "events": list(self.events), "finished": self.finished}
@@ -126,13 +131,55 @@ class Hub:
     def jpeg(self, quality: int = 80) -> tuple[int, bytes] | None:
         """The newest frame as JPEG bytes with its sequence number (encoded once)."""
         with self._lock:
-            frame, seq = self.frame, self.frame_seq
-        if frame is None:
-            return None
-        cached = self._jpeg
+            frame, seq, cached = self.frame, self.frame_seq, self._jpeg
         if cached is not None and cached[0] == seq:
             return cached
+        if frame is None:
+            return None
         from relrl.monitor.frames import encode_jpeg
 
         self._jpeg = (seq, encode_jpeg(frame, quality))
         return self._jpeg
+
+    def tree_state(self) -> tuple[int, dict[str, Any] | None]:
+        """The tree's version and the tree (one consistent pair)."""
+        with self._lock:
+            return self.tree_version, self.tree
+
+    # -- handing over to another process (relrl.monitor.live) ----------------------------
+
+    def changes(self, mark: dict[str, int]) -> dict[str, Any] | None:
+        """What changed since ``mark`` (updated in place; start with ``{}``) as plain data
+        for :meth:`apply`: the message (every new point of the series the hub keeps), the
+        tree when it changed, the newest frame as JPEG when it changed. ``None``: nothing."""
+        update: dict[str, Any] = {}
+        msg, mark["version"], mark["count"] = self.message(
+            mark.get("version", -1), mark.get("count", 0), keep=SERIES_KEEP)
+        if msg is not None:
+            update["message"] = msg
+        tree_version, tree = self.tree_state()
+        if tree_version != mark.get("tree", -1):
+            update["tree"], mark["tree"] = (tree_version, tree), tree_version
+        got = self.jpeg()
+        if got is not None and got[0] != mark.get("frame", -1):
+            update["jpeg"], mark["frame"] = got, got[0]
+        return update or None
+
+    def apply(self, update: dict[str, Any]) -> None:
+        """Take over what another hub's :meth:`changes` gave."""
+        msg = update.get("message")
+        with self._lock:
+            if msg is not None:
+                self.info = {k: v for k, v in (msg.get("info") or {}).items() if k != "rate"}
+                self.view = msg.get("view")
+                for t, ys, r in msg.get("series") or ():
+                    self._series_count += 1
+                    self._series.append((self._series_count, t, ys, r))
+                self.events = list(msg.get("events") or ())
+                self.finished = bool(msg.get("finished"))
+            if "tree" in update:
+                self.tree_version, self.tree = update["tree"]
+            if "jpeg" in update:
+                self._jpeg = tuple(update["jpeg"])  # type: ignore[assignment]
+                self.frame_seq = self._jpeg[0]
+            self.version += 1

@@ -10,6 +10,13 @@ and no handler touches the robot or the knowledge base (they read the hub or the
 Bound to a loopback address, the server checks the Host header (no DNS rebinding); bound
 elsewhere, every request must carry the token printed at start (``?token=``, a
 ``Authorization: Bearer`` header, or the cookie the page sets).
+
+Hostile clients: connections, request time and send time are bounded
+(:mod:`relrl.monitor.bounds`); numbers in paths and queries are ASCII digits, at most 15 of
+them; every answer carries a content-security policy (the tree's SVG one that runs nothing)
+and ``nosniff``; JSON never holds NaN (it becomes ``null``); a handler that fails anyway
+answers 500 and logs one line, never a traceback. The live session's server runs in a
+process of its own (:mod:`relrl.monitor.live`); replay's in a thread.
 """
 
 from __future__ import annotations
@@ -17,6 +24,8 @@ from __future__ import annotations
 import asyncio
 import ipaddress
 import json
+import logging
+import re
 import secrets
 import socket
 import threading
@@ -24,12 +33,29 @@ from pathlib import Path
 from typing import Any
 
 from relrl.errors import ConfigError
+from relrl.monitor.bounds import Limits, bounded_protocol
+from relrl.monitor.schema import finite
 
-__all__ = ["MonitorServer", "build_app", "is_loopback", "parse_address"]
+__all__ = ["Endpoint", "LiveSource", "MonitorServer", "build_app", "host_of", "is_loopback",
+           "listen", "parse_address", "whole"]
+
+log = logging.getLogger(__name__)
 
 STATIC = Path(__file__).resolve().parent / "static"
 DEFAULT_HOST = "127.0.0.1"
 _READ_METHODS = frozenset({"GET", "HEAD"})
+#: the page: its own scripts, styles and pictures, nothing inline, never framed.
+PAGE_CSP = ("default-src 'none'; script-src 'self'; style-src 'self'; "
+            "img-src 'self' data: blob:; connect-src 'self'; base-uri 'none'; "
+            "form-action 'none'; frame-ancestors 'none'")
+#: the tree's SVG, even opened on its own: no script, no link target, a sandbox.
+PICTURE_CSP = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; sandbox"
+_SECURITY = [(b"x-content-type-options", b"nosniff"), (b"referrer-policy", b"no-referrer"),
+             (b"cross-origin-resource-policy", b"same-origin")]
+_WHOLE = re.compile(r"-?[0-9]{1,15}")
+#: client connections waiting to be accepted (the kernel holds them, not this process), and
+#: the most accepted in one go (asyncio takes up to this many before the cap is applied).
+BACKLOG = 64
 
 
 def parse_address(text: str | None) -> tuple[str, int]:
@@ -68,18 +94,53 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+def host_of(header: str) -> str:
+    """The host of a ``Host`` header, lower-case, without its port or IPv6 brackets
+    (``[::1]:8000`` and ``[::1]`` are ``::1``; ``localhost:80`` is ``localhost``)."""
+    value = header.strip().lower()
+    if value.startswith("["):
+        inside, bracket, _ = value[1:].partition("]")
+        return inside if bracket else ""
+    if value.count(":") == 1:
+        return value.split(":")[0]
+    return value  # a name, an IPv4 address, or an IPv6 address given without brackets
+
+
+def whole(text: str | None) -> int | None:
+    """``text`` as an integer when it is ASCII digits (at most 15, an optional minus), else
+    ``None`` (no ``'²'``, no 5,000-digit numbers)."""
+    if text is None or not _WHOLE.fullmatch(text):
+        return None
+    return int(text)
+
+
+def _dumps(data: Any) -> str:
+    try:
+        return json.dumps(data, allow_nan=False, default=str)
+    except ValueError:  # a NaN somewhere: said as null
+        return json.dumps(finite(data), allow_nan=False, default=str)
+
+
 def _json(data: Any, status: int = 200) -> Any:
     from starlette.responses import Response
 
-    return Response(json.dumps(data, allow_nan=False, default=str), status_code=status,
-                    media_type="application/json", headers={"Cache-Control": "no-store"})
+    return Response(_dumps(data), status_code=status, media_type="application/json",
+                    headers={"Cache-Control": "no-store"})
+
+
+def _text(message: str, status: int) -> Any:
+    from starlette.responses import Response
+
+    return Response(message + "\n", status_code=status, media_type="text/plain",
+                    headers={"Cache-Control": "no-store"})
 
 
 class _Guard:
     """ASGI middleware: GET/HEAD only, the token off loopback, the Host header on loopback."""
 
     def __init__(self, app: Any, token: str | None, hosts: set[str]) -> None:
-        self.app, self.token, self.hosts = app, token, hosts
+        self.app, self.token = app, token
+        self.hosts = {host_of(h) if h.startswith("[") else h.lower() for h in hosts}
 
     def _token_of(self, scope: dict[str, Any]) -> str | None:
         from urllib.parse import parse_qs
@@ -104,24 +165,49 @@ class _Guard:
             return
         from starlette.responses import PlainTextResponse
 
+        started = False
+
+        async def secured(message: dict[str, Any]) -> None:
+            nonlocal started
+            if message["type"] == "http.response.start":
+                started = True
+                headers = list(message.get("headers", []))
+                kind = dict(headers).get(b"content-type", b"")
+                csp = PICTURE_CSP if kind.startswith(b"image/svg") else PAGE_CSP
+                message = {**message, "headers": headers + _SECURITY + [
+                    (b"content-security-policy", csp.encode())]}
+            await send(message)
+
         if scope["method"] not in _READ_METHODS:
             response = PlainTextResponse("the monitor is read-only\n", status_code=405,
                                          headers={"Allow": "GET, HEAD"})
         elif self.token is not None:
             given = self._token_of(scope) or ""
             if secrets.compare_digest(given.encode(), self.token.encode()):
-                await self.app(scope, receive, send)
+                await self._answer(scope, receive, secured, lambda: started)
                 return
             response = PlainTextResponse("a token is required: use the address printed "
                                          "when the monitor started\n", status_code=401)
         else:
             headers = dict(scope.get("headers", []))
-            host = headers.get(b"host", b"").decode("latin-1").rsplit(":", 1)[0].strip("[]")
+            host = host_of(headers.get(b"host", b"").decode("latin-1"))
             if host in self.hosts:
-                await self.app(scope, receive, send)
+                await self._answer(scope, receive, secured, lambda: started)
                 return
             response = PlainTextResponse(f"unexpected Host {host!r}\n", status_code=403)
-        await response(scope, receive, send)
+        await response(scope, receive, secured)
+
+    async def _answer(self, scope: dict[str, Any], receive: Any, send: Any,
+                      started: Any) -> None:
+        """The application's answer; one that fails is a 500 and one log line."""
+        try:
+            await self.app(scope, receive, send)
+        except Exception as exc:  # a bug: said in one line, the server goes on
+            log.warning("the monitor could not answer %s: %s: %s", scope.get("path"),
+                        type(exc).__name__, str(exc)[:200])
+            if not started():
+                await _text("the monitor could not answer this request", 500)(
+                    scope, receive, send)
 
 
 def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None = None) -> Any:
@@ -153,7 +239,7 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
             while True:
                 msg, version, count = source.message(version, count)
                 if msg is not None:
-                    yield f"data: {json.dumps(msg, allow_nan=False, default=str)}\n\n"
+                    yield f"data: {_dumps(msg)}\n\n"
                     if msg.get("finished"):
                         return
                 await asyncio.sleep(source.period)
@@ -164,25 +250,37 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
 
     def _jpeg(data: bytes | None) -> Any:
         if data is None:
-            return Response("no frame\n", status_code=404, media_type="text/plain")
+            return _text("no frame", 404)
         return Response(data, media_type="image/jpeg", headers={"Cache-Control": "no-store"})
 
     async def frame(request: Any) -> Any:
-        got = source.jpeg()  # about a millisecond for a 320x240 frame, once per frame
+        got = source.jpeg()  # encoded once per frame, by whoever feeds the hub
         return _jpeg(None if got is None else got[1])
 
     async def recorded_frame(request: Any) -> Any:
-        return _jpeg(source.frame_jpeg(int(request.path_params["index"])))
+        index = whole(request.path_params["index"])
+        if index is None:
+            return _text("no frame (frames are /frames/N.jpg, N from 1)", 404)
+        return _jpeg(await asyncio.to_thread(source.frame_jpeg, index))
 
     async def tree(request: Any) -> Any:
-        t = request.query_params.get("t")
-        svg = await asyncio.to_thread(source.tree_svg, int(t) if t and t.isdigit() else None)
+        from relrl.monitor.graph import GraphError
+
+        text = request.query_params.get("t")
+        t = whole(text)
+        if text is not None and t is None:
+            return _text(f"t must be a time unit (a whole number), not {text[:40]!r}", 400)
+        try:
+            svg = await asyncio.to_thread(source.tree_svg, t)
+        except GraphError as exc:
+            return _text(f"the tree cannot be drawn: {exc}", 422)
         if svg is None:
-            return Response("no tree\n", status_code=404, media_type="text/plain")
+            return _text("no tree", 404)
         return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-store"})
 
     async def step(request: Any) -> Any:
-        row = source.step(int(request.path_params["t"]))
+        t = whole(request.path_params["t"])
+        row = None if t is None else source.step(t)
         return _json(row) if row is not None else _json({"error": "no such time unit"}, 404)
 
     async def series(request: Any) -> Any:
@@ -197,10 +295,24 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
     if source.mode == "live":
         routes += [Route("/api/events", events), Route("/frame.jpg", frame)]
     else:
-        routes += [Route("/api/step/{t:int}", step), Route("/api/series", series),
-                   Route("/frames/{index:int}.jpg", recorded_frame)]
+        routes += [Route("/api/step/{t}", step), Route("/api/series", series),
+                   Route("/frames/{index}.jpg", recorded_frame)]
     app = Starlette(routes=routes)
     return _Guard(app, token, hosts or {"127.0.0.1", "localhost", "::1"})
+
+
+def drawn(graph: dict[str, Any] | None) -> bytes | Exception | None:
+    """The tree's SVG, the :class:`~relrl.monitor.graph.GraphError` saying why it cannot be
+    drawn (kept, so a tree that fails is not drawn again), or ``None`` for no tree."""
+    from relrl.monitor.graph import GraphError, render
+
+    if not graph or not graph.get("nodes"):
+        return None
+    try:
+        return render(graph)
+    except GraphError as exc:
+        log.warning("the tree cannot be drawn: %s", exc)
+        return exc
 
 
 class LiveSource:
@@ -211,7 +323,7 @@ class LiveSource:
     def __init__(self, hub: Any) -> None:
         self.hub = hub
         self.period = hub.period
-        self._svg: tuple[int, bytes | None] = (-1, None)
+        self._svg: tuple[int, bytes | Exception | None] = (-1, None)
         self._svg_lock = threading.Lock()
 
     def info(self) -> dict[str, Any]:
@@ -224,16 +336,108 @@ class LiveSource:
         return self.hub.jpeg()
 
     def tree_svg(self, t: int | None = None) -> bytes | None:
-        from relrl.monitor.graph import render
+        """The newest tree as SVG (``t`` is for replay; live shows the newest).
 
+        Raises:
+            GraphError: the tree cannot be drawn.
+        """
         with self._svg_lock:
-            version, graph = self.hub.tree_version, self.hub.tree
+            version, graph = self.hub.tree_state()
             if self._svg[0] != version:
-                self._svg = (version, render(graph) if graph and graph.get("nodes") else None)
-            return self._svg[1]
+                self._svg = (version, drawn(graph))
+            svg = self._svg[1]
+        if isinstance(svg, Exception):
+            raise svg
+        return svg
 
 
-class MonitorServer:
+def listen(host: str, port: int, what: str = "the monitor",
+           backlog: int | None = None) -> socket.socket:
+    """A TCP socket listening on ``host:port`` (port 0: a free one).
+
+    Args:
+        host, port: the address.
+        what: who would listen there, for the message.
+        backlog: connections the kernel may hold before they are accepted (default
+            :data:`BACKLOG`).
+
+    Raises:
+        ConfigError: the address cannot be bound (in use, not on this machine).
+    """
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    # IPPROTO_TCP named, so that the connections it accepts get TCP_NODELAY from asyncio
+    # (without it a keep-alive answer waits 40 ms for the client's delayed ACK)
+    sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((host, port))
+        sock.listen(BACKLOG if backlog is None else backlog)
+    except (OSError, OverflowError) as exc:
+        sock.close()
+        raise ConfigError(f"{what} cannot listen on {host}:{port}: "
+                          f"{getattr(exc, 'strerror', None) or exc}") from None
+    return sock
+
+
+class Endpoint:
+    """Where a monitor serves: the address, whether it is loopback, the token it requires.
+
+    Args:
+        address: ``HOST:PORT`` (see :func:`parse_address`).
+        token: the token to require (default: a fresh one when not bound to loopback).
+    """
+
+    def __init__(self, address: str | None = None, token: str | None = None) -> None:
+        self.host, self.port = parse_address(address)
+        self.loopback = is_loopback(self.host)
+        self.token = token if token is not None else \
+            (None if self.loopback else secrets.token_urlsafe(18))
+
+    @property
+    def address(self) -> str:
+        """``HOST:PORT`` (IPv6 hosts in brackets)."""
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"{host}:{self.port}"
+
+    @property
+    def url(self) -> str:
+        """The page's address (with the token when one is needed)."""
+        query = f"?token={self.token}" if self.token else ""
+        return f"http://{self.address}/{query}"
+
+    @property
+    def hosts(self) -> set[str]:
+        """The Host header values accepted on loopback."""
+        return {"127.0.0.1", "localhost", "::1", self.host}
+
+    @property
+    def running(self) -> bool:
+        """Whether it serves (between ``start()`` and ``close()``)."""
+        raise NotImplementedError
+
+    def start(self) -> Endpoint:
+        """Start serving; returns itself."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Stop serving (safe twice)."""
+        raise NotImplementedError
+
+    def __enter__(self) -> Any:
+        return self if self.running else self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _quiet(loop: Any, context: dict[str, Any]) -> None:
+    """The server loop's errors (an accept that failed, ...) as one log line."""
+    exc = context.get("exception")
+    log.warning("the monitor's server: %s%s", context.get("message", "error"),
+                f" ({type(exc).__name__}: {exc})" if exc is not None else "")
+
+
+class MonitorServer(Endpoint):
     """The web server in a daemon thread; ``start()`` binds (errors are one line), ``close()``
     stops it (safe twice).
 
@@ -241,51 +445,47 @@ class MonitorServer:
         source: a :class:`LiveSource` or a replay source.
         address: ``HOST:PORT`` (see :func:`parse_address`).
         token: the token to require (default: a fresh one when not bound to loopback).
+        limits: the bounds on clients (:class:`~relrl.monitor.bounds.Limits`).
     """
 
     def __init__(self, source: Any, address: str | None = None, *,
-                 token: str | None = None) -> None:
+                 token: str | None = None, limits: Limits | None = None) -> None:
+        super().__init__(address, token)
         self.source = source
-        self.host, self.port = parse_address(address)
-        self.loopback = is_loopback(self.host)
-        self.token = token if token is not None else \
-            (None if self.loopback else secrets.token_urlsafe(18))
+        self.limits = limits or Limits()
         self._server: Any = None
         self._thread: threading.Thread | None = None
+        self._sock: socket.socket | None = None
 
-    @property
-    def url(self) -> str:
-        """The page's address (with the token when one is needed)."""
-        host = f"[{self.host}]" if ":" in self.host else self.host
-        query = f"?token={self.token}" if self.token else ""
-        return f"http://{host}:{self.port}/{query}"
-
-    def start(self) -> MonitorServer:
-        """Bind and serve in the background.
+    def start(self, sock: socket.socket | None = None) -> MonitorServer:
+        """Serve in the background, on ``sock`` when given (a listening socket), else on a
+        socket bound to the address.
 
         Raises:
             ConfigError: the address cannot be bound (in use, not on this machine).
         """
         import uvicorn
 
-        family = socket.AF_INET6 if ":" in self.host else socket.AF_INET
-        sock = socket.socket(family, socket.SOCK_STREAM)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        try:
-            sock.bind((self.host, self.port))
-        except (OSError, OverflowError) as exc:
-            sock.close()
-            raise ConfigError(f"the monitor cannot listen on {self.host}:{self.port}: "
-                              f"{getattr(exc, 'strerror', None) or exc}") from None
-        sock.listen(16)
+        sock = sock if sock is not None else listen(self.host, self.port)
         self.port = sock.getsockname()[1]
-        hosts = {"127.0.0.1", "localhost", "::1", self.host}
-        app = build_app(self.source, token=self.token, hosts=hosts)
-        config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off",
-                                timeout_graceful_shutdown=1)
-        self._server = uvicorn.Server(config)
-        self._thread = threading.Thread(target=self._server.run, kwargs={"sockets": [sock]},
-                                        name="relrl-monitor", daemon=True)
+        app = build_app(self.source, token=self.token, hosts=self.hosts)
+        # uvicorn's own lines only for its errors: a client's bad request is not news on the
+        # session's console (a flood of them would flood it)
+        config = uvicorn.Config(app, http=bounded_protocol(self.limits), log_level="error",
+                                access_log=False, lifespan="off", timeout_graceful_shutdown=1,
+                                timeout_keep_alive=self.limits.idle_seconds,  # type: ignore
+                                h11_max_incomplete_event_size=16 * 1024,
+                                backlog=BACKLOG)  # also: accepted at once, at most
+        self._server = server = uvicorn.Server(config)
+
+        def run() -> None:
+            async def serve() -> None:
+                asyncio.get_running_loop().set_exception_handler(_quiet)
+                await server.serve(sockets=[sock])
+
+            asyncio.run(serve())
+
+        self._thread = threading.Thread(target=run, name="relrl-monitor", daemon=True)
         self._thread.start()
         self._sock = sock
         return self
@@ -297,11 +497,11 @@ class MonitorServer:
             self._server.force_exit = True
             if self._thread is not None:
                 self._thread.join(timeout=5)
-            self._sock.close()
+            if self._sock is not None:
+                self._sock.close()
             self._server = None
 
-    def __enter__(self) -> MonitorServer:
-        return self if self._server is not None else self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    @property
+    def running(self) -> bool:
+        """Whether it serves."""
+        return self._server is not None

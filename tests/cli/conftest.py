@@ -43,6 +43,17 @@ def jpeg_header(width: int, height: int) -> bytes:
         + b"\x00\x01\x00\x01\x00\x00" + sof + b"\xff\xd9"
 
 
+def _mcap_start() -> bytes:
+    """The first bytes an MCAP writer writes (magic and header record)."""
+    import io
+
+    from mcap.writer import Writer
+
+    buf = io.BytesIO()
+    Writer(buf).start(profile="", library="relrl")
+    return buf.getvalue()
+
+
 @pytest.fixture(scope="session")
 def corpus(tmp_path_factory) -> Path:
     """A folder of hostile inputs shared by the corpus tests."""
@@ -62,6 +73,8 @@ def corpus(tmp_path_factory) -> Path:
     (d / "truncated.png").write_bytes(png_bytes(64, 48)[:40])
     (d / "text.png").write_text("this is not an image\n")
     (d / "calibration.bin").write_bytes(noise)
+    (d / "junk.mcap").write_bytes(noise)
+    (d / "cut.mcap").write_bytes(_mcap_start()[:30])  # a recording cut in its header
     eps = {
         "ok.toml": episode_text(),
         "negative_seed.toml": episode_text().replace("seed = 1", "seed = -1"),

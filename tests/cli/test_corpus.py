@@ -135,6 +135,17 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("replay-missing", ["replay", "{d}/nope"], ["nope", "no such folder"]),
     ("replay-not-a-session", ["replay", "{d}/adir"], ["adir", "trace.jsonl"]),
     ("replay-a-file", ["replay", "{d}/afile"], ["afile"]),
+    ("replay-not-mcap", ["replay", "{d}/junk.mcap"], ["junk.mcap", "not an MCAP file"]),
+    ("replay-mcap-cut", ["replay", "{d}/cut.mcap"], ["cut.mcap", "cut short"]),
+    ("run-camera-not-a-bag", ["run", "{d}/ok.toml", "--camera", "{d}/junk.mcap"],
+     ["junk.mcap", "not an MCAP file"]),
+    ("run-foxglove-address", ["run", "{d}/ok.toml", "--foxglove", "host:port"],
+     ["host:port"]),
+    ("perceive-not-a-bag", ["perceive", "{d}/junk.mcap"], ["junk.mcap", "not an MCAP file"]),
+    ("perceive-bag-topic", ["perceive", "{d}/junk.mcap:/camera"], ["junk.mcap"]),
+    ("migrate-missing", ["migrate", "{d}/nope"], ["nope", "no such folder"]),
+    ("report-missing", ["report", "{d}/nope"], ["nope", "not a run folder"]),
+    ("migrate-a-file", ["migrate", "{d}/afile"], ["afile"]),
     ("tree-missing", ["tree", "{d}/nope.pl", "--domain", "{fruits}"], ["nope.pl"]),
     ("tree-no-domain", ["tree", "{d}/afile"], ["domain.pl", "--domain"]),
     ("tree-random-bytes", ["tree", "{d}/random.toml", "--domain", "{fruits}"],
@@ -147,6 +158,13 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
     ("demo-out-proc", ["demo", "--out", "/proc/foo"], ["/proc/foo"]),
     ("demo-workers", ["demo", "--workers", "0"], ["--workers", "0"]),
+    # ---- report ----------------------------------------------------------------------------
+    ("report-nothing", ["report"], ["run folders", "--update"]),
+    ("report-missing-run", ["report", "{d}/nope"], ["nope", "run folder"]),
+    ("report-not-a-run", ["report", "{d}/adir"], ["results.json", "no such file"]),
+    ("report-random-bytes", ["report", "{d}/random.toml"], ["random.toml", "run folder"]),
+    ("report-missing-markdown", ["report", "--check", "{d}/nope.md"], ["nope.md"]),
+    ("report-out-dir", ["report", "{d}/adir", "--out", "{d}/adir"], ["adir"]),
 ]
 
 

@@ -12,44 +12,48 @@ from perception import Perceiver, open_camera
 from perception.errors import CameraError
 from perception.render import SceneView, render
 from relrl.cli import main
-from relrl.episodes.recording import FrameRecorder
 from relrl.monitor.frames import decode_jpeg
+from relrl.recording.reader import McapRecording
 from tests.monitor.conftest import episode
 
 
-def test_frames_round_trip(tmp_path: Path) -> None:
+def test_frames_round_trip_through_jpeg(tmp_path: Path) -> None:
+    """A frame as the session records it: JPEG in a ROS 2 CompressedImage, decoded by
+    mcap-ros2-support, close to the frame."""
+    from mcap.records import Schema
+    from mcap_ros2.decoder import DecoderFactory
+
+    from relrl.monitor.frames import encode_jpeg
+    from relrl.recording.channels import IMAGE
+    from relrl.recording.encoder import Encoder
+
     frames = [render(SceneView(place, "frontal", {"left": "apple"}, 1.0, k))
               for k, place in enumerate(["centre", "left", "down", "right"])]
-    rec = FrameRecorder(tmp_path, rate=0, quality=90)
+    encoder = Encoder()
+    schema = Schema(id=1, name=IMAGE.schema, encoding="ros2msg", data=IMAGE.schema_data)
+    decode = DecoderFactory().decoder_for("cdr", schema)
     for t, frame in enumerate(frames, 1):
-        assert rec.add(frame, t, "centre") == t
-    rec.close()
-    rec.close()  # safe twice
-    index = [json.loads(x) for x in (tmp_path / "frames.jsonl").read_text().splitlines()]
-    assert [e["t"] for e in index] == [1, 2, 3, 4]
-    assert rec.bytes == sum((tmp_path / e["file"]).stat().st_size for e in index)
-    camera = open_camera(str(tmp_path))  # a folder with frames.jsonl: the recording source
-    for frame in frames:
-        back = camera.read()
+        jpeg = encode_jpeg(frame, 90)
+        messages = encoder.unit(t, {"t": t, "percepts": [], "overlay": None, "frame": t}, jpeg)
+        image = [decode(data) for ch, _, data in messages if ch is IMAGE]
+        assert len(image) == 1 and image[0].format == "jpeg" and bytes(image[0].data) == jpeg
+        back = decode_jpeg(bytes(image[0].data))
         assert back.shape == frame.shape
         err = np.abs(back.astype(int) - frame.astype(int)).mean()
         psnr = 10 * np.log10(255 ** 2 / np.mean((back.astype(float) - frame) ** 2))
         assert err < 3 and psnr > 30, (err, psnr)
-    assert camera.read() is None
-    decoded = decode_jpeg((tmp_path / index[0]["file"]).read_bytes())
-    assert decoded.shape == frames[0].shape
 
 
 def test_the_rate_limits_recorded_frames(tmp_path: Path) -> None:
-    rec = FrameRecorder(tmp_path, rate=1.0)
-    frame = np.zeros((8, 8, 3), np.uint8)
-    kept = 0
-    for t in range(50):
-        if rec.due():
-            rec.add(frame, t, None)
-            kept += 1
-    rec.close()
-    assert kept == 1  # 50 time units within far less than a second: one frame
+    """--record-rate 1 on a session far shorter than a second: one frame."""
+    script = episode(tmp_path, steps=30)
+    out = tmp_path / "rec"
+    assert main(["run", str(script), "--out", str(out), "--record", "--record-rate", "1",
+                 "--no-plots"]) == 0
+    rec = McapRecording(out / "session.mcap")
+    assert len(rec.rows) == 30
+    assert 1 <= len(rec.frames) <= 1 + 30 * 0.5  # a unit takes longer than 2 ms
+    assert sum(1 for r in rec.rows if r.get("frame")) == len(rec.frames)
 
 
 def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
@@ -58,8 +62,9 @@ def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
     assert main(["run", str(script), "--out", str(out), "--record", "--record-rate", "0",
                  "--record-quality", "95", "--no-plots"]) == 0
     rows = [json.loads(x) for x in (out / "trace.jsonl").read_text().splitlines()]
-    index = [json.loads(x) for x in (out / "frames.jsonl").read_text().splitlines()]
-    assert len(index) == 41 and [r["frame"] for r in rows] == list(range(1, 41))
+    rec = McapRecording(out / "session.mcap")
+    assert rec.rows == rows  # the recording holds the trace, every field
+    assert len(rec.frames) == 41 and [r["frame"] for r in rows] == list(range(1, 41))
     for key in ("percepts", "memory", "memory_size", "activation", "necessity", "reward",
                 "response", "explanation", "head", "metrics", "overlay"):
         assert key in rows[0], key
@@ -68,8 +73,8 @@ def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
     perceiver = Perceiver()
     camera = open_camera(f"recording://{out}")
     same = 0
-    for row, entry in zip(rows, index, strict=False):
-        facts = perceiver.perceive(camera.read(), looking_at=entry["looking_at"])
+    for row in rows:
+        facts = perceiver.perceive(camera.read(), looking_at=row["frame_looking_at"])
         from relrl.terms import format_term
 
         seen = [format_term(f) for f in facts if f[0] not in ("pan", "tilt")] \
@@ -87,7 +92,7 @@ def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
 
 
 def test_not_a_recording_is_a_clear_error(tmp_path: Path) -> None:
-    with pytest.raises(CameraError, match="frames.jsonl"):
+    with pytest.raises(CameraError, match="not a recorded session"):
         open_camera(f"recording://{tmp_path}")
     assert main(["replay", str(tmp_path)]) == 2
 

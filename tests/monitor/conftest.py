@@ -123,3 +123,96 @@ def relrl_process() -> Iterator[type[RelrlProcess]]:
     yield start  # type: ignore[misc]
     for p in started:
         p.kill()
+
+
+
+class Slowloris:
+    """A slowloris client on loopback in a process of its own (``relrl.monitor.bench``'s),
+    bounded in ``count`` and ``seconds``: ``with Slowloris(port, 300, 4) as attack: ...``
+    (``attack.opened`` once the connections are made; :meth:`result` waits for the end)."""
+
+    def __init__(self, port: int, count: int, seconds: float) -> None:
+        from relrl.monitor.bench import SLOWLORIS
+
+        self.proc = subprocess.Popen([sys.executable, "-c", SLOWLORIS, str(port), str(count),
+                                      str(seconds)], stdout=subprocess.PIPE, text=True)
+        self.seconds = seconds
+        self.opened = -1
+
+    def __enter__(self) -> Slowloris:
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline().split()
+        self.opened = int(line[1]) if line[:1] == ["opened"] else -1
+        return self
+
+    def result(self) -> tuple[int, int]:
+        """``(answered, closed)`` once the attack has ended."""
+        out, _ = self.proc.communicate(timeout=self.seconds + 30)
+        words = out.split()
+        return int(words[1]), int(words[3])
+
+    def __exit__(self, *exc: object) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.communicate()
+
+
+def _jpeg() -> bytes:
+    import numpy as np
+
+    from relrl.monitor.frames import encode_jpeg
+
+    return encode_jpeg(np.full((24, 32, 3), 120, np.uint8))
+
+
+def trace_line(t: int, **extra: object) -> str:
+    """One line of a small recorded trace (valid unless ``extra`` says otherwise)."""
+    import json
+
+    row = {"t": t, "phase": "fruits", "activation": {"socialize": 0.5}, "reward": -1.0,
+           "response": "look(left)", "percepts": ["see(face)"], "allowed": ["look(left)"],
+           "explanation": {"learner": "etg", "path": [{"test": "stimulus(face)", "holds": True}],
+                           "ranked": [{"response": "look(left)", "q": 30.0}]}, "frame": 1}
+    row.update(extra)
+    return json.dumps(row)
+
+
+def recording_files() -> dict[str, bytes]:
+    """The files of a small valid recorded session (three time units, one frame)."""
+    import json
+
+    tree = {"nodes": [{"id": "0", "kind": "test", "label": "stimulus(face)"},
+                      {"id": "1", "kind": "leaf", "label": "look(left) 30.0"},
+                      {"id": "2", "kind": "leaf", "label": "look(centre) 30.0"}],
+            "edges": [{"from": "0", "to": "1", "branch": "yes"},
+                      {"from": "0", "to": "2", "branch": "no"}]}
+    return {
+        "trace.jsonl": "".join(trace_line(t) + "\n" for t in (1, 2, 3)).encode(),
+        "frames.jsonl": json.dumps({"index": 1, "t": 1, "file": "frames/000001.jpg"}).encode()
+        + b"\n",
+        "frames/000001.jpg": _jpeg(),
+        "trees.jsonl": json.dumps({"t": 1, "graph": tree}).encode() + b"\n",
+        "events.jsonl": json.dumps({"kind": "evaluation", "t": 2, "cgi_mean": 0.5,
+                                    "cgi_std": 0.1, "on": "simulator"}).encode() + b"\n",
+        "session.json": json.dumps({"episode": "small", "learner": {"name": "etg"},
+                                    "necessities": ["socialize"], "seed": 1},
+                                   indent=1).encode(),
+        "summary.json": json.dumps({"episode": "small", "learner": {"name": "etg"}},
+                                   indent=1).encode(),
+    }
+
+
+def write_recording(folder: Path, **changes: bytes | str | None) -> Path:
+    """A small recorded session in ``folder``; ``changes`` replace files (``frames__x`` is
+    ``frames/x``; ``None`` removes one)."""
+    files = recording_files()
+    for name, content in changes.items():
+        files[name.replace("__", "/")] = content.encode() if isinstance(content, str) \
+            else content  # type: ignore[assignment]
+    for name, content in files.items():
+        if content is None:
+            continue
+        path = folder / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(content)
+    return folder

@@ -10,7 +10,7 @@ import pytest
 
 from relrl.episodes import RunOptions, load_episode, run_episode
 from relrl.monitor import start_replay
-from relrl.monitor.replay import Recording
+from relrl.recording.reader import open_recording
 from tests.monitor.conftest import episode
 
 
@@ -39,7 +39,7 @@ def _scrub(page, t: int) -> None:
 
 
 def test_scrubbing_shows_each_time_unit(page, recorded: Path, tmp_path: Path) -> None:
-    rec = Recording(recorded)
+    rec = open_recording(recorded)  # its session.mcap
     with start_replay(recorded) as server:
         page.goto(server.url)
         page.wait_for_selector("#mode.replay")
@@ -78,7 +78,7 @@ def test_the_recorded_folder_is_self_contained(recorded: Path) -> None:
     ep = load_episode(recorded / "episode.toml")
     assert ep.domain.resolve() == (recorded / "domain.pl").resolve()
     assert manifest["recording"]["frames"] == 81       # every unit, and the last view
-    assert len(list((recorded / "frames").glob("*.jpg"))) == 81
+    rec = open_recording(recorded)
+    assert len(rec.frames) == 81 and rec.manifest == manifest
     assert manifest["necessities"] == ["socialize"]
-    trees = [json.loads(x) for x in (recorded / "trees.jsonl").read_text().splitlines()]
-    assert trees[-1]["graph"]["nodes"]
+    assert rec.trees[-1]["graph"]["nodes"]

@@ -272,8 +272,13 @@ function showEvents(events) {
 function showTree(param) {
   const img = $("tree");
   img.onload = () => { img.hidden = false; $("tree-note").textContent = ""; };
-  img.onerror = () => { img.hidden = true;
-                        $("tree-note").textContent = "(no tree: this learner has none yet)"; };
+  img.onerror = () => {
+    img.hidden = true;
+    $("tree-note").textContent = "(no tree: this learner has none yet)";
+    fetch(img.src, { cache: "no-store" }).then(async (r) => {   // say why, when it is not 404
+      if (r.status !== 404) $("tree-note").textContent = `(${(await r.text()).trim()})`;
+    }).catch(() => {});
+  };
   img.src = url("tree.svg", param);
 }
 
