@@ -1,13 +1,19 @@
-"""``relrl check DOMAIN.pl``: load a domain, validate it and list its declarations;
+"""``relrl check DOMAIN.pl [--policy FILE]``: load a domain, validate it and list its
+declarations; with ``--policy``, also check a saved policy against it as a whole;
 ``relrl check --world WORLD.pl``: the same for a world written in Prolog."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from relrl.kb import KnowledgeBase
 
 HELP = "load and validate a domain file; list its stimuli and facts with their codes"
 EXAMPLE = ("relrl check examples/domains/fruits.pl\n"
+           "  relrl check examples/domains/fruits.pl --policy runs/hello/hello-policy.pl\n"
            "  relrl check --world examples/worlds/blocks.pl")
 
 
@@ -17,6 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="domain file(s) to load, in order")
     parser.add_argument("-q", "--quiet", action="store_true",
                         help="print only problems, not the declarations")
+    parser.add_argument("--policy", action="append", default=[], metavar="FILE",
+                        help="also check a saved policy (.pl or .npz) against the domain, as "
+                             "a run or the shell would load it (repeatable)")
     from perception.vocabulary import WORLDS
 
     parser.add_argument("--world", metavar="NAME|WORLD.pl",
@@ -31,16 +40,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the domain; exit status 0 when valid, 2 when it has problems (load warnings
     and, with ``--world``, facts the world can never make hold count as problems). Warnings
-    about the tg learner's language bias are printed and do not count as problems."""
+    about the tg learner's language bias are printed and do not count as problems. With
+    ``--world WORLD.pl``, check that world file instead."""
     from perception.vocabulary import WORLDS
+
     from relrl.errors import ConfigError, PrologLoadError
     from relrl.kb import KnowledgeBase
     from relrl.validate import bias_warnings, describe, validate, world_warnings
 
     if args.world and args.world not in WORLDS:
-        if args.domain:
+        if args.domain or args.policy:
             raise ConfigError("relrl check --world WORLD.pl checks a world file alone; "
-                              "give domain files without --world")
+                              "give domain files (and --policy) without it")
         return _check_world(args)
     if not args.domain:
         raise ConfigError("give a domain file (relrl check DOMAIN.pl) or a world file "
@@ -62,14 +73,36 @@ def run(args: argparse.Namespace) -> int:
             print(describe(kb))
         for warning in bias_warnings(kb):     # a valid domain, a bias that will not scale
             print(warning, file=sys.stderr)
+        checked = [] if problems else [_check_policy(kb, p, problems) for p in args.policy]
         if problems:
             _print_problems(problems)
             return 2
         if not args.quiet:
             print(f"ok: {', '.join(args.domain)} is valid")
+            for line in checked:
+                print(line)
         return 0
     finally:
         kb.close()
+
+
+def _check_policy(kb: KnowledgeBase, path: str, problems: list[str]) -> str:
+    """Load the policy at ``path`` into a fresh learner of its kind (every check a load
+    makes); a problem is appended to ``problems``. Returns the line that says it is ok."""
+    from relrl.errors import UserError
+    from relrl.learners import make_learner
+    from relrl.loop import Agent
+    from relrl.policy import policy_learner
+
+    try:
+        name = policy_learner(path, kb)
+        agent = Agent(kb, make_learner(name), seed=0)
+        agent.learner.load(path)
+    except UserError as exc:
+        problems.append(str(exc))
+        return ""
+    positions = agent.learner.size()["positions"]
+    return f"ok: {path} is a valid {name} policy for it ({positions} positions)"
 
 
 def _check_world(args: argparse.Namespace) -> int:
