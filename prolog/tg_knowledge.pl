@@ -377,6 +377,7 @@ restored(node(Id, Lits, New, Y, N), B, Path, Vars, node(Id, Lits, New, RY, RN), 
     ->  true
     ;   domain_error(tg_tree, node(Id, Lits, New))
     ),
+    B = b(Bias, _),
     (   member(Lit, Lits), \+ bias_literal(Bias, Lit)
     ->  policy_refuse(node(Id, Lits, New, Y, N), "node ~d: ~q is not a literal of the \c
                       domain's language bias (rmode/1)", [Id, Lit])

@@ -43,7 +43,6 @@ def run(args: argparse.Namespace) -> int:
     about the tg learner's language bias are printed and do not count as problems. With
     ``--world WORLD.pl``, check that world file instead."""
     from perception.vocabulary import WORLDS
-
     from relrl.errors import ConfigError, PrologLoadError
     from relrl.kb import KnowledgeBase
     from relrl.validate import bias_warnings, describe, validate, world_warnings
