@@ -260,6 +260,7 @@ python_api(relrl_world:world_episodes/3).
 python_api(relrl_world:world_info/2).
 python_api(relrl_world:world_task/3).
 python_api(relrl_world:world_verify/5).
+python_api(relrl_world:world_for_task/2).
 python_api(relrl_world_check:world_problems/2).
 python_api(relrl_gateway:gw_new_kb/1).
 python_api(relrl_gateway:gw_drop_kb/1).

@@ -58,11 +58,17 @@ the names of their variables are given once.
 
 %!  tg_bias(+KB, -Bias) is det.
 %
-%   Bias is bias(Modes, Consts): the rmode/1 literals of KB in declaration order and
-%   Type-Constants pairs (necessity: the declared necessities and none).
+%   Bias is bias(Modes, Consts): the rmode/1 literals of KB in declaration order, then the
+%   modes extra_rmode/2 adds, and Type-Constants pairs (necessity: the declared necessities
+%   and none).
+
+:- multifile extra_rmode/2.
+
+%   extra_rmode(?KB, ?Mode): a mode a driver adds to KB's bias for its run (world.pl: the
+%   task_rmode/2 modes of the task the world's learner is configured for).
 
 tg_bias(KB, bias(Modes, Consts)) :-
-    findall(M, declared(KB, rmode(M)), Modes0),
+    findall(M, ( declared(KB, rmode(M)) ; extra_rmode(KB, M) ), Modes0),
     list_to_set(Modes0, Modes),
     findall(T-C, declared(KB, rconst(T, C)), Pairs0),
     findall(necessity-N, ( kb_necessity(KB, N) ; N = none ), Nec),

@@ -10,7 +10,8 @@
             world_predicate/2,    % ?Name/Arity, ?Required
             world_defines/2,      % +KB, ?Name/Arity
             world_task/3,         % +KB, +Spec, -Task
-            world_verify/5        % +KB, +Task, +Size, +Count, -Pairs
+            world_verify/5,       % +KB, +Task, +Size, +Count, -Pairs
+            world_for_task/2      % +KB, +Task
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -43,6 +44,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | step_bound(+Goal, +State, -Steps)     | optional: default 100                               |
   | optimal_steps(+Goal, +State, -Steps)  | optional: the optimal number of steps, when known (relrl check verifies it against a search) |
   | sizes(train|test, Sizes)              | optional: the sizes learning and transfer use by default |
+  | task_rmode(Task, Mode)                | optional: a mode of the language bias for episodes of Task only (world_for_task/2) |
   | discount(Gamma)                       | optional: the task's discount, the learners' gamma (default theirs) |
   | relation/1, rmode/1, rconst/2         | the learner's view and language bias, as in a domain (docs/tg.md) |
 
@@ -86,6 +88,7 @@ world_predicate(step_bound/3, optional).
 world_predicate(optimal_steps/3, optional).
 world_predicate(sizes/2, optional).
 world_predicate(discount/1, optional).
+world_predicate(task_rmode/2, optional).
 
 %!  world_defines(+KB, +PI) is semidet.
 %
@@ -413,6 +416,32 @@ expand([A|As], KB, Goal, S, Seen0, Seen, N0, N, Next0, Next, Found) :-
         N1 is N0 + 1,
         expand(As, KB, Goal, S, Seen1, Seen, N1, N, [S1|Next0], Next, Found)
     ).
+
+% ---- a task's own language bias -----------------------------------------------------------
+
+%!  world_for_task(+KB, +Task) is det.
+%
+%   The learner configured next in KB (engine_configure/4) learns Task: the modes of
+%   task_rmode(T, Mode) for a T that Task is an instance of join the bias (rmode/1) of that
+%   run, through tg_bias's extra_rmode/2. Background knowledge that serves one task can
+%   mislead another: highest/1, the top of a tallest tower, is what stacking needs, and a
+%   tree that splits on it while unstacking values moves by tower heights seen in small
+%   worlds. Call it before engine_configure/4; a later call changes only the next run.
+
+world_for_task(KB, Task) :-
+    must_be(atom, KB),
+    must_be(callable, Task),
+    atom_concat('$relrl_world_task:', KB, Key),
+    nb_setval(Key, Task).
+
+:- multifile relrl_tg_bias:extra_rmode/2.
+
+relrl_tg_bias:extra_rmode(KB, Mode) :-
+    atom(KB),
+    atom_concat('$relrl_world_task:', KB, Key),
+    nb_current(Key, Task),
+    declared(KB, task_rmode(T, Mode)),
+    subsumes_term(T, Task).
 
 % ---- what the world offers -----------------------------------------------------------------
 

@@ -88,6 +88,19 @@ static_problem(KB, problem(File, Line, Msg)) :-
     \+ ( number(G), G > 0, G =< 1 ),
     clause_location(Ref, File, Line),
     format(string(Msg), "discount(~q): the discount must be a number in (0, 1]", [G]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, task_rmode(T, M), true, Ref),
+    (   \+ ( declared(KB, task(T0)), \+ T0 \= T )
+    ->  format(string(Msg), "task_rmode(~q, ~q): no declared task is ~q", [T, M, T])
+    ;   \+ callable(M)
+    ->  format(string(Msg), "task_rmode(~q, ~q): the mode must be a literal", [T, M])
+    ;   M \= action(_),
+        functor(M, Name, Arity),
+        \+ ( declared(KB, relation(R)), callable(R), functor(R, Name, Arity) )
+    ->  format(string(Msg), "task_rmode(~q, ~q): ~q is not a declared relation (add \c
+                             relation/1)", [T, M, Name/Arity])
+    ),
+    clause_location(Ref, File, Line).
 static_problem(KB, P) :-
     bias_problem(KB, P).
 

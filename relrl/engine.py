@@ -94,6 +94,7 @@ GOALS: dict[str, str] = {
     "world_info": "relrl_world:world_info",
     "world_task": "relrl_world:world_task",
     "world_verify": "relrl_world:world_verify",
+    "world_for_task": "relrl_world:world_for_task",
     "world_check": "relrl_world_check:world_problems",
     "findall": "relrl_gateway:gw_findall",
     "parse": "relrl_gateway:gw_parse",

@@ -73,7 +73,7 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
     with World(config.world) as world:
         task = world.task(config.task)
         learner = world.learner(config.learner, **config.params)
-        world.attach(learner, config.seed)
+        world.attach(learner, config.seed, task)
         if policy_in is not None:
             world.load_policy(policy_in)
         curve: list[dict[str, Any]] = []

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from relrl.engine import Engine, one
+from relrl.engine import Engine, call, one
 from relrl.errors import ConfigError, PrologError
 from relrl.kb import KnowledgeBase, _display_path
 from relrl.terms import Term, Var, format_term
@@ -193,9 +193,12 @@ class World:
             params = {**params, "gamma": self.discount}
         return make_world_learner(name, **params)
 
-    def attach(self, learner: Any, seed: int) -> None:
+    def attach(self, learner: Any, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a :class:`relrl.learners.Learner` whose Prolog learner reads the
-        relational view: ``tg``, ``qtable``) afresh in this world, seeded."""
+        relational view: ``tg``, ``qtable``) afresh in this world, seeded; for ``task``, its
+        language bias holds the task's own modes too (task_rmode/2)."""
+        if task is not None:
+            call(self.kb, "world_for_task", self.kb.module, self._task(task))
         learner.attach(self.engine, seed)
         self.learner_name = learner.name
 

@@ -155,7 +155,33 @@ test(wrong_optimal_steps, [Line == 10]) :-
             KB, Path),
     world_problems(KB, [problem(Path, Line, _)]).
 
+test(task_rmode_of_no_task, [Msg == "task_rmode(fly, p(+x)): no declared task is fly"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, _) :- fail.", "relation(p(_)).", "task_rmode(fly, p(+x))."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
+
 :- end_tests(world_check).
+
+:- begin_tests(world_task_bias).
+
+bias_modes(KB, Task, Modes) :-
+    world_for_task(KB, Task),
+    relrl_tg_bias:tg_bias(KB, bias(Modes, _)).
+
+test(only_stack_sees_highest) :-
+    blocks(KB),
+    bias_modes(KB, stack, Stack),
+    bias_modes(KB, unstack, Unstack),
+    bias_modes(KB, on(b1, b2), On),
+    assertion(memberchk(highest(+block), Stack)),
+    assertion(\+ memberchk(highest(+block), Unstack)),
+    assertion(\+ memberchk(highest(+block), On)),
+    subtract(Stack, [highest(+block)], Rest),
+    assertion(Rest == Unstack).
+
+:- end_tests(world_task_bias).
 
 :- begin_tests(world_episodes).
 
