@@ -7,7 +7,7 @@
             engine_graph/2,           % +KB, -Graph
             engine_knowledge/2,       % +KB, -Terms
             engine_size/2,            % +KB, -Size
-            engine_save/3,            % +KB, +File, +Header
+            engine_policy/3,          % +KB, +Header, -Text
             engine_snapshot/2,        % +KB, -Snapshot
             engine_restore/2,         % +KB, +Snapshot
             engine_keep/2,            % +KB, +Slot
@@ -654,7 +654,7 @@ slot_key(KB, Slot, Key) :-
 %!  engine_policy_info(+KB, -Info:list) is det.
 %
 %   What a policy of KB's learner is tied to in the domain, Key(Value) terms written in the
-%   policy's header (engine_save/3) and compared with the loaded domain's when a policy is
+%   policy's header (engine_policy/3) and compared with the loaded domain's when a policy is
 %   read (policy.pl): the learner's learner_policy_info/3 (a relational learner: its
 %   relations and language bias, the same in every world of a family, so its policy loads
 %   in any of them), else [features(Features), responses(Responses)]. Each Key(Value) has
@@ -667,23 +667,21 @@ engine_policy_info(KB, Info) :-
     ;   Info = [features(Features), responses(Responses)]
     ).
 
-%!  engine_save(+KB, +File, +Header:string) is det.
+%!  engine_policy(+KB, +Header:text, -Text:string) is det.
 %
-%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with what
-%   the policy is tied to in the domain (engine_policy_info/2), then the learner's own
-%   clauses. Plain swipl consults
-%   the file; relrl reads it back as data (policy.pl). The file is written next to File
-%   and renamed into place, so a reader never sees half a policy.
+%   Text is KB's learned knowledge as a policy file: a comment, relrl_policy(Learner, Info)
+%   with what the policy is tied to in the domain (engine_policy_info/2), then the learner's
+%   own clauses. Plain swipl consults the file; relrl reads it back as data (policy.pl).
+%   Python writes Text to disk through relrl's one writer (atomic, never through a link).
 
-engine_save(KB, File, Header) :-
+engine_policy(KB, Header, Text) :-
+    must_be(text, Header),
     engine_learner(KB, Learner),
     engine_policy_info(KB, Info),
-    atom_concat(File, '.tmp', Tmp),
-    setup_call_cleanup(
-        open(Tmp, write, S, [encoding(utf8)]),
-        write_policy(S, KB, Learner, Info, Header),
-        close(S)),
-    rename_file(Tmp, File).
+    with_output_to(string(Text),
+                   (   current_output(S),
+                       write_policy(S, KB, Learner, Info, Header)
+                   )).
 
 write_policy(S, KB, Learner, Info, Header) :-
     split_string(Header, "\n", "", Lines),

@@ -13,7 +13,7 @@
 
 /** <module> Reading a saved policy as data
 
-A policy file (written by engine_save/3) is Prolog that plain swipl can consult, but relrl
+A policy file (the text of engine_policy/3) is Prolog that plain swipl can consult, but relrl
 never consults it: a policy is data labs exchange, and loading one must never run anything.
 This module reads it term by term with read_term/3 and accepts only
 

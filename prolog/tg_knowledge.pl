@@ -371,13 +371,13 @@ restored(leaf(Id, Q, N), b(Bias, Keep), Path, Vars, leaf(Id, Path, Vars, Cands),
     length(Cands, K),
     tg_new_stats(Q, N, K, 0, Keep, L).
 restored(node(Id, Lits, New, Y, N), B, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
+    B = b(Bias, _),
     !,
     (   integer(Id), Id > 0, is_list(Lits), Lits \== [], maplist(callable, Lits),
         is_list(New), maplist(typed_var, New)
     ->  true
     ;   domain_error(tg_tree, node(Id, Lits, New))
     ),
-    B = b(Bias, _),
     (   member(Lit, Lits), \+ bias_literal(Bias, Lit)
     ->  policy_refuse(node(Id, Lits, New, Y, N), "node ~d: ~q is not a literal of the \c
                       domain's language bias (rmode/1)", [Id, Lit])

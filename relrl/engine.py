@@ -56,7 +56,7 @@ GOALS: dict[str, str] = {
     "graph": "relrl_engine:engine_graph",
     "knowledge": "relrl_engine:engine_knowledge",
     "size": "relrl_engine:engine_size",
-    "save": "relrl_engine:engine_save",
+    "policy": "relrl_engine:engine_policy",
     "keep": "relrl_engine:engine_keep",
     "resume": "relrl_engine:engine_resume",
     "reseed": "relrl_engine:engine_reseed",
@@ -275,17 +275,23 @@ class Engine:
 
     # -- files ------------------------------------------------------------------------------
 
-    def save(self, path: str | Path, header: str) -> Path:
-        """Write the learned knowledge as a readable policy file (atomic).
+    def policy_text(self, header: str) -> str:
+        """The learned knowledge as the text of a policy file (``header`` as its comment).
 
-        Writing is linear in what was learned: it may take the knowledge base's time limit
+        Making it is linear in what was learned: it may take the knowledge base's time limit
         plus :data:`POLICY_SECONDS_PER_MB` per megabyte the policy is expected to take
         (:data:`POLICY_BYTES_PER_POSITION` per position of :meth:`size`).
         """
         megabytes = self.size()[0] * POLICY_BYTES_PER_POSITION / 1e6
-        call(self.kb, "save", self.module, str(path), header,
-             timeout=self.kb.timeout + POLICY_SECONDS_PER_MB * megabytes)
-        return Path(path)
+        return call(self.kb, "policy", self.module, header, Var(),
+                    timeout=self.kb.timeout + POLICY_SECONDS_PER_MB * megabytes)[0]
+
+    def save(self, path: str | Path, header: str) -> Path:
+        """Write the learned knowledge as a readable policy file (:mod:`relrl.outdir`: atomic,
+        never through a link; the text as :meth:`policy_text` makes it)."""
+        from relrl.outdir import write_atomic
+
+        return write_atomic(path, self.policy_text(header))
 
     def load_policy(self, path: str | Path) -> None:
         """Replace the learned knowledge by the policy at ``path``, read as data.

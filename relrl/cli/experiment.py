@@ -331,7 +331,7 @@ def run(args: argparse.Namespace) -> int:
     """Check everything, claim the output folder, run the experiment, print the summary.
 
     ``kill -USR1 PID`` prints the stack of every thread to stderr (for a sweep that seems
-    stuck); Ctrl-C or SIGTERM stops it keeping what finished."""
+    stuck); Ctrl-C, SIGTERM or SIGHUP stops it keeping what finished."""
     import faulthandler
     import io
     import signal
@@ -343,7 +343,8 @@ def run(args: argparse.Namespace) -> int:
         except (ValueError, OSError, io.UnsupportedOperation):
             pass  # no real stderr (embedded): no stack dumps, nothing else changes
     from relrl.experiments import main as sis_main
-    from relrl.experiments.report import summary_table
+    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.runner import command_signals
     from relrl.outdir import OutDir
 
     if args.name == "scaling":
@@ -354,8 +355,9 @@ def run(args: argparse.Namespace) -> int:
 
     config = build_config(args)
     print(f"setting: {config.setting()}")
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/exp1") as out:
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/exp1", outputs=OUTPUTS) as out:
         results, files = sis_main.run_sis(config, out.path, workers=args.workers,
                                           engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
@@ -363,22 +365,24 @@ def run(args: argparse.Namespace) -> int:
     if any(c["held"] is not None for c in results.get("claims", {}).values()):
         print("\nthe paper's claims (docs/experiment1.md):")
         print(claims_table(results["claims"]))
-    return _finish(results, files, out.path)
+    return _finish(results, files, out.path, signals.signum)
 
 
 def _run_scaling(args: argparse.Namespace) -> int:
-    from relrl.experiments.scaling_report import run_scaling, scaling_table
+    from relrl.experiments.runner import command_signals
+    from relrl.experiments.scaling_report import OUTPUTS, run_scaling, scaling_table
     from relrl.outdir import OutDir
 
     config = build_scaling_config(args)
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/scaling") as out:
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/scaling", outputs=OUTPUTS) as out:
         results, files = run_scaling(config, out.path, workers=args.workers,
                                      engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
     timing = json.loads((out.path / "timing.json").read_text())
     print(scaling_table(results, timing))
-    return _finish(results, files, out.path)
+    return _finish(results, files, out.path, signals.signum)
 
 
 def build_worlds_config(args: argparse.Namespace):
@@ -441,25 +445,37 @@ def build_worlds_config(args: argparse.Namespace):
 
 
 def _run_worlds(args: argparse.Namespace) -> int:
+    from relrl.experiments.runner import command_signals
     from relrl.outdir import OutDir
-    from relrl.worlds.experiment import run_worlds, worlds_table
+    from relrl.worlds.experiment import OUTPUTS, run_worlds, worlds_table
 
     config = build_worlds_config(args)
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/worlds") as out:
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/worlds", outputs=OUTPUTS) as out:
         results, files = run_worlds(config, out.path, workers=args.workers,
                                     engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
     print(worlds_table(results))
-    return _finish(results, files, out.path)
+    return _finish(results, files, out.path, signals.signum)
 
 
-def _finish(results: dict, files: list, out: Path) -> int:
+def _finish(results: dict, files: list, out: Path, signum: int | None) -> int:
+    """Say what was written; 128 + N when signal N stopped the experiment (or came while
+    its outputs were being written)."""
+    import signal
+
     print(f"\nwrote {len(files)} files to {out}/:")
     for f in files:
         print(f"  {f}")
     if results.get("partial"):
-        print(f"stopped by {results.get('interrupted_by', 'a signal')}: the results are "
-              "partial (every finished evaluation point is kept)")
-        return 130 if results.get("interrupted_by") == "SIGINT" else 143
+        by = results.get("interrupted_by", "a signal")
+        print(f"stopped by {by}: the results are partial (every finished evaluation point "
+              "is kept)")
+        return 128 + (signal.Signals[by].value if by in signal.Signals.__members__
+                      else signum or signal.SIGINT)
+    if signum is not None:
+        print(f"{signal.Signals(signum).name} came as the outputs were written: they are "
+              "complete")
+        return 128 + signum
     return 0

@@ -9,6 +9,9 @@ from pathlib import Path
 
 from relrl.outdir import add_out_options
 
+#: the files and folders ``relrl learn --out DIR`` writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "curve.csv", "policy.pl", "traces.jsonl", "replay/")
+
 HELP = "learn a task of a world written in Prolog (blocks world ...) and evaluate the policy"
 EXAMPLE = ("relrl learn examples/worlds/blocks.pl --learner tg --task stack --episodes 500\n"
            "  relrl learn examples/worlds/blocks.pl --task on --size 4 --eval-sizes 6,8 "
@@ -137,7 +140,8 @@ def run(args: argparse.Namespace) -> int:
         result = learn_task(config, report=show, policy_in=args.policy)
         _summary(result, result["timing"])
         return 0
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite) as out:
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      outputs=OUTPUTS) as out:
         result = learn_task(config, report=show, policy_in=args.policy,
                             policy_out=out.path / "policy.pl", traces=args.traces)
         timing = result["timing"]

@@ -8,13 +8,19 @@ version; it is byte-identical for the same configuration and seeds. Wall-clock f
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "pyplot_or_note", "skip_plots", "summary_table", "write_json_atomic",
-           "write_outputs"]
+__all__ = ["OUTPUTS", "aggregate", "pyplot_or_note", "save_figure", "skip_plots",
+           "summary_table", "write_csv", "write_json_atomic", "write_outputs"]
+
+#: the files Experiment 1 writes into its folder (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
+           "memory.csv", "cgi_places.csv", "fig5_cgi.png", "fig4_eye_contacts.png",
+           "cgi_places.png", "PLOTS.txt")
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -23,6 +29,34 @@ def write_json_atomic(path: Path, data: Any) -> None:
     from relrl.outdir import write_json_atomic as write
 
     write(path, data)
+
+
+def write_csv(path: Path, header: list[str], rows: Any) -> Path:
+    """Write a CSV file whole (:func:`relrl.outdir.write_atomic`; on a full disk it does not
+    take the space held back for the results); returns ``path``."""
+    from relrl.outdir import write_atomic
+
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(header)
+    w.writerows(rows)
+    return write_atomic(path, buf.getvalue(), spare=False)
+
+
+def save_figure(fig: Any, path: Path, **kwargs: Any) -> Path:
+    """Save a matplotlib figure whole (:func:`relrl.outdir.write_atomic`; on a full disk it
+    does not take the space held back for the results), in the format its suffix names, and
+    close it; ``kwargs`` go to ``savefig`` (``dpi``). Returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    from relrl.outdir import write_atomic
+
+    buf = io.BytesIO()
+    try:
+        fig.savefig(buf, format=Path(path).suffix.lstrip(".") or "png", **kwargs)
+    finally:
+        plt.close(fig)
+    return write_atomic(path, buf.getvalue(), spare=False)
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
@@ -125,49 +159,37 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
 
     Returns the files written.
     """
-    out_dir.mkdir(parents=True, exist_ok=True)
     written = [out_dir / "results.json", out_dir / "timing.json"]
     write_json_atomic(written[0], results)
     write_json_atomic(written[1], timing)
     summary = results["summary"]
-    fig5 = out_dir / "fig5_cgi.csv"
-    with open(fig5, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std",
-                    "cgi_literal_mean", "cgi_literal_std", "n_runs"])
-        for name, s in summary.items():
-            for c in s["curve"]:
-                w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
-                            f"{c['cgi_std']:.6f}", f"{c['cgi_literal_mean']:.6f}",
-                            f"{c['cgi_literal_std']:.6f}", c["n_runs"]])
-    fig4 = out_dir / "fig4_eye_contacts.csv"
-    with open(fig4, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "opportunity", "cumulative_eye_contacts"])
-        for name, s in summary.items():
-            for i, c in enumerate(s["eye_contacts"]["cumulative_mean"], start=1):
-                w.writerow([name, i, f"{c:.4f}"])
-    memory = out_dir / "memory.csv"
-    with open(memory, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "positions", "detail", "states_met"])
-        for name, s in summary.items():
-            detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
-            w.writerow([name, f"{s['memory']['positions']:g}", detail,
-                        "" if s["states_met"] is None else f"{s['states_met']:g}"])
-    written += [fig5, fig4, memory]
+    written.append(write_csv(
+        out_dir / "fig5_cgi.csv",
+        ["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "cgi_literal_mean",
+         "cgi_literal_std", "n_runs"],
+        [[name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}", f"{c['cgi_std']:.6f}",
+          f"{c['cgi_literal_mean']:.6f}", f"{c['cgi_literal_std']:.6f}", c["n_runs"]]
+         for name, s in summary.items() for c in s["curve"]]))
+    written.append(write_csv(
+        out_dir / "fig4_eye_contacts.csv", ["learner", "opportunity", "cumulative_eye_contacts"],
+        [[name, i, f"{c:.4f}"] for name, s in summary.items()
+         for i, c in enumerate(s["eye_contacts"]["cumulative_mean"], start=1)]))
+    written.append(write_csv(
+        out_dir / "memory.csv", ["learner", "positions", "detail", "states_met"],
+        [[name, f"{s['memory']['positions']:g}",
+          "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions"),
+          "" if s["states_met"] is None else f"{s['states_met']:g}"]
+         for name, s in summary.items()]))
     if any("cgi_places" in s for s in summary.values()):
-        places = out_dir / "cgi_places.csv"
-        with open(places, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["learner", "point", "cgi_trained", "cgi_held_out"])
-            for name, s in summary.items():
-                groups = s.get("cgi_places", {})
-                for p in range(len(s["curve"])):
-                    w.writerow([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
-                                            else f"{groups[g][p]:.6f}"
-                                            for g in ("trained", "held_out")])
-        written.append(places)
+        rows = []
+        for name, s in summary.items():
+            groups = s.get("cgi_places", {})
+            for p in range(len(s["curve"])):
+                rows.append([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
+                                         else f"{groups[g][p]:.6f}"
+                                         for g in ("trained", "held_out")])
+        written.append(write_csv(out_dir / "cgi_places.csv",
+                                 ["learner", "point", "cgi_trained", "cgi_held_out"], rows))
     written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
 
@@ -175,10 +197,12 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
 def skip_plots(out_dir: Path) -> list[Path]:
     """A note in place of the figures of an interrupted run (drawing them would delay the
     stop by seconds; the numbers are in results.json and the CSVs)."""
-    note = out_dir / "PLOTS.txt"
-    note.write_text("The run was interrupted, so no figures were drawn (to stop at once); "
-                    "every finished point is in results.json and the CSV files.\n")
-    return [note]
+    from relrl.outdir import write_atomic
+
+    return [write_atomic(out_dir / "PLOTS.txt",
+                         "The run was interrupted, so no figures were drawn (to stop at once); "
+                         "every finished point is in results.json and the CSV files.\n",
+                         spare=False)]
 
 
 def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
@@ -190,11 +214,12 @@ def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        note = out_dir / "PLOTS.txt"
-        note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
-                        "are in the CSV files.\nInstall the extra to get plots:  "
-                        "pip install 'relrl[plots]'\n")
-        return None, [note]
+        from relrl.outdir import write_atomic
+
+        return None, [write_atomic(out_dir / "PLOTS.txt",
+                                   "matplotlib is not installed, so no PNG plots were drawn; "
+                                   "the numbers are in the CSV files.\nInstall the extra to "
+                                   "get plots:  pip install 'relrl[plots]'\n", spare=False)]
     return plt, []
 
 
@@ -212,10 +237,7 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         ax.legend()
         ax.grid(alpha=0.3)
         fig.tight_layout()
-        path = out_dir / name
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-        return path
+        return save_figure(fig, out_dir / name, dpi=120)
 
     files = []
     fig, ax = plt.subplots(figsize=(7, 4.2))

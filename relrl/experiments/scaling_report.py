@@ -9,18 +9,28 @@ Files (in the output folder): ``results.json`` (every number and the full config
 
 from __future__ import annotations
 
-import csv
 import platform
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import pyplot_or_note, skip_plots, write_json_atomic
+from relrl.experiments.report import (
+    pyplot_or_note,
+    save_figure,
+    skip_plots,
+    write_csv,
+    write_json_atomic,
+)
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
 from relrl.machine import machine_info
 
-__all__ = ["run_scaling", "scaling_table"]
+__all__ = ["OUTPUTS", "run_scaling", "scaling_table"]
 
+
+#: the files and folders the scaling benchmark writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "scaling.csv", "transfer.csv", "curves.csv",
+           "speed.csv", "memory_vs_size.png", "time_to_threshold.png", "transfer.png",
+           "PLOTS.txt", "domains/")
 
 def _label(args: tuple) -> str:
     _, learner, size, seed, kind = args
@@ -37,7 +47,6 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
     from relrl import __version__
 
     out = Path(out_dir)
-    (out / "domains").mkdir(parents=True, exist_ok=True)
     transfer_sizes = (set(config.transfer_sizes) | {config.transfer_from}
                       if config.transfer == "sizes" else set(config.transfer_sizes)
                       if config.transfer != "none" else set())
@@ -87,7 +96,6 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """results.json, timing.json, the CSVs and the plots; returns the files written."""
-    out.mkdir(parents=True, exist_ok=True)
     files = [out / "results.json", out / "timing.json"]
     write_json_atomic(files[0], results)
     write_json_atomic(files[1], timing)
@@ -95,13 +103,9 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
     learners = results["config"]["learners"]
 
     def table(name: str, header: list[str], rows: list[list[Any]]) -> None:
-        path = out / name
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows([["" if v is None else (f"{v:.6g}" if isinstance(v, float) else v)
-                          for v in row] for row in rows])
-        files.append(path)
+        files.append(write_csv(out / name, header, [
+            ["" if v is None else (f"{v:.6g}" if isinstance(v, float) else v) for v in row]
+            for row in rows]))
 
     keys = ["seeds", "reached", "steps_to_threshold", "steps_to_threshold_max", "cgi_final",
             "cgi_literal_final", "memory_positions", "candidates_per_leaf", "candidates_max",
@@ -137,9 +141,7 @@ def plot(out: Path, results: dict[str, Any]) -> list[Path]:
 
     def save(fig: Any, name: str) -> None:
         fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-        files.append(out / name)
+        files.append(save_figure(fig, out / name, dpi=120))
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     sizes_seen: set[int] = set()

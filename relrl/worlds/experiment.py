@@ -17,20 +17,23 @@ into a world of any size: ``relrl learn WORLD --policy FILE``).
 
 from __future__ import annotations
 
-import csv
-import io
 import platform
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import pyplot_or_note, skip_plots
+from relrl.experiments.report import pyplot_or_note, save_figure, skip_plots, write_csv
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.machine import machine_info
 from relrl.outdir import write_atomic, write_json_atomic
 from relrl.worlds.learn import LearnConfig, learn_task
 
-__all__ = ["WorldsConfig", "run_worlds", "run_worlds_job", "worlds_table"]
+__all__ = ["OUTPUTS", "WorldsConfig", "run_worlds", "run_worlds_job", "worlds_table"]
+
+#: the files and folders the experiment writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "summary.csv", "curves.csv", "test.csv",
+           "step_cost.csv", "optimal_check.csv", "curves.png", "transfer.png",
+           "step_cost.png", "PLOTS.txt", "policies/")
 
 
 @dataclass
@@ -154,7 +157,6 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
               "python": platform.python_version(), "machine_info": machine_info(),
               "jobs": timings}
     files = write_outputs(out, results, timing)
-    (out / "policies").mkdir(exist_ok=True)
     files += [write_atomic(out / "policies" / name, text) for name, text in policies.items()]
     if outcome.error:
         raise_kept(outcome.error, out)
@@ -203,12 +205,9 @@ def _first(curve: list[dict[str, Any]], level: float) -> int | None:
 
 
 def _csv(path: Path, header: list[str], rows: list[list[Any]]) -> Path:
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(header)
-    w.writerows([["" if v is None else (f"{v:.6g}" if isinstance(v, float) else v)
-                  for v in row] for row in rows])
-    return write_atomic(path, buf.getvalue())
+    return write_csv(path, header, [["" if v is None else (f"{v:.6g}" if isinstance(v, float)
+                                                          else v) for v in row]
+                                    for row in rows])
 
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
@@ -281,9 +280,7 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
     axes[0][0].set_ylabel("greedy: fraction of optimal")
     axes[0][0].legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "curves.png", dpi=120)
-    plt.close(fig)
-    files.append(out / "curves.png")
+    files.append(save_figure(fig, out / "curves.png", dpi=120))
     fig, ax = plt.subplots(figsize=(5, 3.2))
     sizes = results["config"]["test_sizes"]
     for r in results["summary"]:
@@ -295,9 +292,7 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
     ax.axhline(0.9, color="grey", lw=0.5, ls="--")
     ax.legend(fontsize=6)
     fig.tight_layout()
-    fig.savefig(out / "transfer.png", dpi=120)
-    plt.close(fig)
-    files.append(out / "transfer.png")
+    files.append(save_figure(fig, out / "transfer.png", dpi=120))
     fig, ax = plt.subplots(figsize=(5, 3.2))
     for t in timing["jobs"]:
         cost = t.get("step_cost_by_size")
@@ -312,9 +307,7 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
     ax.set_ylabel("learning-step cost / smallest size's")
     ax.legend(fontsize=6)
     fig.tight_layout()
-    fig.savefig(out / "step_cost.png", dpi=120)
-    plt.close(fig)
-    files.append(out / "step_cost.png")
+    files.append(save_figure(fig, out / "step_cost.png", dpi=120))
     return files
 
 

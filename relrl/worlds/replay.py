@@ -25,12 +25,11 @@ def write_replay(folder: Path, traces: dict[str, list[dict[str, Any]]], *, learn
     kept episodes into ``folder``.
 
     Args:
-        folder: the session folder (created).
+        folder: the session folder, inside a claimed output folder (made when missing).
         traces: per size, episodes as :func:`relrl.worlds.learn.learn_task` keeps them.
         learner, world, task, seed: for the page's heading.
         graph: the learned tree (:meth:`relrl.engine.Engine.graph`), shown from the start.
     """
-    folder.mkdir(parents=True, exist_ok=True)
     rows, t = [], 0
     for size, episodes in traces.items():
         for n, ep in enumerate(episodes, 1):
