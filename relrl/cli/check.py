@@ -28,7 +28,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "a run or the shell would load it (repeatable)")
     from perception.vocabulary import WORLDS
 
-    parser.add_argument("--world", metavar="NAME|WORLD.pl",
+    def world(text: str) -> str:
+        if text in WORLDS or text.endswith(".pl"):
+            return text
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is neither a world's percepts ({', '.join(WORLDS)}) nor a world file "
+            "(WORLD.pl)")
+
+    parser.add_argument("--world", metavar="NAME|WORLD.pl", type=world,
                         help="a world file written in Prolog (WORLD.pl, docs/worlds.md): "
                              "check it instead of a domain; or a world's percepts, to also "
                              "warn about a domain's facts that can never hold and stimuli "

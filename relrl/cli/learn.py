@@ -45,9 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from relrl.worlds import WORLD_LEARNERS
 
     parser.add_argument("world", metavar="WORLD.pl", help="the world file (docs/worlds.md)")
-    parser.add_argument("--learner", choices=list(WORLD_LEARNERS), default="tg",
-                        help="tg (relational, default) or qtable (Q-learning over ground "
-                             "states, the baseline)")
+    parser.add_argument("--learner", default="tg",
+                        help=f"{' or '.join(WORLD_LEARNERS)}: tg (relational, the default) or "
+                             "qtable (Q-learning over ground states, the baseline)")
     parser.add_argument("--task", default=None,
                         help="a task of the world: its name (stack, on) or an instance "
                              "(on(b1, b2)); default: the first the world declares")
@@ -93,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
     path = Path(args.world)
     if not path.is_file():
         raise ConfigError(f"{args.world}: no such world file")
+    make_world_learner(args.learner, **dict(args.param))          # validate before loading
     with World(path) as world:
         problems = world.problems()
         if problems:
@@ -118,7 +119,6 @@ def run(args: argparse.Namespace) -> int:
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")
     params = dict(args.param)
-    make_world_learner(args.learner, **params)                    # validate now
     if args.policy and not Path(args.policy).is_file():
         raise ConfigError(f"--policy {args.policy}: no such file")
     config = LearnConfig(world=str(path.resolve()), task=task_text, learner=args.learner,

@@ -131,3 +131,17 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
         assert (out / name).is_file(), name
     text = render(load_run(out), "summary")
     assert "| blocks | stack | tg | 1 |" in text
+
+
+def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
+    """The output folder's policy.pl is a link to a file elsewhere: refused before learning
+    (exit 2, one line), and the file it points to is left as it was."""
+    out, victim = tmp_path / "run", tmp_path / "victim.txt"
+    out.mkdir()
+    victim.write_text("keep me")
+    (out / "policy.pl").symlink_to(victim)
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "5",
+                 "--eval-sizes", "3", "--eval-episodes", "2", "--no-speed", "--out", str(out),
+                 "--overwrite"]) == 2
+    assert "link" in capsys.readouterr().err
+    assert victim.read_text() == "keep me"
