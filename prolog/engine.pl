@@ -15,6 +15,7 @@
             engine_reseed/2,          % +KB, +Seed
             engine_forget/1,          % +KB
             engine_park/0,
+            engine_claim_random/1,    % +KB
             engine_param/3,           % +KB, ?Name, ?Value
             engine_params/2,          % +KB, -Params
             engine_config/3,          % +KB, ?Key, ?Value
@@ -61,7 +62,7 @@ touches its own file and one line of learners.pl.
   | learner_init(Name, KB, Params)                  | start afresh                           |
   | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
   | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
-  | learner_update(Name, KB, Transition)            | transition(S0, A0, N0, R, Reinforced, S1, N1, Allowed1) |
+  | learner_update(Name, KB, Transition)            | transition(S0, A0, N0, R, Reinforced, S1, N1, Allowed1); S1 = terminal: the episode ended in the goal (target R alone; worlds, world.pl) |
   | learner_explain(Name, KB, State, N, Explanation)| why it would choose what it chooses    |
   | learner_size(Name, KB, size(Positions, Details))| memory in the paper's positions        |
   | learner_save(Name, KB, Stream)                  | write the learned knowledge as clauses |
@@ -188,6 +189,16 @@ engine_park :-
         nb_setval(relrl_random_owner, none)
     ;   true
     ).
+
+%!  engine_claim_random(+KB) is det.
+%
+%   Load KB's random stream into the generator, where it stays until another knowledge
+%   base steps or engine_park/0 puts it away: for a driver that runs the learner's hooks
+%   itself, many steps in one call (relrl_world:world_episodes/3).
+
+engine_claim_random(KB) :-
+    engine(KB, Engine),
+    claim_random(KB, Engine).
 
 %   Load KB's stream into the generator (Engine is KB's engine term).
 claim_random(KB, Engine) :-

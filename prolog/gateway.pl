@@ -125,6 +125,12 @@ python_api(relrl_check:rule_listing/2).
 python_api(relrl_check:bias_listing/2).
 python_api(relrl_percepts:world_problems/3).
 python_api(relrl_percepts:unread_percepts/3).
+python_api(relrl_world:world_episodes/3).
+python_api(relrl_world:world_info/2).
+python_api(relrl_world:world_task/3).
+python_api(relrl_world:world_verify/5).
+python_api(relrl_world:world_for_task/2).
+python_api(relrl_world_check:world_problems/2).
 python_api(relrl_gateway:gw_new_kb/1).
 python_api(relrl_gateway:gw_drop_kb/1).
 python_api(relrl_gateway:gw_load/3).

@@ -30,6 +30,8 @@
 :- use_module(engine).
 :- use_module(learners).
 :- use_module(policy).
+:- use_module(world).
+:- use_module(world_check).
 
 /** <module> relrl: the knowledge layer
 

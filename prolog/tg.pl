@@ -321,10 +321,14 @@ pick([W|Ws], [A|As], X, Action) :-
 %
 %   Learn from transition(S0, A0, N0, Reward, Reinforced, S1, N1, Allowed1): insert the
 %   example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the responses
-%   Allowed1 (over every response when none is allowed). The max is taken over one
+%   Allowed1 (over every response when none is allowed); S1 = terminal (the episode ended
+%   in a world's goal): Q-target Reward alone. The max is taken over one
 %   representative of each class of responses (tg_classes.pl): the members of a class have
 %   the same Q.
 
+tg_update(KB, transition(S0, A0, N0, Reward, _, terminal, _, _)) :-
+    !,                                          % the episode ended (a world's goal)
+    tg_insert(KB, S0, A0, N0, Reward).
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
     D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, Cache0, Version, _, Index),

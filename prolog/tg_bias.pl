@@ -58,11 +58,17 @@ the names of their variables are given once.
 
 %!  tg_bias(+KB, -Bias) is det.
 %
-%   Bias is bias(Modes, Consts): the rmode/1 literals of KB in declaration order and
-%   Type-Constants pairs (necessity: the declared necessities and none).
+%   Bias is bias(Modes, Consts): the rmode/1 literals of KB in declaration order, then the
+%   modes extra_rmode/2 adds, and Type-Constants pairs (necessity: the declared necessities
+%   and none).
+
+:- multifile extra_rmode/2.
+
+%   extra_rmode(?KB, ?Mode): a mode a driver adds to KB's bias for its run (world.pl: the
+%   task_rmode/2 modes of the task the world's learner is configured for).
 
 tg_bias(KB, bias(Modes, Consts)) :-
-    findall(M, declared(KB, rmode(M)), Modes0),
+    findall(M, ( declared(KB, rmode(M)) ; extra_rmode(KB, M) ), Modes0),
     list_to_set(Modes0, Modes),
     findall(T-C, declared(KB, rconst(T, C)), Pairs0),
     findall(necessity-N, ( kb_necessity(KB, N) ; N = none ), Nec),
@@ -309,7 +315,7 @@ mode_problem(KB, M, Msg) :-
                              constant or a term of these)", [MT, Bad])
     ;   M = action(A)
     ->  pattern(A, P),
-        \+ ( kb_response(KB, R), \+ R \= P ),
+        \+ ( ( kb_response(KB, R) ; declared(KB, action(R)) ), \+ R \= P ),
         format(string(Msg), "rmode ~w matches no declared response", [MT])
     ;   M = necessity(A)
     ->  \+ ( A = #(necessity) ; A = -(necessity) ; atomic(A) ),

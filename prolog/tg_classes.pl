@@ -131,8 +131,10 @@ known(known(Assoc, Extra), X) :-
 %
 %   Classes partitions the Allowed responses in the state Facts into classes no test of the
 %   bias tells apart: cls(Rep, Pick), Rep the representative the class is scored by, Pick
-%   how to draw a member: one (Rep itself), among(Positions) (uniformly) or rest(Group,
-%   Excluded) (uniformly among the members of Group not in Excluded). All = true says
+%   how to draw a member: one (Rep itself), among(Positions) (uniformly), rest(Group,
+%   Excluded) (uniformly among the members of Group not in Excluded) or terms(Actions)
+%   (uniformly; for an index of no responses, a world's, whose actions come with each
+%   state). All = true says
 %   Allowed are all the responses (no constraint rule forbids one): the classes then come
 %   from the index, without a pass over the responses. Classes are in a fixed order: the
 %   index's groups, then the responses the state names by their first position.
@@ -147,6 +149,8 @@ tg_classes(rindex(Rs, Known, Groups, GroupOf, Atoms), Facts, Allowed, All, Class
         maplist(position_sig(Rs, Known1), Named, Pairs),
         sig_classes(Pairs, Rs, NamedClasses),
         append(Rest, NamedClasses, Classes)
+    ;   functor(Rs, _, 0)               % no declared responses: a world's actions come
+    ->  term_classes(Allowed, Known1, Classes)  % with each state (world.pl)
     ;   allowed_pairs(Allowed, Rs, 1, Known1, Pairs),
         sig_classes(Pairs, Rs, Classes)
     ).
@@ -220,6 +224,27 @@ group_class(Rs, [I|Is], cls(Rep, Pick)) :-
     ;   Pick = among([I|Is])
     ).
 
+%   The classes of actions that are not positions of the index (a world declares no
+%   responses: its legal actions come with each state): grouped by their signature, in
+%   order of first occurrence; cls(Rep, terms(Members)) for a class of several. Signatures
+%   are ground, so a stable key sort groups them.
+term_classes(Allowed, Known, Classes) :-
+    findall(Sig-(I-A), ( nth1(I, Allowed, A), tg_signature(A, Known, Sig) ), Pairs),
+    keysort(Pairs, Sorted),
+    group_pairs_by_key(Sorted, Groups),
+    findall(I-Cls, ( member(_-[I-Rep|More], Groups),
+                     term_class(Rep, More, Cls) ),
+            Keyed),
+    keysort(Keyed, InOrder),
+    pairs_values(InOrder, Classes).
+
+term_class(Rep, More, Cls) :-
+    (   More == []
+    ->  Cls = cls(Rep, one)
+    ;   pairs_values(More, Others),
+        Cls = cls(Rep, terms([Rep|Others]))
+    ).
+
 %   Sig-Position pairs of the Allowed responses (a sub-list of the responses, in their
 %   order: one walk along both).
 allowed_pairs([], _, _, _, []).
@@ -249,6 +274,8 @@ tg_class_member(rindex(Rs, _, Groups, _, _), cls(Rep, Pick), Action) :-
     ;   Pick = among(Is)
     ->  random_member(I, Is),
         arg(I, Rs, Action)
+    ;   Pick = terms(As)
+    ->  random_member(Action, As)
     ;   Pick = rest(G, Excluded),
         arg(G, Groups, grp(Members, Size)),
         draw_free(Members, Size, Excluded, I),
@@ -273,6 +300,8 @@ tg_class_size(rindex(_, _, Groups, _, _), cls(_, Pick), Size) :-
     ->  Size = 1
     ;   Pick = among(Is)
     ->  length(Is, Size)
+    ;   Pick = terms(As)
+    ->  length(As, Size)
     ;   Pick = rest(G, Excluded),
         arg(G, Groups, grp(_, GSize)),
         length(Excluded, E),

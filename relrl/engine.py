@@ -93,6 +93,13 @@ GOALS: dict[str, str] = {
     # percepts against a world's vocabulary (prolog/percepts.pl)
     "world_problems": "relrl_percepts:world_problems",
     "unread_percepts": "relrl_percepts:unread_percepts",
+    # worlds written in Prolog (prolog/world.pl, prolog/world_check.pl)
+    "world_episodes": "relrl_world:world_episodes",
+    "world_info": "relrl_world:world_info",
+    "world_task": "relrl_world:world_task",
+    "world_verify": "relrl_world:world_verify",
+    "world_for_task": "relrl_world:world_for_task",
+    "world_check": "relrl_world_check:world_problems",
     "findall": "relrl_gateway:gw_findall",
     "parse": "relrl_gateway:gw_parse",
 }

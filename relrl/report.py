@@ -310,3 +310,38 @@ def _exp2_short(run: Run) -> str:
         rows.append(["*paper (2012)*", "rises, then flat", f"{paper['success'][0]}"])
     return table(["learner / time unit", "final CGI (Fig. 6)", "success rate % (Table 1)"],
                  rows)
+
+
+# ---- Worlds written in Prolog --------------------------------------------------------------
+
+
+@view("worlds", "summary")
+def _worlds_summary(run: Run) -> str:
+    from relrl.worlds.experiment import worlds_table
+
+    r = run.results
+    cfg = r["config"]
+    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), "
+            f"{cfg['episodes']} learning episodes on sizes "
+            f"{', '.join(map(str, cfg['train_sizes']))}, greedy evaluations of "
+            f"{cfg['eval_episodes']} episodes; a score is optimal / steps per episode (0 for "
+            "a missed goal), the test sizes with no further learning.\n\n")
+    return head + worlds_table(r)
+
+
+@view("worlds", "cost")
+def _worlds_cost(run: Run) -> str:
+    rows = []
+    for t in run.timing.get("jobs", []):
+        cost = t.get("step_cost_by_size")
+        if not cost:
+            continue
+        sizes = cost["sizes"]
+        rows.append([Path(t["world"]).stem, t["task"], t["learner"], t["seed"],
+                     _f(t.get("learning_steps_per_second"), 0),
+                     " / ".join(_f(cost["us_per_step"][str(s)], 0) for s in sizes),
+                     _f(cost["cost_ratio"][str(sizes[-1])]),
+                     _f(cost["size_ratio"][str(sizes[-1])])])
+    return table(["world", "task", "learner", "seed", "learning steps/s",
+                  "µs per learning step by size", "cost ratio, largest / smallest",
+                  "size ratio"], rows)

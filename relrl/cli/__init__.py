@@ -35,6 +35,7 @@ SUBCOMMANDS: dict[str, str] = {
     "migrate": "relrl.cli.migrate",
     "tree": "relrl.cli.tree",
     "report": "relrl.cli.report",
+    "learn": "relrl.cli.learn",
 }
 
 

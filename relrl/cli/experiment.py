@@ -12,9 +12,10 @@ from relrl.outdir import add_out_options
 
 HELP = ("run the experiments (sis: the paper's Experiment 1, with relrl's relational learner tg "
         "beside the paper's three; scaling: every learner in worlds that grow, with zero-shot "
-        "transfer)")
+        "transfer; worlds: tasks of worlds written in Prolog, blocks world first)")
 EXAMPLE = ("relrl experiment sis --quick --out runs/exp1-quick\n"
-           "  relrl experiment scaling --quick --out runs/scaling-quick")
+           "  relrl experiment scaling --quick --out runs/scaling-quick\n"
+           "  relrl experiment worlds --quick --out runs/worlds-quick")
 
 #: ``--quick`` settings of the scaling benchmark (under 5 minutes on 2 cores).
 QUICK_SCALING = {"seeds": "0", "budget": 20_000, "block": 2_000, "eval_runs": 4,
@@ -148,6 +149,43 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                     help="share of places (or kinds) held out (default 0.4)")
     add_out_options(sc, default="runs/scaling",
                     what="output folder: results.json, CSVs, figures, domains")
+    _add_worlds(sub)
+
+
+def _add_worlds(sub) -> None:
+    from relrl.worlds import WORLD_LEARNERS
+
+    w = sub.add_parser("worlds", help="tasks of worlds written in Prolog (blocks world)",
+                       description="Learning curves, evaluation on other sizes with no "
+                                   "further learning, memory and step cost of the learners "
+                                   "of worlds (tg, qtable) on tasks of worlds written in "
+                                   "Prolog; the worlds' stated optimum checked by search.")
+    w.add_argument("--worlds", default=None, metavar="FILE,FILE",
+                   help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
+    w.add_argument("--tasks", default="stack,unstack,on",
+                   help="tasks of each world (default stack,unstack,on)")
+    w.add_argument("--learners", default=",".join(WORLD_LEARNERS),
+                   help=f"learners (default {','.join(WORLD_LEARNERS)})")
+    w.add_argument("--seeds", default=None, help="comma-separated seeds (default 0,1,2)")
+    w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
+    w.add_argument("--test-sizes", default="6,8,10",
+                   help="sizes evaluated with no further learning (default 6,8,10)")
+    w.add_argument("--episodes", type=int, default=None,
+                   help="learning episodes per job (default 1000; --quick 200)")
+    w.add_argument("--block", type=int, default=None,
+                   help="learning episodes between evaluations (default 100; --quick 50)")
+    w.add_argument("--eval-episodes", type=int, default=None,
+                   help="greedy episodes per evaluation (default 100; --quick 30)")
+    w.add_argument("--param", type=_param, action="append", default=[],
+                   metavar="LEARNER.NAME=X", help="learner parameter (repeatable)")
+    w.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
+                   help="worker processes, one Prolog engine each (default: up to 2)")
+    w.add_argument("--engine", choices=["local", "ray"], default="local",
+                   help="local worker processes (default) or a Ray cluster")
+    w.add_argument("--address", default=None, help="with --engine ray: the cluster to join")
+    w.add_argument("--quick", action="store_true", help="a short run (one seed, tg)")
+    add_out_options(w, default="runs/worlds",
+                    what="output folder: results.json, CSVs, figures")
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -311,6 +349,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.name == "scaling":
         return _run_scaling(args)
+    if args.name == "worlds":
+        return _run_worlds(args)
     from relrl.experiments.sis import claims_table
 
     config = build_config(args)
@@ -342,6 +382,81 @@ def _run_scaling(args: argparse.Namespace) -> int:
         out.status = "partial" if results.get("partial") else "complete"
     timing = json.loads((out.path / "timing.json").read_text())
     print(scaling_table(results, timing))
+    return _finish(results, files, out.path, signals.signum)
+
+
+def build_worlds_config(args: argparse.Namespace):
+    """The WorldsConfig the options of ``relrl experiment worlds`` describe."""
+    from relrl.errors import ConfigError
+    from relrl.resources import examples_dir
+    from relrl.worlds import WORLD_LEARNERS, World, make_world_learner
+    from relrl.worlds.experiment import WorldsConfig
+
+    config = WorldsConfig(seeds=_ints(args.seeds or "0,1,2", "--seeds"))
+    if args.quick:
+        config.seeds = _ints(args.seeds or "0", "--seeds")
+    if args.worlds:
+        config.worlds = [w.strip() for w in args.worlds.split(",") if w.strip()]
+    else:
+        folder = examples_dir() / "worlds"
+        config.worlds = [str(folder / "blocks.pl"), str(folder / "blocks_moves.pl")]
+    for i, path in enumerate(config.worlds):
+        if not Path(path).is_file():
+            raise ConfigError(f"--worlds {path}: no such world file")
+        config.worlds[i] = str(Path(path).resolve())
+    config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    config.learners = [x.strip() for x in args.learners.split(",") if x.strip()]
+    for name in config.learners:
+        if name not in WORLD_LEARNERS:
+            raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "
+                              f"{', '.join(WORLD_LEARNERS)})")
+    if not config.tasks or not config.learners:
+        raise ConfigError("--tasks and --learners must name at least one each")
+    config.train_sizes = _ints(args.sizes, "--sizes")
+    config.test_sizes = _ints(args.test_sizes, "--test-sizes")
+    if any(s < 1 for s in config.train_sizes + config.test_sizes):
+        raise ConfigError("sizes must be whole numbers >= 1")
+    config.episodes = args.episodes or (200 if args.quick else 1000)
+    config.block = args.block or (50 if args.quick else 100)
+    config.eval_episodes = args.eval_episodes or (30 if args.quick else 100)
+    for what, value in [("--episodes", config.episodes), ("--block", config.block),
+                        ("--eval-episodes", config.eval_episodes)]:
+        if value < 1:
+            raise ConfigError(f"{what} must be at least 1, not {value}")
+    if len(set(config.seeds)) != len(config.seeds) or any(s < 0 for s in config.seeds):
+        raise ConfigError(f"--seeds must be distinct whole numbers >= 0, not {args.seeds!r}")
+    for learner, name, value in args.param:
+        if learner not in config.learners:
+            raise ConfigError(f"--param {learner}.{name}: {learner} is not among --learners")
+        config.learner_params.setdefault(learner, {})[name] = value
+    for learner in config.learners:
+        make_world_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    for path in config.worlds:
+        with World(path) as world:
+            problems = world.problems()
+            if problems:
+                raise ConfigError("\n".join([*problems, f"{len(problems)} problem(s) in "
+                                             f"{path} (relrl check --world {path})"]))
+            for task in config.tasks:
+                world.task(task)
+    if args.workers < 1:
+        raise ConfigError(f"--workers must be at least 1, not {args.workers}")
+    return config
+
+
+def _run_worlds(args: argparse.Namespace) -> int:
+    from relrl.experiments.runner import command_signals
+    from relrl.outdir import OutDir
+    from relrl.worlds.experiment import OUTPUTS, run_worlds, worlds_table
+
+    config = build_worlds_config(args)
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/worlds", outputs=OUTPUTS) as out:
+        results, files = run_worlds(config, out.path, workers=args.workers,
+                                    engine=args.engine, address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
+    print(worlds_table(results))
     return _finish(results, files, out.path, signals.signum)
 
 

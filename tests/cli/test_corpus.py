@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 215 cases: 149 bad inputs in ``CASES`` and 23 more tests here, 26 in
+The corpus holds 231 cases: 165 bad inputs in ``CASES`` and 23 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -29,6 +29,11 @@ EXP = ["experiment", "sis", "--learners", "etg", "--points", "1", "--eval-runs",
        "--eval-steps", "10", "--block", "10", "--workers", "1"]
 BENCH = ["bench", "--steps", "100", "--no-perception", "--no-faces"]
 SMALL = "synthetic://?size=64x48"
+#: a world written in Prolog (relrl learn, relrl experiment worlds).
+BLOCKS = str(__import__("pathlib").Path(__file__).resolve().parents[2] / "examples" / "worlds"
+             / "blocks.pl")
+LEARN = ["learn", BLOCKS, "--task", "stack", "--episodes", "1", "--eval-episodes", "1",
+         "--no-speed"]
 
 CASES: list[tuple[str, list[str], list[str]]] = [
     # ---- shell -----------------------------------------------------------------------------
@@ -248,6 +253,26 @@ CASES: list[tuple[str, list[str], list[str]]] = [
                                            "{d}/cal_scripts_dev_zero.toml", "status"],
      ["cal_scripts_dev_zero.toml", "head.scripts", "/dev/zero", "not a regular file"]),
     ("report-out-unwritable", ["report", "{d}/adir", "--out", "/proc/relrl.md"], ["/proc"]),
+    # ---- learn (worlds written in Prolog) ---------------------------------------------------
+    ("learn-missing-world", ["learn", "{d}/nope.pl"], ["nope.pl", "no such world file"]),
+    ("learn-world-a-folder", ["learn", "{d}/adir"], ["adir", "no such world file"]),
+    ("learn-random-bytes", ["learn", "{d}/random.toml"], ["random.toml"]),
+    ("learn-unknown-task", LEARN + ["--task", "fly"], ["fly", "no such task"]),
+    ("learn-bad-task-term", LEARN + ["--task", "on(("], ["on((", "not a task term"]),
+    ("learn-episodes", LEARN + ["--episodes", "-1"], ["--episodes", "-1"]),
+    ("learn-sizes", LEARN + ["--sizes", "3,0"], ["--sizes", "3,0"]),
+    ("learn-size-and-sizes", LEARN + ["--size", "3", "--sizes", "4"], ["--size", "--sizes"]),
+    ("learn-unknown-learner", LEARN + ["--learner", "etg"], ["etg"]),
+    ("learn-unknown-param", LEARN + ["--param", "nope=1"], ["nope"]),
+    ("learn-nan-param", LEARN + ["--param", "alpha=nan"], ["alpha", "nan"]),
+    ("learn-missing-policy", LEARN + ["--policy", "{d}/nope.pl"], ["nope.pl"]),
+    ("learn-out-file", LEARN + ["--out", "{d}/afile"], ["afile", "not a folder"]),
+    ("experiment-worlds-missing", ["experiment", "worlds", "--worlds", "{d}/nope.pl"],
+     ["nope.pl", "no such world file"]),
+    ("experiment-worlds-learner", ["experiment", "worlds", "--worlds", BLOCKS, "--learners",
+                                   "etg"], ["etg", "learners of worlds"]),
+    ("experiment-worlds-task", ["experiment", "worlds", "--worlds", BLOCKS, "--tasks", "fly"],
+     ["fly", "no such task"]),
     # ---- demo ------------------------------------------------------------------------------
     ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),

@@ -29,9 +29,13 @@ SCALING = ["scaling", "--learners", "qlearning,etg", "--sizes", "5,9", "--seeds"
            "--transfer-sizes", "5"]
 SIS = ["sis", "--learners", "etg", "--points", "1", "--eval-runs", "2", "--eval-steps", "100",
        "--block", "200"]
+WORLDS = ["worlds", "--worlds", str(Path(__file__).resolve().parents[2] / "examples" / "worlds"
+                                    / "blocks.pl"),
+          "--tasks", "stack", "--learners", "tg,qtable", "--seeds", "0", "--episodes", "20",
+          "--block", "10", "--eval-episodes", "5", "--sizes", "3", "--test-sizes", "4"]
 
 
-@pytest.mark.parametrize("args", [SCALING, SIS], ids=["scaling", "sis"])
+@pytest.mark.parametrize("args", [SCALING, SIS, WORLDS], ids=["scaling", "sis", "worlds"])
 def test_ray_results_are_byte_identical_to_the_local_run(args: list[str], local_ray,
                                                          tmp_path: Path) -> None:
     a, b = tmp_path / "local", tmp_path / "ray"

@@ -1,0 +1,182 @@
+/*  Blocks world: the relational reinforcement-learning benchmark (Dzeroski, De Raedt &
+    Driessens, "Relational Reinforcement Learning", Machine Learning 43, 2001; Driessens,
+    Ramon & Blockeel, RRL-TG, ECML 2001), stated in relrl's world vocabulary (docs/worlds.md).
+
+    Load it with relrl (relrl check --world examples/worlds/blocks.pl) or in plain swipl:
+        swipl prolog/relrl.pl examples/worlds/blocks.pl
+        ?- initial_state(4, S), task_goal(on(_, _), S, G), optimal_steps(G, S, N).
+
+    Blocks b1 ... bN stand on the floor or on one another. A state holds on(X, Y) for each
+    block (Y a block or floor) and clear(X) for each block with nothing on it. One action,
+    move(X, Y): a clear block X onto a clear block Y, or onto the floor when X is not on it.
+    Tasks: stack (all blocks in one tower), unstack (all on the floor), on(A, B) (block A on
+    block B, two blocks drawn for each episode and shown to the learner as goal_on(A, B)).
+    Reward 1 when the goal is reached, within a step bound of three moves per block.
+*/
+
+% ---- states ------------------------------------------------------------------------------
+
+% A random state of Size blocks: the blocks in a random order, each put on the floor or on
+% top of one of the towers built so far, the floor and each tower equally likely.
+initial_state(Size, State) :-
+    blocks(Size, Blocks),
+    random_permutation(Blocks, Order),
+    foldl(place_block, Order, []-[], Towers-Facts0),
+    foldl(top_clear, Towers, Facts0, State).
+
+blocks(Size, Blocks) :-
+    numlist(1, Size, Is),
+    maplist(block_name, Is, Blocks).
+
+block_name(I, B) :-
+    atom_concat(b, I, B).
+
+% Towers: a list of the blocks on top of each tower.
+place_block(B, Towers0-Facts0, Towers-[on(B, Under)|Facts0]) :-
+    length(Towers0, K),
+    random_between(0, K, J),
+    (   J =:= 0
+    ->  Under = floor,
+        Towers = [B|Towers0]
+    ;   nth1(J, Towers0, Under, Rest),
+        Towers = [B|Rest]
+    ).
+
+top_clear(B, Facts, [clear(B)|Facts]).
+
+% ---- tasks and goals ---------------------------------------------------------------------
+
+task(stack).
+task(unstack).
+task(on(_, _)).
+
+% on(A, B): two distinct blocks of the state, drawn at random, unless the task names them.
+task_goal(on(A, B), State, on(A, B)) :-
+    !,
+    (   var(A), var(B)
+    ->  findall(X, member(on(X, _), State), Blocks),
+        random_select(A, Blocks, Others),
+        random_member(B, Others)
+    ;   true
+    ).
+task_goal(Task, _, Task).
+
+goal(stack, State) :-
+    aggregate_all(count, member(on(_, floor), State), 1).
+goal(unstack, State) :-
+    \+ ( member(on(_, Y), State), Y \== floor ).
+goal(on(A, B), State) :-
+    memberchk(on(A, B), State).
+
+goal_fact(on(A, B), goal_on(A, B)).
+
+step_bound(_, State, Bound) :-
+    aggregate_all(count, member(on(_, _), State), N),
+    Bound is 3 * N.
+
+% ---- actions -----------------------------------------------------------------------------
+
+action(move(_X, _Y)).
+
+precondition(move(X, Y), State) :-
+    member(clear(X), State),
+    (   member(clear(Y), State),
+        Y \== X
+    ;   \+ memberchk(on(X, floor), State),
+        Y = floor
+    ).
+
+effect(move(X, Y), State, [on(X, Z)|Del], [on(X, Y)|Add]) :-
+    memberchk(on(X, Z), State),
+    (   Y == floor
+    ->  Del = []
+    ;   Del = [clear(Y)]
+    ),
+    (   Z == floor
+    ->  Add = []
+    ;   Add = [clear(Z)]
+    ).
+
+% ---- what the learner sees ---------------------------------------------------------------
+
+% Besides on/2, clear/1 and goal_on/2, two relations computed from the state and the goal,
+% each with at most two facts per block (the view grows linearly with the world; above/2
+% over every pair would grow with the square of a tower's height): covers(X, Y), X above Y
+% in Y's tower, for the blocks Y the goal names; highest(T), T the top of a tallest tower.
+derived(covers(X, Y), Facts) :-
+    member(goal_on(A, B), Facts),
+    member(Y, [A, B]),
+    member(on(X, _), Facts),
+    below(Facts, X, Y).
+derived(highest(T), State) :-
+    findall(H-T0, ( member(clear(T0), State), height(State, T0, H) ), Pairs),
+    max_member(Max-_, Pairs),
+    member(Max-T, Pairs).
+
+below(State, T, X) :-
+    memberchk(on(T, Y), State),
+    Y \== floor,
+    (   X = Y
+    ;   below(State, Y, X)
+    ).
+
+height(State, B, H) :-
+    (   memberchk(on(B, Y), State), Y \== floor
+    ->  height(State, Y, H0),
+        H is H0 + 1
+    ;   H = 1
+    ).
+
+relation(on(_, _)).
+relation(clear(_)).
+relation(goal_on(_, _)).
+relation(covers(_, _)).
+relation(highest(_)).
+
+% The language bias: blocks are variables (a test speaks of *a* block, never of b3), the
+% floor the one constant.
+rmode(action(move(-block, -block))).
+rmode(action(move(-block, floor))).
+rmode(on(+block, -block)).
+rmode(on(+block, +block)).
+rmode(on(+block, floor)).
+rmode(goal_on(+block, -block)).
+rmode(goal_on(-block, +block)).
+rmode(goal_on(+block, +block)).
+rmode(covers(+block, -block)).
+rmode(covers(+block, +block)).
+
+% Stacking needs the top of a tallest tower; for the other tasks it is a distraction (a tree
+% that splits on it values moves by the tower heights of 3-5 blocks), so only stack's bias
+% holds it.
+task_rmode(stack, highest(+block)).
+
+% ---- the optimal number of moves (verified against a breadth-first search by relrl check) --
+
+% stack: every block outside a tallest tower moves once; unstack: every block not on the
+% floor moves once; on(A, B): every block above A or B moves once and A once more, and A
+% twice when it stands above B (it must leave B's tower before B is clear).
+optimal_steps(stack, State, N) :-
+    aggregate_all(count, member(on(_, _), State), Blocks),
+    aggregate_all(max(H), ( member(clear(T), State), height(State, T, H) ), Max),
+    N is Blocks - Max.
+optimal_steps(unstack, State, N) :-
+    aggregate_all(count, ( member(on(_, Y), State), Y \== floor ), N).
+optimal_steps(on(A, B), State, N) :-
+    (   memberchk(on(A, B), State)
+    ->  N = 0
+    ;   count_above(State, A, NA),
+        count_above(State, B, NB),
+        (   below(State, A, B)              % A above B
+        ->  N is NB + 1
+        ;   below(State, B, A)              % B above A
+        ->  N is NA + 1
+        ;   N is NA + NB + 1
+        )
+    ).
+
+count_above(State, X, N) :-
+    aggregate_all(count, ( member(on(Y, _), State), below(State, Y, X) ), N).
+
+sizes(train, [3, 4, 5]).
+sizes(test, [6, 8, 10]).

@@ -1,0 +1,257 @@
+:- module(relrl_world_check,
+          [ world_problems/2      % +KB, -Problems
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(random)).
+:- use_module(library(pairs)).
+:- use_module(declarations).
+:- use_module(rules).
+:- use_module(engine, [engine_park/0]).
+:- use_module(check, [body_goal/2, clause_location/3]).
+:- use_module(tg_bias, [bias_problem/2]).
+:- use_module(world).
+
+/** <module> Validating a world file
+
+world_problems/2 lists what is wrong with the world loaded into a knowledge base, as
+problem(File, Line, Message) terms in file order (File '' for the world as a whole):
+
+  - a required predicate of the vocabulary that the world does not define (world.pl);
+  - a clause that calls an undefined predicate;
+  - a task/1, action/1 or sizes/2 declaration of the wrong shape;
+  - a bad relational view or language bias (relation/1, rmode/1, rconst/2; tg_bias.pl);
+  - what running the world shows: for every task, a few episodes of random legal actions
+    from random start states of the smallest training size (seeded, so the same problems
+    every time). A goal of the world that raises an error or breaks the vocabulary's
+    contract (an unbound action, an effect that is not two lists of ground facts, a reward
+    that is not a number ...) is a problem at that rule's file and line; so is a fact of the
+    learner's view that no relation/1 declares, and an action no action/1 template covers;
+  - optimal_steps/3, when the world defines it, checked against a breadth-first search over
+    the world's own dynamics (world_bfs/5) on random start states of the training sizes up
+    to five objects: a different number is a problem at optimal_steps/3.
+
+A time limit, Ctrl-C or a resource error outside the world's own goals is not a problem of
+the world: it propagates.
+*/
+
+%!  world_problems(+KB, -Problems:list) is det.
+%
+%   Problems lists every problem found in the world loaded into KB, in file order.
+
+world_problems(KB, Problems) :-
+    must_be(atom, KB),
+    findall(P, static_problem(KB, P), Static),
+    (   Static == [],
+        \+ missing_required(KB, _)
+    ->  findall(P, run_problem(KB, P), Run)
+    ;   Run = []
+    ),
+    append(Static, Run, All),
+    sort(All, Problems0),
+    map_list_to_pairs(problem_key, Problems0, Keyed),
+    keysort(Keyed, Sorted),
+    pairs_values(Sorted, Problems).
+
+problem_key(problem(File, Line, _), File-Line).
+
+% ---- what the file says --------------------------------------------------------------------
+
+static_problem(KB, problem('', 0, Msg)) :-
+    missing_required(KB, Name/Arity),
+    format(string(Msg), "the world defines no ~q (a world needs initial_state/2, task/1, \c
+                         action/1, precondition/2, effect/4 and goal/2; see docs/worlds.md)",
+           [Name/Arity]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, Head, Body, Ref),
+    body_goal(Body, Goal),
+    undefined(KB, Goal, PI),
+    clause_location(Ref, File, Line),
+    functor(Head, HN, HA),
+    format(string(Msg), "~q calls undefined predicate ~q", [HN/HA, PI]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    member(Head-Check, [task(T)-callable(T), action(T)-callable(T)]),
+    world_clause(KB, Head, true, Ref),
+    \+ Check,
+    clause_location(Ref, File, Line),
+    format(string(Msg), "~q: the argument must be a term, e.g. task(stack), \c
+                         action(move(_, _))", [Head]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, sizes(K, L), true, Ref),
+    \+ ( memberchk(K, [train, test]), is_list(L), L = [_|_], maplist(positive, L) ),
+    clause_location(Ref, File, Line),
+    format(string(Msg), "sizes(~q, ~q): use sizes(train, [3, 4, 5]) or sizes(test, [...]) \c
+                         with positive integers", [K, L]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, discount(G), true, Ref),
+    \+ ( number(G), G > 0, G =< 1 ),
+    clause_location(Ref, File, Line),
+    format(string(Msg), "discount(~q): the discount must be a number in (0, 1]", [G]).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, task_rmode(T, M), true, Ref),
+    (   \+ ( declared(KB, task(T0)), \+ T0 \= T )
+    ->  format(string(Msg), "task_rmode(~q, ~q): no declared task is ~q", [T, M, T])
+    ;   \+ callable(M)
+    ->  format(string(Msg), "task_rmode(~q, ~q): the mode must be a literal", [T, M])
+    ;   M \= action(_),
+        functor(M, Name, Arity),
+        \+ ( declared(KB, relation(R)), callable(R), functor(R, Name, Arity) )
+    ->  format(string(Msg), "task_rmode(~q, ~q): ~q is not a declared relation (add \c
+                             relation/1)", [T, M, Name/Arity])
+    ),
+    clause_location(Ref, File, Line).
+static_problem(KB, P) :-
+    bias_problem(KB, P).
+
+positive(X) :-
+    integer(X),
+    X > 0.
+
+missing_required(KB, PI) :-
+    world_predicate(PI, required),
+    \+ world_defines(KB, PI).
+
+world_clause(KB, Head, Body, Ref) :-
+    current_predicate(KB:Name/Arity),
+    functor(Head, Name, Arity),
+    \+ predicate_property(KB:Head, imported_from(_)),
+    \+ predicate_property(KB:Head, foreign),
+    catch(clause(KB:Head, Body, Ref),
+          error(permission_error(access, private_procedure, _), _), fail).
+
+undefined(KB, Goal, Name/Arity) :-
+    callable(Goal),
+    Goal \= _:_,
+    functor(Goal, Name, Arity),
+    \+ predicate_property(KB:Goal, defined),
+    \+ predicate_property(KB:Goal, autoload(_)),
+    \+ '$in_library'(Name, Arity, _).
+
+% ---- what running it shows -----------------------------------------------------------------
+
+%   Episodes of random legal actions, 3 per task, seeded; then optimal_steps/3 against the
+%   search. Each problem is reported once (the first episode that shows it).
+run_problem(KB, P) :-
+    engine_park,
+    set_random(seed(0)),
+    sizes(KB, Sizes),
+    Sizes = [Smallest|_],
+    findall(T, declared(KB, task(T)), Tasks),
+    (   member(Task, Tasks),
+        between(1, 3, _),
+        once(episode_problem(KB, Task, Smallest, P))
+    ;   world_defines(KB, optimal_steps/3),
+        member(Task, Tasks),
+        member(Size, Sizes), Size =< 5,
+        between(1, 10, _),
+        once(optimal_problem(KB, Task, Size, P))
+    ).
+
+sizes(KB, Sizes) :-
+    (   declared(KB, sizes(train, S0)), is_list(S0), S0 = [_|_]
+    ->  msort(S0, Sizes)
+    ;   Sizes = [3]
+    ).
+
+%   A problem shown by one episode of random legal actions (fails when it shows none).
+episode_problem(KB, Task, Size, P) :-
+    shown(random_episode(KB, Task, Size), P).
+
+%   call(Check, Found) gives found(P) or none; an error of a world goal is found too.
+shown(Check, P) :-
+    catch(call(Check, Found), relrl_rule_error(Goal, Where, E),
+          rule_problem(Goal, Where, E, Found)),
+    Found = found(P).
+
+random_episode(KB, Task, Size, Found) :-
+    world_start(KB, Task, Size, S0, Goal),
+    (   view_problem(KB, Goal, S0, Found)
+    ->  true
+    ;   walk(KB, Goal, S0, 30, Found)
+    ).
+
+walk(KB, Goal, S, N, Found) :-
+    world_legal(KB, S, As),
+    (   member(A, As), \+ covered_action(KB, A)
+    ->  rule_where(KB, action(_), Where),
+        where_file_line(Where, File, Line),
+        format(string(Msg), "precondition/2 gave the action ~q, which no action/1 template \c
+                             covers", [A]),
+        Found = found(problem(File, Line, Msg))
+    ;   N =:= 0
+    ->  Found = none
+    ;   As == []
+    ->  Found = none
+    ;   random_member(A, As),
+        world_next(KB, Goal, S, A, S1, outcome(_, Reached)),
+        (   view_problem(KB, Goal, S1, Found)
+        ->  true
+        ;   Reached == true
+        ->  Found = none
+        ;   N1 is N - 1,
+            walk(KB, Goal, S1, N1, Found)
+        )
+    ).
+
+covered_action(KB, A) :-
+    declared(KB, action(T)),
+    subsumes_term(T, A),
+    !.
+
+%   A fact of the learner's view that no relation/1 template covers (when the world
+%   declares relations at all).
+view_problem(KB, Goal, State, found(problem(File, Line, Msg))) :-
+    declared(KB, relation(_)),
+    world_view(KB, Goal, State, View),
+    member(F, View),
+    \+ ( declared(KB, relation(T)), subsumes_term(T, F) ),
+    !,
+    functor(F, Name, Arity),
+    rule_where(KB, relation(_), Where),
+    where_file_line(Where, File, Line),
+    format(string(Msg), "the learner's view holds ~q, but no relation/1 declares ~q (add \c
+                         relation(~q).)", [F, Name/Arity, Name/Arity]).
+
+%   An error of a world goal: a problem at its file and line (a time limit or Ctrl-C is
+%   not the world's problem: it propagates).
+rule_problem(Goal, Where, E, found(problem(File, Line, Msg))) :-
+    (   ( E == time_limit_exceeded ; E == relrl_interrupted )
+    ->  throw(relrl_rule_error(Goal, Where, E))
+    ;   true
+    ),
+    where_file_line(Where, File, Line),
+    (   E = error(domain_error(world_vocabulary, Text), _)
+    ->  Msg = Text
+    ;   message_to_codes(E, Text),
+        format(string(Msg), "~q raised: ~s", [Goal, Text])
+    ).
+
+message_to_codes(E, Codes) :-
+    '$messages':translate_message(E, Lines, []),
+    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).
+
+where_file_line(Where, File, Line) :-
+    (   Where = File:Line
+    ->  true
+    ;   File = '', Line = 0
+    ).
+
+%   optimal_steps/3 against a breadth-first search on one random start state.
+optimal_problem(KB, Task, Size, P) :-
+    shown(optimal_mismatch(KB, Task, Size), P).
+
+optimal_mismatch(KB, Task, Size, Found) :-
+    world_start(KB, Task, Size, S, Goal),
+    world_optimal(KB, Goal, S, 0, Declared),
+    world_bfs(KB, Goal, S, 50000, Searched),
+    (   Searched \== none,
+        Declared \== Searched
+    ->  rule_where(KB, optimal_steps(_, _, _), Where),
+        where_file_line(Where, File, Line),
+        format(string(Msg), "optimal_steps/3 gives ~q for ~q from ~q; a breadth-first \c
+                             search over the world's actions finds ~q", [Declared, Goal, S,
+                                                                         Searched]),
+        Found = found(problem(File, Line, Msg))
+    ;   Found = none
+    ).

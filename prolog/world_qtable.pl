@@ -1,0 +1,193 @@
+:- module(relrl_world_qtable,
+          [ qtable_q/5,           % +KB, +State, +Necessity, +Action, -Q
+            qtable_size/2         % +KB, -Size
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(random)).
+:- use_module(library(aggregate)).
+:- use_module(engine).
+:- use_module(declarations).
+
+/** <module> qtable: Q-learning over ground relational states (the baseline of worlds)
+
+The honest baseline for a relational learner in a world written in Prolog: tabular
+Q-learning whose table is keyed on the **ground** view of the state (world.pl's
+world_view/4: every fact with its object names, e.g. [clear(b2), goal_on(b1, b3), on(b1,
+floor), ...]) and the ground action. It shares nothing between two states that differ
+only in the names of their objects, and a state it never met — every state of a larger
+world — has q_init for every action: it cannot transfer. It is the ground-state Q-learning
+the relational-RL literature compares against, run inside Prolog like the world itself
+(relrl's `qlearning` learner is the same update over the domains' 2^x state code, in
+Python).
+
+Choices: Boltzmann over the allowed actions with temperature T > 0 (T = 0: epsilon-greedy)
+while learning or exploring; greedy (ties at random) otherwise. Update: Q += alpha * (target
+- Q), target = r + gamma * max_a' Q(s', a') (r alone when the episode ended in the goal:
+the next state `terminal`). Params: alpha, gamma, epsilon, temperature, q_init.
+
+The table is a dynamic predicate of this module only, keyed by the term hash of (state,
+necessity, action), so a look-up costs a hash and a first-argument index, whatever the
+table's size.
+*/
+
+:- dynamic q_/5.                  % Hash, KB, Key, Q, Visits  (Key = k(State, N, Action))
+
+params(KB, P) :-
+    atom_concat('$qtable:', KB, K),
+    (   nb_current(K, P0)
+    ->  P = P0
+    ;   existence_error(qtable, KB)
+    ).
+
+init(KB, Params) :-
+    must_be(atom, KB),
+    maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init],
+            [Alpha, Gamma, Epsilon, Tau, Qinit]),
+    retractall(q_(_, KB, _, _, _)),
+    atom_concat('$qtable:', KB, K),
+    nb_setval(K, p(Alpha, Gamma, Epsilon, Tau, Qinit)).
+
+param(Params, Name, Value) :-
+    (   memberchk(Name=V, Params)
+    ->  must_be(number, V),
+        Value = V
+    ;   existence_error(qtable_parameter, Name)
+    ).
+
+%!  qtable_q(+KB, +State, +Necessity, +Action, -Q) is det.
+%
+%   Q of Action in the ground State under Necessity: the table's entry, or q_init.
+
+qtable_q(KB, S, N, A, Q) :-
+    Key = k(S, N, A),
+    term_hash(Key, H),
+    (   q_(H, KB, Key, Q0, _)
+    ->  Q = Q0
+    ;   params(KB, p(_, _, _, _, Q))
+    ).
+
+choose(KB, S, N, Allowed, Mode, Action) :-
+    Allowed = [_|_],
+    params(KB, p(_, _, Epsilon, Tau, _)),
+    maplist(qtable_q(KB, S, N), Allowed, Qs),
+    max_list(Qs, Best),
+    (   Mode == greedy
+    ->  ties(Qs, Allowed, Best, Ties),
+        random_member(Action, Ties)
+    ;   Tau =:= 0
+    ->  (   random_float < Epsilon
+        ->  random_member(Action, Allowed)
+        ;   ties(Qs, Allowed, Best, Ties),
+            random_member(Action, Ties)
+        )
+    ;   boltzmann(Qs, Allowed, Best, Tau, Action)
+    ).
+
+ties([], [], _, []).
+ties([Q|Qs], [A|As], Best, Ties) :-
+    (   Q =:= Best
+    ->  Ties = [A|Ties1]
+    ;   Ties = Ties1
+    ),
+    ties(Qs, As, Best, Ties1).
+
+boltzmann(Qs, As, Best, Tau, Action) :-
+    foldl(weight(Best, Tau), Qs, Ws, 0.0, Total),
+    X is random_float * Total,
+    pick(Ws, As, X, Action).
+
+weight(Best, Tau, Q, W, T0, T) :-
+    W is exp((Q - Best) / Tau),
+    T is T0 + W.
+
+pick([W|Ws], [A|As], X, Action) :-
+    (   ( X < W ; Ws == [] )
+    ->  Action = A
+    ;   X1 is X - W,
+        pick(Ws, As, X1, Action)
+    ).
+
+update(KB, transition(S0, A0, N0, R, _, S1, N1, Allowed1)) :-
+    params(KB, p(Alpha, Gamma, _, _, Qinit)),
+    (   ( S1 == terminal ; Allowed1 == [] )
+    ->  Target = R
+    ;   maplist(qtable_q(KB, S1, N1), Allowed1, Qs),
+        max_list(Qs, Max),
+        Target is R + Gamma * Max
+    ),
+    Key = k(S0, N0, A0),
+    term_hash(Key, H),
+    (   retract(q_(H, KB, Key, Q0, V0))
+    ->  true
+    ;   Q0 = Qinit, V0 = 0
+    ),
+    Q is Q0 + Alpha * (Target - Q0),
+    V is V0 + 1,
+    assertz(q_(H, KB, Key, Q, V)).
+
+%!  qtable_size(+KB, -Size) is det.
+%
+%   Size is size(Positions, [entries=E, states=S]): one position per table entry.
+
+qtable_size(KB, size(E, [entries=E, states=NS])) :-
+    aggregate_all(count, q_(_, KB, _, _, _), E),
+    findall(S-N, q_(_, KB, k(S, N, _), _, _), SNs),
+    sort(SNs, Set),
+    length(Set, NS).
+
+save(KB, Stream) :-
+    format(Stream, "% q(State, Necessity, Action, Q, Visits): Q-learning over ground states~n",
+           []),
+    forall(q_(_, KB, k(S, N, A), Q, V),
+           portray_clause(Stream, q(S, N, A, Q, V))).
+
+restore(KB, Terms) :-
+    params(KB, _),
+    maplist(check_term, Terms),
+    retractall(q_(_, KB, _, _, _)),
+    forall(member(q(S, N, A, Q, V), Terms),
+           ( Key = k(S, N, A), term_hash(Key, H), assertz(q_(H, KB, Key, Q, V)) )).
+
+check_term(T) :-
+    (   T = q(S, N, A, Q, V), ground(S), is_list(S), ground(N-A), number(Q), integer(V)
+    ->  true
+    ;   domain_error(qtable_entry, T)
+    ).
+
+% ---- the engine's hooks (see engine.pl) ----------------------------------------------------
+
+relrl_engine:learner(qtable).
+
+relrl_engine:learner_property(qtable, view(relational)).
+
+relrl_engine:learner_init(qtable, KB, Params) :-
+    init(KB, Params).
+
+relrl_engine:learner_state(qtable, KB, _Code, Facts) :-
+    engine_relational_state(KB, Facts).
+
+relrl_engine:learner_choose(qtable, KB, S, N, Allowed, Mode, Action) :-
+    choose(KB, S, N, Allowed, Mode, Action).
+
+relrl_engine:learner_update(qtable, KB, Transition) :-
+    update(KB, Transition).
+
+relrl_engine:learner_explain(qtable, KB, S, N, ranked(Pairs)) :-
+    findall(Q-A, q_(_, KB, k(S, N, A), Q, _), Pairs0),
+    sort(1, @>=, Pairs0, Pairs).
+
+relrl_engine:learner_size(qtable, KB, Size) :-
+    qtable_size(KB, Size).
+
+relrl_engine:learner_save(qtable, KB, Stream) :-
+    save(KB, Stream).
+
+relrl_engine:learner_policy_term(qtable, q(_, _, _, _, _)).
+
+relrl_engine:learner_restore(qtable, KB, Terms) :-
+    restore(KB, Terms).
+
+relrl_engine:learner_policy_info(qtable, KB, [relations(Templates)]) :-
+    findall(T, declared(KB, relation(T)), Templates).

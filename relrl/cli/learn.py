@@ -1,0 +1,204 @@
+"""``relrl learn WORLD.pl``: learn a task of a world written in Prolog, evaluate it on other
+sizes with no further learning."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from relrl.outdir import add_out_options
+
+#: the files and folders ``relrl learn --out DIR`` writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "curve.csv", "policy.pl", "traces.jsonl", "replay/")
+
+HELP = "learn a task of a world written in Prolog (blocks world ...) and evaluate the policy"
+EXAMPLE = ("relrl learn examples/worlds/blocks.pl --learner tg --task stack --episodes 500\n"
+           "  relrl learn examples/worlds/blocks.pl --task on --size 4 --eval-sizes 6,8 "
+           "--out runs/blocks-on")
+
+
+def _sizes(text: str, option: str) -> list[int]:
+    from relrl.errors import ConfigError
+
+    try:
+        sizes = [int(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise ConfigError(f"{option} must be comma-separated whole numbers, not "
+                          f"{text!r}") from None
+    if not sizes or any(s < 1 for s in sizes):
+        raise ConfigError(f"{option} must be whole numbers >= 1, not {text!r}")
+    return sizes
+
+
+def _param(text: str) -> tuple[str, float]:
+    try:
+        key, value = text.split("=", 1)
+        return key.strip(), float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"bad --param {text!r}: use NAME=NUMBER, e.g. gamma=1") from None
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Declare the options of ``relrl learn``."""
+    from relrl.worlds import WORLD_LEARNERS
+
+    parser.add_argument("world", metavar="WORLD.pl", help="the world file (docs/worlds.md)")
+    parser.add_argument("--learner", default="tg",
+                        help=f"{' or '.join(WORLD_LEARNERS)}: tg (relational, the default) or "
+                             "qtable (Q-learning over ground states, the baseline)")
+    parser.add_argument("--task", default=None,
+                        help="a task of the world: its name (stack, on) or an instance "
+                             "(on(b1, b2)); default: the first the world declares")
+    parser.add_argument("--size", type=int, default=None,
+                        help="learn on worlds of this size only")
+    parser.add_argument("--sizes", default=None, metavar="N,N,...",
+                        help="learn on these sizes, one drawn per episode (default: the "
+                             "world's sizes(train, ...), else 3)")
+    parser.add_argument("--eval-sizes", default=None, metavar="N,N,...",
+                        help="evaluate on these sizes with no further learning (default: "
+                             "the world's sizes(test, ...))")
+    parser.add_argument("--episodes", type=int, default=500,
+                        help="learning episodes (500; 0 with --policy: evaluate it only)")
+    parser.add_argument("--block", type=int, default=None,
+                        help="learning episodes between evaluations (default episodes/10)")
+    parser.add_argument("--eval-episodes", type=int, default=100,
+                        help="greedy episodes per evaluation and per evaluation size (100)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    parser.add_argument("--param", type=_param, action="append", default=[],
+                        metavar="NAME=X", help="learner parameter (repeatable)")
+    parser.add_argument("--updates", choices=["episode", "online"], default="episode",
+                        help="episode: an episode's examples are learned when it ends, last "
+                             "first (RRL's, default); online: each step's at once")
+    parser.add_argument("--policy", default=None, metavar="FILE",
+                        help="start from this saved policy (read as data)")
+    parser.add_argument("--traces", type=int, default=3,
+                        help="with --out: greedy episodes of each evaluation size kept "
+                             "step by step in traces.jsonl and replay/ (relrl replay "
+                             "DIR/replay shows the world's states) (3)")
+    parser.add_argument("--no-speed", action="store_true",
+                        help="skip the step-cost and crossing measurements")
+    add_out_options(parser, default=None,
+                    what="output folder: results.json, curve.csv, policy.pl, traces.jsonl")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check the world and the options, learn, print the curve and the evaluation."""
+    from relrl.errors import ConfigError
+    from relrl.outdir import OutDir
+    from relrl.worlds import World, make_world_learner
+    from relrl.worlds.learn import LearnConfig, learn_task
+
+    path = Path(args.world)
+    if not path.is_file():
+        raise ConfigError(f"{args.world}: no such world file")
+    make_world_learner(args.learner, **dict(args.param))          # validate before loading
+    with World(path) as world:
+        problems = world.problems()
+        if problems:
+            raise ConfigError("\n".join([*problems, f"{len(problems)} problem"
+                                         f"{'s' if len(problems) != 1 else ''} in the world "
+                                         f"(relrl check --world {args.world})"]))
+        task_text = args.task or world.task_names()[0].split("(")[0]
+        world.task(task_text)                                     # validate now
+        train = ([args.size] if args.size is not None else
+                 _sizes(args.sizes, "--sizes") if args.sizes else world.train_sizes)
+        if args.size is not None and args.size < 1:
+            raise ConfigError(f"--size must be at least 1, not {args.size}")
+        test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes
+                else world.test_sizes)
+    if args.size is not None and args.sizes:
+        raise ConfigError("give --size or --sizes, not both")
+    if args.episodes < 0 or (args.episodes == 0 and not args.policy):
+        raise ConfigError(f"--episodes must be at least 1 (0 only with --policy), not "
+                          f"{args.episodes}")
+    if args.eval_episodes < 1:
+        raise ConfigError(f"--eval-episodes must be at least 1, not {args.eval_episodes}")
+    block = args.block if args.block is not None else max(1, args.episodes // 10)
+    if block < 1:
+        raise ConfigError(f"--block must be at least 1, not {block}")
+    params = dict(args.param)
+    if args.policy and not Path(args.policy).is_file():
+        raise ConfigError(f"--policy {args.policy}: no such file")
+    config = LearnConfig(world=str(path.resolve()), task=task_text, learner=args.learner,
+                         params=params, train_sizes=train, test_sizes=test,
+                         episodes=args.episodes, block=block,
+                         eval_episodes=args.eval_episodes, seed=args.seed,
+                         updates=args.updates, speed=not args.no_speed)
+
+    def show(event: dict) -> None:
+        e = event["entry"]
+        print(f"episodes {e['episodes']:6d}  steps {e['learning_steps']:7d}  of optimal "
+              f"{e['optimality']:.3f}  reached {e['success']:.3f}  positions "
+              f"{e['memory_positions']}", flush=True)
+
+    print(f"{args.learner} learns {task_text} on sizes {','.join(map(str, train))} "
+          f"({args.episodes} episodes, seed {args.seed}); greedy evaluation of "
+          f"{args.eval_episodes} episodes:")
+    if args.out is None:
+        result = learn_task(config, report=show, policy_in=args.policy)
+        _summary(result, result["timing"])
+        return 0
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      outputs=OUTPUTS) as out:
+        result = learn_task(config, report=show, policy_in=args.policy,
+                            policy_out=out.path / "policy.pl", traces=args.traces)
+        timing = result["timing"]
+        files = _write(out.path, config, result)
+        out.status = "complete"
+    _summary(result, timing)
+    print(f"\nwrote {len(files)} files to {out.path}/: "
+          f"{', '.join(str(f.relative_to(out.path)) for f in files)}")
+    if (out.path / "replay").is_dir():
+        print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
+    return 0
+
+
+def _summary(result: dict, t: dict) -> None:
+    print("evaluation, no further learning:")
+    for size, s in result["test"].items():
+        print(f"  size {size:>3}: of optimal {s['optimality']:.3f}, reached {s['success']:.3f}, "
+              f"steps {s['steps']:.2f} (optimal {s['optimal_steps']:.2f})")
+    if t.get("learning_steps_per_second"):
+        print(f"learning: {t['learning_steps_per_second']:,.0f} steps/s (a batch of episodes "
+              f"per crossing)")
+    cost = t.get("step_cost_by_size")
+    if cost:
+        print("learning-step cost by size (us/step, ratio to the smallest; sizes' ratio): "
+              + ", ".join(f"{s}: {cost['us_per_step'][s]:.0f} ({cost['cost_ratio'][s]:.2f}; "
+                          f"{cost['size_ratio'][s]:.2f})" for s in cost["us_per_step"]
+                          if cost["us_per_step"][s] is not None))
+
+
+def _write(out: Path, config, result: dict) -> list[Path]:
+    import csv
+    import io
+
+    from relrl.outdir import write_atomic, write_json_atomic
+
+    traces = result.pop("traces", {})
+    graph = result.pop("graph", None)
+    timing = result.pop("timing")
+    files = [write_json_atomic(out / "results.json",
+                               {"command": "learn", "config": config.to_dict(), **result}),
+             write_json_atomic(out / "timing.json", timing)]
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    keys = ["point", "episodes", "learning_steps", "optimality", "success", "exactly_optimal",
+            "steps", "optimal_steps", "memory_positions"]
+    w.writerow(keys)
+    for c in result["curve"]:
+        w.writerow([c[k] for k in keys])
+    files.append(write_atomic(out / "curve.csv", buf.getvalue()))
+    files.append(out / "policy.pl")
+    if traces:
+        from relrl.worlds.replay import write_replay
+
+        lines = [json.dumps({"size": int(size), **ep}) for size, eps in traces.items()
+                 for ep in eps]
+        files.append(write_atomic(out / "traces.jsonl", "\n".join(lines) + "\n"))
+        files += write_replay(out / "replay", traces, learner=config.learner,
+                              world=Path(config.world).name, task=config.task,
+                              seed=config.seed, graph=graph)
+    return files

@@ -1,0 +1,332 @@
+"""``relrl experiment worlds``: learners x tasks x seeds in worlds written in Prolog.
+
+Each job is one :func:`relrl.worlds.learn.learn_task` run (one world file, task, learner,
+seed): a learning curve on the training sizes, an evaluation with no further learning on
+each test size, memory, steps/s and the step cost by size. Jobs run in worker processes or
+on Ray (:mod:`relrl.experiments.runner`), one Prolog engine each. Besides the jobs, the
+world's stated optimum (optimal_steps/3) is checked against a breadth-first search on random
+start states of the small sizes, and the check is written with the results.
+
+Files: ``results.json`` (every number and the configuration; ``"partial": true`` when
+stopped early), ``timing.json`` (wall clock, steps/s, step cost by size), ``summary.csv``
+(per world, task and learner: the mean over seeds), ``curves.csv``, ``test.csv``,
+``step_cost.csv``, ``optimal_check.csv``, ``curves.png``, ``transfer.png``,
+``step_cost.png`` and ``policies/`` (every job's learned policy, readable Prolog that loads
+into a world of any size: ``relrl learn WORLD --policy FILE``).
+"""
+
+from __future__ import annotations
+
+import platform
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from relrl.experiments.report import pyplot_or_note, save_figure, skip_plots, write_csv
+from relrl.experiments.runner import raise_kept, run_jobs
+from relrl.machine import machine_info
+from relrl.outdir import write_atomic, write_json_atomic
+from relrl.worlds.learn import LearnConfig, learn_task
+
+__all__ = ["OUTPUTS", "WorldsConfig", "run_worlds", "run_worlds_job", "worlds_table"]
+
+#: the files and folders the experiment writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "summary.csv", "curves.csv", "test.csv",
+           "step_cost.csv", "optimal_check.csv", "curves.png", "transfer.png",
+           "step_cost.png", "PLOTS.txt", "policies/")
+
+
+@dataclass
+class WorldsConfig:
+    """Everything that determines a worlds run (written into results.json)."""
+
+    worlds: list[str] = field(default_factory=list)           #: world files
+    tasks: list[str] = field(default_factory=lambda: ["stack", "unstack", "on"])
+    learners: list[str] = field(default_factory=lambda: ["tg", "qtable"])
+    seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
+    learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
+    train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
+    test_sizes: list[int] = field(default_factory=lambda: [6, 8, 10])
+    episodes: int = 1000
+    block: int = 100
+    eval_episodes: int = 100
+    updates: str = "episode"
+    verify_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
+    verify_states: int = 30
+
+    def jobs(self) -> list[tuple[str, str, str, int]]:
+        """Every (world, task, learner, seed) job."""
+        return [(w, t, lr, s) for w in self.worlds for t in self.tasks for lr in self.learners
+                for s in self.seeds]
+
+    def learn_config(self, world: str, task: str, learner: str, seed: int) -> LearnConfig:
+        """The :class:`LearnConfig` of one job."""
+        return LearnConfig(world=world, task=task, learner=learner,
+                           params=dict(self.learner_params.get(learner, {})),
+                           train_sizes=list(self.train_sizes),
+                           test_sizes=list(self.test_sizes), episodes=self.episodes,
+                           block=self.block, eval_episodes=self.eval_episodes, seed=seed,
+                           updates=self.updates)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form (world files by name: the folder is the machine's)."""
+        out = asdict(self)
+        out["worlds"] = [Path(w).name for w in self.worlds]
+        return out
+
+
+def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, seed: int, *,
+                   report: Any = None) -> dict[str, Any]:
+    """One job: :func:`learn_task` of (world, task, learner, seed); the learned policy comes
+    back as text (``policy``), for the run folder's ``policies/``."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(prefix="relrl-worlds-") as tmp:
+        path = Path(tmp) / "policy.pl"
+        result = learn_task(config.learn_config(world, task, learner, seed), report=report,
+                            policy_out=path)
+        result["policy"] = path.read_text(encoding="utf-8")
+    return result
+
+
+def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = None
+               ) -> dict[str, Any]:
+    """The world's optimal_steps/3 against a breadth-first search (seeded, per size)."""
+    from relrl.worlds.world import World, make_world_learner
+
+    rows = []
+    with World(world) as w:
+        if not w.optimal_known:
+            return {"world": Path(world).name, "task": task, "rows": [], "stated": False}
+        w.attach(make_world_learner("qtable"), 0)
+        for size in config.verify_sizes:
+            pairs = w.verify_optimal(task, size, config.verify_states)
+            searched = [p for p in pairs if p[1] is not None]
+            rows.append({"size": size, "states": len(pairs), "searched": len(searched),
+                         "agree": sum(1 for a, b in searched if a == b)})
+    return {"world": Path(world).name, "task": task, "rows": rows, "stated": True}
+
+
+def _label(args: tuple) -> str:
+    if len(args) == 3:
+        return f"check {Path(args[1]).stem} {args[2]}"
+    _, world, task, learner, seed = args
+    return f"{Path(world).stem} {task} {learner} seed {seed}"
+
+
+def _job(*args: Any, report: Any = None) -> dict[str, Any]:
+    if len(args) == 3:
+        return verify_job(*args, report=report)
+    return run_worlds_job(*args, report=report)
+
+
+def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
+               engine: str = "local", address: str | None = None
+               ) -> tuple[dict[str, Any], list[Path]]:
+    """Run every job and write the outputs to ``out_dir``; stopped by a signal or a failing
+    job, it writes what finished (``"partial": true``)."""
+    from relrl import __version__
+
+    out = Path(out_dir)
+    checks = [(config, w, t) for w in config.worlds for t in config.tasks]
+    tasks = checks + [(config, *job) for job in config.jobs()]
+    outcome = run_jobs(_job, tasks, workers=workers, engine=engine, address=address,
+                       units=config.episodes // config.block + 1, label=_label)
+    jobs, timings, verified = [], [], []
+    policies: dict[str, str] = {}
+    for task, result in zip(tasks, outcome.results, strict=True):
+        if result is None:
+            continue
+        if len(task) == 3:
+            verified.append(result)
+            continue
+        timings.append({"world": result["world"], "task": result["task"],
+                        "learner": result["learner"], "seed": result["seed"],
+                        **result.pop("timing")})
+        policies[_policy_name(result)] = result.pop("policy")
+        jobs.append(result)
+    results = {"experiment": "worlds", "relrl_version": __version__,
+               "config": config.to_dict(), "seeds": config.seeds,
+               "partial": not outcome.complete, "summary": summarize(jobs, config),
+               "optimal_check": verified, "jobs": jobs}
+    if outcome.interrupted:
+        results["interrupted_by"] = outcome.interrupted
+    if outcome.error:
+        results["error"] = outcome.error
+    timing = {"wall_seconds": outcome.seconds, "workers": workers, "engine": engine,
+              "python": platform.python_version(), "machine_info": machine_info(),
+              "jobs": timings}
+    files = write_outputs(out, results, timing)
+    files += [write_atomic(out / "policies" / name, text) for name, text in policies.items()]
+    if outcome.error:
+        raise_kept(outcome.error, out)
+    return results, files
+
+
+def _policy_name(job: dict[str, Any]) -> str:
+    """``policies/WORLD-TASK-LEARNER-sSEED.pl`` (the task's name without arguments)."""
+    task = job["task"].split("(")[0]
+    return f"{Path(job['world']).stem}-{task}-{job['learner']}-s{job['seed']}.pl"
+
+
+def _mean(xs: list[float | None]) -> float | None:
+    vals = [x for x in xs if x is not None]
+    return sum(vals) / len(vals) if vals else None
+
+
+def summarize(jobs: list[dict[str, Any]], config: WorldsConfig) -> list[dict[str, Any]]:
+    """Per (world, task, learner): means over seeds of the final training-size evaluation,
+    of each test size, of memory; and the worst seed's final optimality."""
+    rows = []
+    keys = sorted({(j["world"], j["task"], j["learner"]) for j in jobs})
+    for world, task, learner in keys:
+        js = [j for j in jobs if (j["world"], j["task"], j["learner"]) == (world, task,
+                                                                           learner)]
+        row = {"world": world, "task": task, "learner": learner, "seeds": len(js),
+               "train_optimality": _mean([j["final"]["optimality"] for j in js]),
+               "train_optimality_min": min(j["final"]["optimality"] for j in js),
+               "train_success": _mean([j["final"]["success"] for j in js]),
+               "memory_positions": _mean([j["memory"]["positions"] for j in js]),
+               "episodes_to_095": _mean([_first(j["curve"], 0.95) for j in js]),
+               "test": {}}
+        for size in config.test_sizes:
+            vals = [j["test"][str(size)] for j in js if str(size) in j["test"]]
+            row["test"][str(size)] = {
+                "optimality": _mean([v["optimality"] for v in vals]),
+                "optimality_min": min((v["optimality"] for v in vals), default=None),
+                "success": _mean([v["success"] for v in vals])}
+        rows.append(row)
+    return rows
+
+
+def _first(curve: list[dict[str, Any]], level: float) -> int | None:
+    """Learning episodes at the first evaluation at or above ``level`` (None: never)."""
+    return next((c["episodes"] for c in curve if (c["optimality"] or 0) >= level), None)
+
+
+def _csv(path: Path, header: list[str], rows: list[list[Any]]) -> Path:
+    return write_csv(path, header, [["" if v is None else (f"{v:.6g}" if isinstance(v, float)
+                                                          else v) for v in row]
+                                    for row in rows])
+
+
+def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
+    """results.json, timing.json, the CSVs and the plots; returns the files written."""
+    sizes = results["config"]["test_sizes"]
+    files = [write_json_atomic(out / "results.json", results),
+             write_json_atomic(out / "timing.json", timing)]
+    files.append(_csv(out / "summary.csv",
+                      ["world", "task", "learner", "seeds", "train_optimality",
+                       "train_optimality_min", "train_success", "episodes_to_095",
+                       "memory_positions", *(f"test_{s}_optimality" for s in sizes)],
+                      [[r["world"], r["task"], r["learner"], r["seeds"],
+                        r["train_optimality"], r["train_optimality_min"], r["train_success"],
+                        r["episodes_to_095"], r["memory_positions"],
+                        *(r["test"][str(s)]["optimality"] for s in sizes)]
+                       for r in results["summary"]]))
+    files.append(_csv(out / "curves.csv",
+                      ["world", "task", "learner", "seed", "point", "episodes",
+                       "learning_steps", "optimality", "success", "memory_positions"],
+                      [[j["world"], j["task"], j["learner"], j["seed"], c["point"],
+                        c["episodes"], c["learning_steps"], c["optimality"], c["success"],
+                        c["memory_positions"]] for j in results["jobs"] for c in j["curve"]]))
+    files.append(_csv(out / "test.csv",
+                      ["world", "task", "learner", "seed", "size", "optimality", "success",
+                       "steps", "optimal_steps"],
+                      [[j["world"], j["task"], j["learner"], j["seed"], int(s),
+                        v["optimality"], v["success"], v["steps"], v["optimal_steps"]]
+                       for j in results["jobs"] for s, v in j["test"].items()]))
+    files.append(_csv(out / "step_cost.csv",
+                      ["world", "task", "learner", "seed", "size", "us_per_step",
+                       "cost_ratio", "size_ratio", "learning_steps_per_second"],
+                      [[t["world"], t["task"], t["learner"], t["seed"], int(s),
+                        t["step_cost_by_size"]["us_per_step"][s],
+                        t["step_cost_by_size"]["cost_ratio"][s],
+                        t["step_cost_by_size"]["size_ratio"][s],
+                        t["learning_steps_per_second"]]
+                       for t in timing["jobs"] if "step_cost_by_size" in t
+                       for s in t["step_cost_by_size"]["us_per_step"]]))
+    files.append(_csv(out / "optimal_check.csv",
+                      ["world", "task", "size", "states", "searched", "agree"],
+                      [[v["world"], v["task"], r["size"], r["states"], r["searched"],
+                        r["agree"]] for v in results["optimal_check"] for r in v["rows"]]))
+    files += plot(out, results, timing) if not results.get("partial") else skip_plots(out)
+    return files
+
+
+def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
+    """Learning curves, transfer and step cost as PNG files (a note without matplotlib)."""
+    plt, note = pyplot_or_note(out)
+    if plt is None:
+        return note
+    files = []
+    groups = sorted({(j["world"], j["task"]) for j in results["jobs"]})
+    fig, axes = plt.subplots(1, max(1, len(groups)), figsize=(4 * max(1, len(groups)), 3.2),
+                             squeeze=False)
+    for ax, (world, task) in zip(axes[0], groups, strict=False):
+        for learner in results["config"]["learners"]:
+            js = [j for j in results["jobs"] if (j["world"], j["task"], j["learner"]) ==
+                  (world, task, learner)]
+            if not js:
+                continue
+            xs = [c["episodes"] for c in js[0]["curve"]]
+            ys = [_mean([j["curve"][i]["optimality"] for j in js if i < len(j["curve"])])
+                  for i in range(len(xs))]
+            ax.plot(xs, ys, marker=".", label=learner)
+        ax.set_title(f"{Path(world).stem}: {task}", fontsize=9)
+        ax.set_xlabel("learning episodes")
+        ax.set_ylim(0, 1.05)
+        ax.axhline(0.95, color="grey", lw=0.5, ls="--")
+    axes[0][0].set_ylabel("greedy: fraction of optimal")
+    axes[0][0].legend(fontsize=8)
+    fig.tight_layout()
+    files.append(save_figure(fig, out / "curves.png", dpi=120))
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    sizes = results["config"]["test_sizes"]
+    for r in results["summary"]:
+        ax.plot(sizes, [r["test"][str(s)]["optimality"] for s in sizes], marker="o",
+                label=f"{Path(r['world']).stem} {r['task']} {r['learner']}")
+    ax.set_xlabel("blocks (objects), no further learning")
+    ax.set_ylabel("fraction of optimal")
+    ax.set_ylim(0, 1.05)
+    ax.axhline(0.9, color="grey", lw=0.5, ls="--")
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    files.append(save_figure(fig, out / "transfer.png", dpi=120))
+    fig, ax = plt.subplots(figsize=(5, 3.2))
+    for t in timing["jobs"]:
+        cost = t.get("step_cost_by_size")
+        if cost and t["seed"] == results["seeds"][0]:
+            xs = cost["sizes"]
+            ax.plot(xs, [cost["cost_ratio"][str(s)] for s in xs], marker=".",
+                    label=f"{Path(t['world']).stem} {t['task']} {t['learner']}")
+    if timing["jobs"]:
+        xs = results["config"]["train_sizes"][:1] + results["config"]["test_sizes"]
+        ax.plot(xs, [s / xs[0] for s in xs], color="black", ls="--", label="linear")
+    ax.set_xlabel("objects")
+    ax.set_ylabel("learning-step cost / smallest size's")
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    files.append(save_figure(fig, out / "step_cost.png", dpi=120))
+    return files
+
+
+def worlds_table(results: dict[str, Any]) -> str:
+    """The summary as a Markdown table (what ``relrl report``'s worlds view renders)."""
+    sizes = results["config"]["test_sizes"]
+    train = results["config"]["train_sizes"]
+    head = (f"| world | task | learner | seeds | of optimal, sizes {min(train)}–{max(train)} "
+            "(worst seed) | " + " | ".join(f"size {s}" for s in sizes)
+            + " | episodes to 0.95 | positions |")
+    lines = [head, "|" + "---|" * (8 + len(sizes) - 1)]
+    for r in results["summary"]:
+        lines.append(
+            f"| {Path(r['world']).stem} | {r['task']} | {r['learner']} | {r['seeds']} | "
+            f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
+            + " | ".join(_f(r["test"][str(s)]["optimality"]) for s in sizes)
+            + f" | {_f(r['episodes_to_095'], 0)} | {_f(r['memory_positions'], 0)} |")
+    return "\n".join(lines)
+
+
+def _f(x: float | None, digits: int = 3) -> str:
+    return "—" if x is None else f"{x:.{digits}f}"

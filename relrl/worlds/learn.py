@@ -1,0 +1,184 @@
+"""Learning a task of a world: a learning curve, evaluation on other sizes, memory, speed.
+
+:func:`learn_task` is the one procedure behind ``relrl learn`` and every job of ``relrl
+experiment worlds``: a learner learns ``episodes`` episodes of a task on the training sizes,
+in blocks of ``block`` episodes; after each block the greedy policy (no learning, no
+exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the end
+on each test size — where the policy acts with no further learning. Every evaluation
+episode's optimal number of steps comes from the world (optimal_steps/3, else a
+breadth-first search), so a score is a fraction of optimal: optimal / steps per episode, 0
+for an episode that missed the goal within the step bound (RRL's "percentage of optimal").
+
+Speed is measured inside the job: learning steps per second (wall clock of the learning
+batches, each one crossing into Prolog), the cost of a learning step at each size (blocks
+of learning episodes at each size from the same saved policy, sizes alternating, so the
+sizes see the same machine load), and one episode per crossing against a batch per
+crossing (the shape: how much the crossings cost).
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from relrl.worlds.world import World, score
+
+__all__ = ["LearnConfig", "learn_task", "step_cost_by_size"]
+
+
+@dataclass
+class LearnConfig:
+    """What one learning run is: the world, task, learner, sizes, budget and seed."""
+
+    world: str                              #: the world file
+    task: str = "stack"                     #: a task of the world (its name or an instance)
+    learner: str = "tg"
+    params: dict[str, float] = field(default_factory=dict)
+    train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
+    test_sizes: list[int] = field(default_factory=lambda: [6, 8, 10])
+    episodes: int = 1000                    #: learning episodes
+    block: int = 100                        #: learning episodes between evaluations
+    eval_episodes: int = 100                #: greedy episodes per evaluation (per test size)
+    seed: int = 0
+    updates: str = "episode"                #: episode (RRL's) or online
+    speed: bool = True                      #: measure the step cost by size and the shape
+    cost_sizes: list[int] = field(default_factory=list)   #: default: train + test sizes
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready form."""
+        return asdict(self)
+
+
+def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] | None = None,
+               policy_out: str | Path | None = None, policy_in: str | Path | None = None,
+               traces: int = 0) -> dict[str, Any]:
+    """Learn ``config.task`` and evaluate it; returns a JSON-ready dict.
+
+    Args:
+        config: the run.
+        report: called with ``{"kind": "point", "entry": ...}`` after each evaluation.
+        policy_out: save the learned policy there (readable Prolog).
+        policy_in: start from this saved policy instead of from nothing.
+        traces: keep this many greedy episodes of each test size with every step's state
+            (for replay).
+
+    The result holds ``curve`` (one entry per evaluation), ``test`` (per test size),
+    ``memory``, ``timing`` (wall-clock figures; the caller keeps them out of results.json)
+    and, with ``traces``, ``traces``.
+    """
+    with World(config.world) as world:
+        task = world.task(config.task)
+        learner = world.learner(config.learner, **config.params)
+        world.attach(learner, config.seed, task)
+        if policy_in is not None:
+            world.load_policy(policy_in)
+        curve: list[dict[str, Any]] = []
+        learn_seconds, learn_steps, done = 0.0, 0, 0
+
+        def evaluate() -> None:
+            ev = score(world.episodes(task, config.train_sizes, config.eval_episodes,
+                                      "greedy", optimal=True))
+            positions, details = world.size()
+            entry = {"point": len(curve), **ev, "eval_episodes": ev["episodes"],
+                     "episodes": done, "learning_steps": learn_steps,
+                     "memory_positions": positions}
+            curve.append(entry)
+            if report is not None:
+                report({"kind": "point", "entry": entry})
+
+        evaluate()
+        while done < config.episodes:
+            n = min(config.block, config.episodes - done)
+            t0 = time.perf_counter()
+            eps = world.episodes(task, config.train_sizes, n, "learn", updates=config.updates)
+            learn_seconds += time.perf_counter() - t0
+            learn_steps += sum(e.steps for e in eps)
+            done += n
+            evaluate()
+        positions, details = world.size()
+        test: dict[str, Any] = {}
+        kept: dict[str, list[dict[str, Any]]] = {}
+        for size in config.test_sizes:
+            eps = world.episodes(task, [size], config.eval_episodes, "greedy", optimal=True,
+                                 trace=traces > 0)
+            test[str(size)] = score(eps)
+            if traces:
+                kept[str(size)] = [{"goal": e.goal, "steps": e.steps, "optimal": e.optimal,
+                                    "reached": e.reached, "trace": list(e.trace)}
+                                   for e in eps[:traces]]
+        with tempfile.TemporaryDirectory(prefix="relrl-world-") as tmp:
+            saved = Path(tmp) / "policy.pl"
+            world.save_policy(saved, f"relrl policy: {config.learner} learner, world "
+                                     f"{Path(config.world).name}, task {config.task}")
+            if policy_out is not None:
+                from relrl.outdir import write_atomic
+
+                write_atomic(policy_out, saved.read_text(encoding="utf-8"))
+            timing: dict[str, Any] = {
+                "learning_seconds": learn_seconds, "learning_steps": learn_steps,
+                "learning_steps_per_second": learn_steps / learn_seconds
+                if learn_seconds else None}
+            if config.speed:
+                sizes = config.cost_sizes or sorted({*config.train_sizes, *config.test_sizes})
+                timing["step_cost_by_size"] = step_cost_by_size(world, task, saved, sizes)
+                timing["shape"] = _shape(world, task, saved, config.train_sizes)
+        out = {"world": Path(config.world).name, "task": config.task,
+               "learner": config.learner, "seed": config.seed, "curve": curve, "test": test,
+               "final": curve[-1], "memory": {**details, "positions": positions},
+               "timing": timing}
+        if traces:
+            out["traces"] = kept
+            out["graph"] = world.engine.graph()
+        return out
+
+
+def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int], *,
+                      episodes: int = 20, rounds: int = 3) -> dict[str, Any]:
+    """Wall-clock microseconds per learning step at each size, from the same saved policy.
+
+    For each of ``rounds`` rounds, each size in turn: load ``policy`` (not timed), learn
+    ``episodes`` episodes at that size in one crossing (timed). Sizes alternate within a
+    round, so a change of machine load touches every size alike. Returns per size the
+    median over rounds of microseconds per step, and the ratio of each size's cost to the
+    smallest size's beside the ratio of the sizes (linear growth: the two equal).
+    """
+    per: dict[int, list[float]] = {s: [] for s in sizes}
+    for _ in range(rounds):
+        for size in sizes:
+            world.load_policy(policy)
+            t0 = time.perf_counter()
+            eps = world.episodes(task, [size], episodes, "learn")
+            dt = time.perf_counter() - t0
+            steps = sum(e.steps for e in eps)
+            if steps:
+                per[size].append(1e6 * dt / steps)
+    world.load_policy(policy)
+    med = {s: sorted(v)[len(v) // 2] if v else None for s, v in per.items()}
+    base = sizes[0]
+    return {"sizes": list(sizes), "us_per_step": {str(s): med[s] for s in sizes},
+            "cost_ratio": {str(s): (med[s] / med[base]) if med[s] and med[base] else None
+                           for s in sizes},
+            "size_ratio": {str(s): s / base for s in sizes}}
+
+
+def _shape(world: World, task: Any, policy: Path, sizes: Sequence[int], *,
+           episodes: int = 40, rounds: int = 3) -> dict[str, Any]:
+    """Greedy episodes one per crossing against all in one crossing (alternating rounds):
+    microseconds per step each way and the batch's speed-up."""
+    single, batch = [], []
+    world.load_policy(policy)
+    for _ in range(rounds):
+        t0 = time.perf_counter()
+        steps = sum(e.steps for _ in range(episodes)
+                    for e in world.episodes(task, sizes, 1, "greedy"))
+        single.append(1e6 * (time.perf_counter() - t0) / max(1, steps))
+        t0 = time.perf_counter()
+        steps = sum(e.steps for e in world.episodes(task, sizes, episodes, "greedy"))
+        batch.append(1e6 * (time.perf_counter() - t0) / max(1, steps))
+    s, b = sorted(single)[rounds // 2], sorted(batch)[rounds // 2]
+    return {"us_per_step_one_episode_per_call": s, "us_per_step_batch": b,
+            "batch_speedup": s / b if b else None, "episodes_per_batch": episodes}

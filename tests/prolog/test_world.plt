@@ -1,0 +1,232 @@
+/*  plunit tests of worlds written in Prolog: blocks world's dynamics on hand-made states,
+    its stated optimum against the search, the checker on wrong world files, and the episode
+    runner with a learner. Run from pytest (tests/prolog/test_plunit.py) or:
+        swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_world.plt
+*/
+:- use_module(library(plunit)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module('../../prolog/relrl').
+:- use_module('../../prolog/gateway').
+:- use_module('../../prolog/world').
+:- use_module('../../prolog/world_check').
+
+root_file(Relative, Path) :-
+    module_property(relrl, file(RelrlFile)),
+    file_directory_name(RelrlFile, Dir),
+    atomic_list_concat([Dir, '/../', Relative], Path).
+
+world_kb(Relative, KB) :-
+    relrl_gateway:gw_new_kb(KB),
+    root_file(Relative, Path),
+    relrl_gateway:gw_load(Path, KB, Problems),
+    assertion(Problems == []).
+
+%   A world file written from lines, loaded into a fresh knowledge base.
+text_kb(Lines, KB, Path) :-
+    tmp_file_stream(text, Path, S),
+    forall(member(L, Lines), format(S, "~w~n", [L])),
+    close(S),
+    relrl_gateway:gw_new_kb(KB),
+    relrl_gateway:gw_load(Path, KB, _).
+
+blocks(KB) :-
+    world_kb('examples/worlds/blocks.pl', KB).
+
+%   Towers bottom first: [[b1, b2], [b3]] is b2 on b1 on the floor, b3 on the floor.
+towers(Towers, State) :-
+    foldl(tower, Towers, [], Facts),
+    sort(Facts, State).
+
+tower(Tower, F0, F) :-
+    tower_(Tower, floor, F0, F).
+
+tower_([], Under, F0, [clear(Under)|F0]) :-
+    Under \== floor.
+tower_([B|Bs], Under, F0, F) :-
+    tower_(Bs, B, [on(B, Under)|F0], F).
+
+:- begin_tests(blocks_dynamics).
+
+test(legal_moves, [Moves == [move(b2, b3), move(b2, floor), move(b3, b2)]]) :-
+    blocks(KB),
+    towers([[b1, b2], [b3]], S),
+    world_legal(KB, S, Moves0),
+    msort(Moves0, Moves).
+
+test(move_onto_block, [S == Expected]) :-
+    blocks(KB),
+    towers([[b1, b2], [b3]], S0),
+    world_next(KB, stack, S0, move(b3, b2), S, outcome(R, Reached)),
+    towers([[b1, b2, b3]], Expected),
+    assertion(R == 1),
+    assertion(Reached == true).
+
+test(move_to_floor_clears_the_block_below, [S == Expected]) :-
+    blocks(KB),
+    towers([[b1, b2, b3]], S0),
+    world_next(KB, unstack, S0, move(b3, floor), S, outcome(0, false)),
+    towers([[b1, b2], [b3]], Expected).
+
+test(goals) :-
+    blocks(KB),
+    towers([[b1, b2, b3]], Tower),
+    towers([[b1], [b2], [b3]], Floor),
+    assertion(KB:goal(stack, Tower)),
+    assertion(\+ KB:goal(stack, Floor)),
+    assertion(KB:goal(unstack, Floor)),
+    assertion(KB:goal(on(b2, b1), Tower)),
+    assertion(\+ KB:goal(on(b1, b2), Tower)).
+
+test(view_tells_the_goal_and_the_tops, [View == Expected]) :-
+    blocks(KB),
+    towers([[b1, b2], [b3]], S),
+    world_view(KB, on(b3, b1), S, View),
+    Expected = [clear(b2), clear(b3), highest(b2), covers(b2, b1), goal_on(b3, b1),
+                on(b1, floor), on(b2, b1), on(b3, floor)].
+
+test(optimal_on_a_below_b, [N == 4]) :-
+    % b1 (B) under x under b3 (A) under y: y away, A away, x away, A onto B
+    blocks(KB),
+    towers([[b1, b2, b3, b4]], S),
+    KB:optimal_steps(on(b3, b1), S, N).
+
+test(optimal_matches_search) :-
+    blocks(KB),
+    set_random(seed(3)),
+    forall(( member(Task, [stack, unstack, on(_, _)]), member(Size, [3, 4, 5]),
+             between(1, 5, _) ),
+           ( world_start(KB, Task, Size, S, Goal),
+             KB:optimal_steps(Goal, S, N),
+             world_bfs(KB, Goal, S, 100000, M),
+             assertion(N == M) )).
+
+test(start_states_are_not_goals) :-
+    blocks(KB),
+    set_random(seed(1)),
+    forall(between(1, 20, _),
+           ( world_start(KB, on(_, _), 3, S, Goal),
+             assertion(\+ KB:goal(Goal, S)) )).
+
+:- end_tests(blocks_dynamics).
+
+:- begin_tests(world_check).
+
+test(shipped_worlds_are_valid) :-
+    forall(member(F, ['examples/worlds/blocks.pl', 'examples/worlds/blocks_moves.pl',
+                      'examples/worlds/delivery.pl']),
+           ( world_kb(F, KB),
+             world_problems(KB, Ps),
+             assertion(Ps == []) )).
+
+test(missing_goal, [Msg == "the world defines no goal/2 (a world needs initial_state/2, task/1, action/1, precondition/2, effect/4 and goal/2; see docs/worlds.md)"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], [])."],
+            KB, _),
+    world_problems(KB, [problem('', 0, Msg)]).
+
+test(unbound_action, [Line-Msg == 4-"precondition/2 left the action go(_) unbound (it must bind every argument of the template)"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(_), _).", "effect(go(_), _, [], []).", "goal(t, _) :- fail."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]).
+
+test(effect_not_a_list, [Line == 5]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, none, [])."
+             , "goal(t, _) :- fail."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, _)]).
+
+test(undeclared_relation, [Msg == "the learner's view holds q(a), but no relation/1 declares q/1 (add relation(q/1).)"]) :-
+    text_kb(["initial_state(_, [p(a), q(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, _) :- fail.", "relation(p(_))."],
+            KB, _),
+    world_problems(KB, [problem(_, 7, Msg)]).
+
+test(wrong_optimal_steps, [Line == 10]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(inc).",
+             "precondition(inc, _).",
+             "effect(inc, S, [at(X)], [at(Y)]) :- memberchk(at(X), S), Y is X + 1.",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_)).",
+             "discount(1).", "sizes(train, [3]).",
+             "optimal_steps(t, _, 2)."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, _)]).
+
+test(task_rmode_of_no_task, [Msg == "task_rmode(fly, p(+x)): no declared task is fly"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, _) :- fail.", "relation(p(_)).", "task_rmode(fly, p(+x))."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
+
+:- end_tests(world_check).
+
+:- begin_tests(world_task_bias).
+
+bias_modes(KB, Task, Modes) :-
+    world_for_task(KB, Task),
+    relrl_tg_bias:tg_bias(KB, bias(Modes, _)).
+
+test(only_stack_sees_highest) :-
+    blocks(KB),
+    bias_modes(KB, stack, Stack),
+    bias_modes(KB, unstack, Unstack),
+    bias_modes(KB, on(b1, b2), On),
+    assertion(memberchk(highest(+block), Stack)),
+    assertion(\+ memberchk(highest(+block), Unstack)),
+    assertion(\+ memberchk(highest(+block), On)),
+    subtract(Stack, [highest(+block)], Rest),
+    assertion(Rest == Unstack).
+
+:- end_tests(world_task_bias).
+
+:- begin_tests(world_episodes).
+
+params(P) :-
+    P = [alpha=0.2, gamma=1, epsilon=0.05, temperature=1, q_init=0, significance=0.001,
+         min_examples=5, stale_bonus=0, half_life=1000, novelty_bonus=1,
+         novelty_confidence=2, keep_examples=32, reward_positive=10, reward_negative= -1].
+
+test(terminal_target_is_the_reward, [Q =:= 0]) :-
+    % one leaf; a goal-reaching example with reward 0 moves Q (from q_init 0) towards 0
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    params(P),
+    relrl_engine:engine_configure(KB, tg, P, 0),
+    towers([[b1, b2], [b3]], S),
+    world_view(KB, stack, S, V),
+    relrl_engine:learner_update(tg, KB, transition(V, move(b3, b2), none, 0, true, terminal,
+                                                   none, [])),
+    relrl_tg:tg_q(KB, V, move(b3, b2), none, Q).
+
+test(same_seed_same_episodes, [A == B]) :-
+    % two knowledge bases in one process, stepped in turn: the same numbers as each alone
+    world_kb('examples/worlds/blocks_moves.pl', KB1),
+    world_kb('examples/worlds/blocks_moves.pl', KB2),
+    params(P),
+    relrl_engine:engine_configure(KB1, tg, P, 7),
+    relrl_engine:engine_configure(KB2, tg, P, 7),
+    once(world_episodes(KB1, episodes(stack, [3, 4], 20, learn, []), A)),
+    once(world_episodes(KB2, episodes(stack, [3, 4], 20, learn, []), B)).
+
+test(qtable_learns_a_fixed_start) :-
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    relrl_engine:engine_configure(KB, qtable, [alpha=0.5, gamma=1, epsilon=0.1,
+                                               temperature=0, q_init=0], 1),
+    world_episodes(KB, episodes(unstack, [3], 300, learn, []), _),
+    world_episodes(KB, episodes(unstack, [3], 30, greedy, [optimal(1000)]), Eps),
+    forall(member(ep(_, _, Steps, _, true, Opt, _), Eps), assertion(Steps == Opt)).
+
+test(trace_ends_with_the_last_state) :-
+    world_kb('examples/worlds/blocks.pl', KB),
+    params(P),
+    relrl_engine:engine_configure(KB, tg, P, 2),
+    world_episodes(KB, episodes(unstack, [3], 1, greedy, [trace(true)]), [Ep]),
+    Ep = ep(_, _, Steps, _, _, _, Trace),
+    length(Trace, L),
+    assertion(L =:= Steps + 1),
+    last(Trace, end(_)).
+
+:- end_tests(world_episodes).

@@ -1,0 +1,147 @@
+"""Worlds written in Prolog from Python: learning, evaluation, the command line."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from relrl.cli import main
+from relrl.errors import ConfigError
+from relrl.worlds import World, score
+
+ROOT = Path(__file__).resolve().parents[2]
+BLOCKS = ROOT / "examples" / "worlds" / "blocks.pl"
+
+
+def test_tg_learns_3_block_stack_to_optimal() -> None:
+    """The issue's short test: tg learns stack on 3 blocks (reward 1 at the goal) to the
+    optimal number of moves in every greedy episode."""
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=0)
+        before = score(world.episodes("stack", [3], 50, "greedy", optimal=True))
+        world.episodes("stack", [3], 150, "learn")
+        after = score(world.episodes("stack", [3], 50, "greedy", optimal=True))
+    assert before["optimality"] < 0.9          # the untrained policy is not optimal
+    assert after["optimality"] == 1.0
+    assert after["exactly_optimal"] == 1.0
+
+
+def test_same_seed_same_episodes() -> None:
+    def run() -> list:
+        with World(BLOCKS) as world:
+            world.attach(world.learner("tg"), seed=3)
+            return world.episodes("on", [3, 4], 30, "learn")
+
+    assert run() == run()
+
+
+def test_task_names_and_instances() -> None:
+    with World(BLOCKS) as world:
+        assert world.task_names() == ["stack", "unstack", "on(_, _)"]
+        assert world.task("on(b1, b2)") == ("on", "b1", "b2")
+        with pytest.raises(ConfigError, match="no such task"):
+            world.task("fly")
+
+
+def test_learn_evaluates_a_saved_policy_on_larger_worlds(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "run"
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "150",
+                 "--eval-sizes", "4", "--eval-episodes", "5", "--no-speed", "--out",
+                 str(out)]) == 0
+    capsys.readouterr()
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--episodes", "0", "--policy",
+                 str(out / "policy.pl"), "--eval-sizes", "7", "--eval-episodes", "10",
+                 "--no-speed"]) == 0
+    assert "size   7: of optimal" in capsys.readouterr().out
+
+
+def test_policy_saved_and_loaded_acts_the_same(tmp_path: Path) -> None:
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=1)
+        world.episodes("unstack", [3, 4], 100, "learn")
+        world.save_policy(tmp_path / "p.pl", "test")
+        world.engine.reseed(5)
+        a = world.episodes("unstack", [6], 10, "greedy")
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=9)
+        world.load_policy(tmp_path / "p.pl")
+        world.engine.reseed(5)
+        b = world.episodes("unstack", [6], 10, "greedy")
+    assert a == b
+
+
+def test_check_world_file_line_and_exit_2(tmp_path: Path, capsys) -> None:
+    bad = tmp_path / "bad.pl"
+    bad.write_text("initial_state(_, [p(a)]).\ntask(t).\naction(go(_)).\n"
+                   "precondition(go(X), S) :- member(p(X), S).\neffect(go(_), _, [], []).\n"
+                   "goal(t, S) :- nowhere(S).\n")
+    assert main(["check", "--world", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:6: goal/2 calls undefined predicate nowhere/1" in err
+    assert main(["check", "--world", str(BLOCKS)]) == 0
+    assert "ok:" in capsys.readouterr().out
+
+
+def test_check_world_syntax_error(tmp_path: Path, capsys) -> None:
+    bad = tmp_path / "bad.pl"
+    bad.write_text("task(t).\naction(go(_).\n")
+    assert main(["check", "--world", str(bad)]) == 2
+    assert f"{bad}:2:" in capsys.readouterr().err
+
+
+def test_learn_command_writes_its_folder(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "40",
+                 "--eval-sizes", "4", "--eval-episodes", "5", "--no-speed", "--traces", "1",
+                 "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    assert results["config"]["task"] == "stack" and results["test"]["4"]["episodes"] == 5
+    assert (out / "policy.pl").read_text().count("relrl_policy(tg") == 1
+    trace = json.loads((out / "traces.jsonl").read_text().splitlines()[0])
+    assert trace["trace"][-1]["action"] is None       # the last state, after the last move
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--task", "fly"], "no such task"),
+    (["--episodes", "0"], "--episodes must be at least 1 (0 only with --policy)"),
+    (["--sizes", "3,x"], "--sizes must be comma-separated"),
+    (["--learner", "qtable", "--param", "alpha=2"], "alpha must be in [0, 1]"),
+])
+def test_learn_bad_flags_exit_2(argv: list[str], message: str, capsys) -> None:
+    assert main(["learn", str(BLOCKS), *argv]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_experiment_worlds_and_report(tmp_path: Path) -> None:
+    from relrl.report import load_run, render
+
+    out = tmp_path / "exp"
+    assert main(["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack",
+                 "--learners", "tg,qtable", "--seeds", "0", "--episodes", "20", "--block",
+                 "10", "--eval-episodes", "5", "--sizes", "3", "--test-sizes", "4",
+                 "--workers", "1", "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    assert {r["learner"] for r in results["summary"]} == {"tg", "qtable"}
+    assert results["optimal_check"][0]["rows"][0]["agree"] == \
+        results["optimal_check"][0]["rows"][0]["searched"] > 0
+    for name in ("summary.csv", "curves.csv", "test.csv", "step_cost.csv", "curves.png",
+                 "policies/blocks-stack-tg-s0.pl", "policies/blocks-stack-qtable-s0.pl"):
+        assert (out / name).is_file(), name
+    text = render(load_run(out), "summary")
+    assert "| blocks | stack | tg | 1 |" in text
+
+
+def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
+    """The output folder's policy.pl is a link to a file elsewhere: refused before learning
+    (exit 2, one line), and the file it points to is left as it was."""
+    out, victim = tmp_path / "run", tmp_path / "victim.txt"
+    out.mkdir()
+    victim.write_text("keep me")
+    (out / "policy.pl").symlink_to(victim)
+    assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "5",
+                 "--eval-sizes", "3", "--eval-episodes", "2", "--no-speed", "--out", str(out),
+                 "--overwrite"]) == 2
+    assert "link" in capsys.readouterr().err
+    assert victim.read_text() == "keep me"
