@@ -21,14 +21,15 @@ from typing import Any
 
 from relrl.engine import Engine, call, one
 from relrl.errors import ConfigError, PrologError
-from relrl.kb import KnowledgeBase, _display_path
+from relrl.bridge.calls import display_path as _display_path
+from relrl.kb import KnowledgeBase
 from relrl.terms import Term, Var, format_term
 
 __all__ = ["Episode", "World", "WORLD_DEFAULTS", "WORLD_LEARNERS", "make_world_learner",
            "score"]
 
 #: The learners of worlds: those whose Prolog learner reads the relational view.
-WORLD_LEARNERS = ("tg", "qtable")
+WORLD_LEARNERS = ("tg", "ptg", "qtable")
 
 #: Learner parameters for worlds, where they differ from the learners' own defaults (those
 #: were chosen on the simulator's rewards, 10 and -1, and its one-step reward delays): a
@@ -37,6 +38,7 @@ WORLD_LEARNERS = ("tg", "qtable")
 #: states, and the goal tasks were learned as well without it) and so is the staleness bonus.
 WORLD_DEFAULTS: dict[str, dict[str, float]] = {
     "tg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
+    "ptg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
     "qtable": {},
 }
 
@@ -50,6 +52,7 @@ def make_world_learner(name: str, **params: float) -> Any:
         ConfigError: an unknown learner or parameter.
     """
     from relrl.learners import make_learner
+    from relrl.learners.ptg import PTGLearner
     from relrl.learners.qtable import QTableLearner
 
     if name not in WORLD_LEARNERS:
@@ -58,6 +61,8 @@ def make_world_learner(name: str, **params: float) -> Any:
     merged = {**WORLD_DEFAULTS.get(name, {}), **params}
     if name == "qtable":
         return QTableLearner(**merged)
+    if name == "ptg":
+        return PTGLearner(**merged)
     return make_learner(name, **merged)
 
 
