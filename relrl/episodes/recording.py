@@ -43,7 +43,8 @@ __all__ = ["RECORDING", "SessionTap", "write_manifest"]
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")
-#: seconds between checks of whether the learner's tree changed.
+#: seconds between checks of whether the learner's tree changed (and at once when a step's
+#: leaf is not in the tree last sent: the tree has split).
 TREE_PERIOD = 1.0
 #: the recording's file in the session folder.
 RECORDING = "session.mcap"
@@ -62,6 +63,16 @@ class _Rate:
     def took(self) -> None:
         if self.rate > 0:
             self._next = time.perf_counter() + 1.0 / self.rate
+
+
+def _leaf_of(view: Any) -> str | None:
+    """The id of the leaf a step's response came from (tg: the chosen response's own
+    leaf), as the graph names it; ``None`` when the explanation names none."""
+    exp = view.explanation or {}
+    for entry in exp.get("ranked") or ():
+        if entry.get("response") == view.response and entry.get("leaf") is not None:
+            return str(entry["leaf"])
+    return None if exp.get("leaf") is None else str(exp["leaf"])
 
 
 def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
@@ -134,6 +145,8 @@ class SessionTap:
                     self.recorder.attach(name, "text/plain", (out / name).read_bytes())
         self._tree_key: Any = None
         self._tree_graph: dict[str, Any] | None = None
+        self._tree_ids: set[str] = set()
+        self._tree_missed: str | None = None
         self._tree_next = 0.0
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
@@ -214,7 +227,11 @@ class SessionTap:
             self.recorder.unit(time.time_ns(), line.encode(),
                                encode_jpeg(framed, self.quality) if framed is not None
                                else None)
-        self._tree(run.t)
+        leaf = _leaf_of(view)
+        split = leaf is not None and leaf not in self._tree_ids and leaf != self._tree_missed
+        self._tree(run.t, force=split)
+        if split and leaf not in self._tree_ids:
+            self._tree_missed = leaf  # the learner's ids are not its graph's: asked once
         return row
 
     def _tree(self, t: int, force: bool = False) -> None:
@@ -228,6 +245,7 @@ class SessionTap:
 
         graph = shown_graph(self.run.learner, self._tree_graph)
         self._tree_graph = graph
+        self._tree_ids = {str(n["id"]) for n in (graph or {}).get("nodes") or ()}
         key = json.dumps(graph, sort_keys=True)
         if key == self._tree_key:
             return
