@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from relrl.episodes.provenance import provenance
+from relrl.monitor.tap import TreeWatch, leaf_of
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
 
 __all__ = ["RECORDING", "SessionTap", "write_manifest"]
@@ -63,16 +64,6 @@ class _Rate:
     def took(self) -> None:
         if self.rate > 0:
             self._next = time.perf_counter() + 1.0 / self.rate
-
-
-def _leaf_of(view: Any) -> str | None:
-    """The id of the leaf a step's response came from (tg: the chosen response's own
-    leaf), as the graph names it; ``None`` when the explanation names none."""
-    exp = view.explanation or {}
-    for entry in exp.get("ranked") or ():
-        if entry.get("response") == view.response and entry.get("leaf") is not None:
-            return str(entry["leaf"])
-    return None if exp.get("leaf") is None else str(exp["leaf"])
 
 
 def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
@@ -143,11 +134,7 @@ class SessionTap:
             for name in ("episode.toml", "domain.pl"):
                 if (out / name).is_file():
                     self.recorder.attach(name, "text/plain", (out / name).read_bytes())
-        self._tree_key: Any = None
-        self._tree_graph: dict[str, Any] | None = None
-        self._tree_ids: set[str] = set()
-        self._tree_missed: str | None = None
-        self._tree_next = 0.0
+        self.tree = TreeWatch(run.learner, TREE_PERIOD)
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
         from relrl.terms import format_term
@@ -227,33 +214,18 @@ class SessionTap:
             self.recorder.unit(time.time_ns(), line.encode(),
                                encode_jpeg(framed, self.quality) if framed is not None
                                else None)
-        leaf = _leaf_of(view)
-        split = leaf is not None and leaf not in self._tree_ids and leaf != self._tree_missed
-        self._tree(run.t, force=split)
-        if split and leaf not in self._tree_ids:
-            self._tree_missed = leaf  # the learner's ids are not its graph's: asked once
+        self._tree(run.t, leaf_of(view.explanation, view.response))
         return row
 
-    def _tree(self, t: int, force: bool = False) -> None:
-        if self.hub is None and self.recorder is None:
+    def _tree(self, t: int, leaf: str | None = None, force: bool = False) -> None:
+        """The learner's tree to the monitor and the recording when it changed."""
+        if (self.hub is None and self.recorder is None) or \
+                not self.tree.changed(leaf, force=force):
             return
-        now = time.perf_counter()
-        if not force and now < self._tree_next:
-            return
-        self._tree_next = now + TREE_PERIOD
-        from relrl.monitor.graph import shown_graph
-
-        graph = shown_graph(self.run.learner, self._tree_graph)
-        self._tree_graph = graph
-        self._tree_ids = {str(n["id"]) for n in (graph or {}).get("nodes") or ()}
-        key = json.dumps(graph, sort_keys=True)
-        if key == self._tree_key:
-            return
-        self._tree_key = key
         if self.hub is not None:
-            self.hub.set_tree(graph)
+            self.hub.set_tree(self.tree.graph)
         if self.recorder is not None:
-            self.recorder.tree(t, graph)
+            self.recorder.tree(t, self.tree.graph)
 
     def event(self, kind: str, **data: Any) -> None:
         """A session event (evaluation, naming execution) for the monitor and the recording."""
