@@ -41,6 +41,7 @@ from typing import Any, NoReturn
 
 from head.errors import CalibrationError, UnknownDirection, UnknownResponse, UnknownServo
 from head.scripts import MotorScript, normalise_response, parse_scripts
+from head.tomlfile import MAX_NESTING, read_limited, too_deep
 from perception.vocabulary import PLACES
 
 __all__ = [
@@ -261,18 +262,25 @@ def _parse_directions(raw: Any, servos: dict[str, Servo], fail) -> dict[str, dic
 
 
 def _read_toml(path: Path) -> dict[str, Any]:
+    """The TOML at ``path``: a regular file of at most :data:`head.tomlfile.MAX_BYTES`,
+    arrays and inline tables nested at most :data:`head.tomlfile.MAX_NESTING` deep."""
     try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh)
+        text = read_limited(path).decode("utf-8")
     except FileNotFoundError:
         raise CalibrationError(f"{path}: no such calibration file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CalibrationError(f"{path}: not valid TOML: {exc}") from None
     except UnicodeDecodeError as exc:
         raise CalibrationError(f"{path}: not a calibration file: byte {exc.start} is not UTF-8 "
                                "text (a binary file?)") from None
     except OSError as exc:
-        raise CalibrationError(f"{path}: cannot read: {exc.strerror}") from None
+        raise CalibrationError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    line = too_deep(text)
+    if line is not None:
+        raise CalibrationError(f"{path}:{line}: arrays or inline tables nested more than "
+                               f"{MAX_NESTING} deep")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CalibrationError(f"{path}: not valid TOML: {exc}") from None
 
 
 def load_calibration(path: str | Path | None = None) -> Calibration:
@@ -317,7 +325,10 @@ def load_calibration(path: str | Path | None = None) -> Calibration:
         if not isinstance(scripts_file, str):
             fail("head.scripts", f"{scripts_file!r} must be a file name")
         spath = path.parent / scripts_file
-        sdata = _read_toml(spath)
+        try:
+            sdata = _read_toml(spath)
+        except CalibrationError as exc:
+            fail("head.scripts", str(exc))
         sfail = _failer(spath)
         if set(sdata) - {"scripts"}:
             sfail(min(set(sdata) - {"scripts"}), "a scripts file holds only [scripts]")

@@ -2,6 +2,7 @@
           [ contingency_init/1,     % +KB
             contingency_choose/6,   % +KB, +Code, +N, +Allowed, +Params, -Action
             contingency_update/6,   % +KB, +Code0, +A0, +N0, +Reinforced, +Params
+            contingency_probabilities/6, % +KB, +Code, +N, +Allowed, +Params, -Pairs
             contingency_rules/2,    % +KB, -Rules
             contingency_restore/2,  % +KB, +Rules
             contingency_explain/4,  % +KB, +Code, +N, -Explanation
@@ -15,6 +16,7 @@
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(rules).
+:- use_module(policy, [policy_refuse/3, policy_number/3]).
 
 /** <module> Contingency learning
 
@@ -22,20 +24,24 @@ Section 4.1 of da Silva & Romero (2012). Behaviour rules are three-term continge
 an antecedent (the state), a response, and a consequence (the necessity the response
 satisfies), with a fitness. A response is chosen by roulette-wheel selection over the
 responses allowed now: a response's slice is the summed fitness of the rules that match the
-state and the active necessity, or the default fitness when no rule matches.
+state and the active necessity, or the default fitness when no rule matches (with
+`default_always` 1: the default fitness plus the rules' fitness, every response keeping
+its default slice).
 
-After the response, its rules learn from the consequence: when the reinforcer came and the
-rule's necessity is the active one (the rule satisfied the active necessity) its fitness
-rises by the influence rate; otherwise (it satisfied no necessity, or one that was not
-active) it falls by the influence rate. Fitness stays within [min_fitness, max_fitness].
-If no rule matched the emitted response, a new rule (state(Code), Response, Necessity) is
-stored with the default fitness moved by the same rule.
+After the response, its rules learn from the consequence perceived in the next time unit
+(consequence_delta/4): when the reinforcer came (the rule satisfied the active necessity)
+the fitness rises by the influence rate; when it did not, it falls by `extinction` times the
+rate; with `satiation` 1, a reinforcer that came when no necessity was active (the rule
+satisfied an inactive necessity) lowers it. Fitness stays within [min_fitness,
+max_fitness]. If no rule matched the emitted response, a new rule (state(Code), Response,
+Necessity) is stored with the default fitness moved the same way.
 
 Authored rules come from the domain (behaviour/4, with any goal as antecedent) and are
 copied here when the learner starts, so their fitness can learn too. Learned rules have the
 antecedent state(Code), true when the current state code is Code.
 
-Params: default_fitness, influence, min_fitness, max_fitness.
+Params: default_fitness, influence, min_fitness, max_fitness, default_always, extinction,
+satiation (all numbers; the readings of the paper behind each are in docs/engine.md).
 */
 
 :- dynamic
@@ -65,21 +71,42 @@ contingency_init(KB) :-
 
 contingency_choose(KB, Code, N, Allowed, Params, Action) :-
     Allowed \== [],
-    param(Params, default_fitness, Default),
-    maplist(slice(KB, Code, N, Default), Allowed, Slices),
-    sum_list_of(Slices, Total),
+    slices(KB, Code, N, Allowed, Params, Slices, Total),
     random(X0),
     X is X0 * Total,
     pick(Slices, X, slice(Action, _, Matches)),
     retractall(matched_(KB, _)),
     assertz(matched_(KB, Matches)).
 
-slice(KB, Code, N, Default, R, slice(R, F, Matches)) :-
+%!  contingency_probabilities(+KB, +Code, +N, +Allowed, +Params, -Pairs) is det.
+%
+%   Pairs is Response-Probability for each response of Allowed: the probability that
+%   contingency_choose/6 picks it in the state Code under necessity N (its slice of the
+%   wheel over the whole wheel).
+
+contingency_probabilities(KB, Code, N, Allowed, Params, Pairs) :-
+    must_be(list, Allowed),
+    slices(KB, Code, N, Allowed, Params, Slices, Total),
+    findall(R-P, ( member(slice(R, F, _), Slices), P is F / Total ), Pairs).
+
+slices(KB, Code, N, Allowed, Params, Slices, Total) :-
+    param(Params, default_fitness, Default),
+    param(Params, default_always, Always),
+    maplist(slice(KB, Code, N, Default, Always), Allowed, Slices),
+    sum_list_of(Slices, Total).
+
+%   A response's slice: its matching rules' fitness, or the default without one; with
+%   default_always the default stays in every slice and the rules' fitness is added to it.
+slice(KB, Code, N, Default, Always, R, slice(R, F, Matches)) :-
     findall(M-Fm, matching_rule(KB, Code, N, R, M, Fm), Pairs),
-    (   Pairs == []
-    ->  F = Default, Matches = []
-    ;   pairs_keys_values(Pairs, Matches, Fs),
-        sum_list(Fs, F)
+    pairs_keys_values(Pairs, Matches, Fs),
+    sum_list(Fs, F0),
+    (   Always =:= 0
+    ->  (   Pairs == []
+        ->  F = Default
+        ;   F = F0
+        )
+    ;   F is Default + F0
     ).
 
 matching_rule(KB, Code, N, R, learned(Code, N, R), F) :-
@@ -106,35 +133,57 @@ pick([S|Ss], X, Pick) :-
 
 %!  contingency_update(+KB, +Code0, +A0, +N0, +Reinforced, +Params) is det.
 %
-%   Learn from the consequence of emitting A0 in state Code0 under necessity N0.
-%   Reinforced is true when a reinforcer was perceived after the response.
+%   Learn from the consequence of emitting A0 in state Code0 under necessity N0 (`none`
+%   when no necessity was active). Reinforced is true when a reinforcer was perceived in
+%   the next time unit. The rules the choice used move by consequence_delta/4; without one,
+%   a new rule (state(Code0), A0, N0) is stored, its fitness the default moved by the same
+%   amount (with default_always, where the default stays in the slice apart, the amount
+%   alone, within the bounds).
 
 contingency_update(KB, Code0, A0, N0, Reinforced, Params) :-
-    param(Params, influence, Rate),
-    param(Params, default_fitness, Default),
-    (   Reinforced == true
-    ->  Delta = Rate
-    ;   Delta is -Rate
-    ),
+    consequence_delta(Params, N0, Reinforced, Delta),
     (   retract(matched_(KB, Matches)), Matches \== []
-    ->  forall(member(M, Matches), adjust(KB, M, N0, Delta, Rate, Params))
-    ;   clamp(Params, Default + Delta, F),
+    ->  forall(member(M, Matches), adjust(KB, M, Delta, Params))
+    ;   param(Params, default_fitness, Default),
+        param(Params, default_always, Always),
+        (   Always =:= 0
+        ->  Base = Default
+        ;   Base = 0
+        ),
+        clamp(Params, Base + Delta, F),
         assertz(learned_(KB, Code0, N0, A0, F))
     ).
 
-adjust(KB, learned(Code, N, R), _, Delta, _, Params) :-
+%!  consequence_delta(+Params, +N0, +Reinforced, -Delta) is det.
+%
+%   How much the consequence of a response moves its rules' fitness. A reinforcer raises
+%   them by the influence rate (the rule satisfied the active necessity); with `satiation`
+%   1, a reinforcer that came when no necessity was active (N0 = none) lowers them instead
+%   (the rule satisfied an inactive necessity). No reinforcer lowers them by `extinction`
+%   times the influence rate (1: by the rate; 0: a response with no consequence leaves its
+%   rules as they are).
+
+consequence_delta(Params, N0, Reinforced, Delta) :-
+    param(Params, influence, Rate),
+    (   Reinforced == true
+    ->  param(Params, satiation, Satiation),
+        (   N0 == none, Satiation =\= 0
+        ->  Delta is -Rate
+        ;   Delta = Rate
+        )
+    ;   param(Params, extinction, Extinction),
+        Delta is -Rate * Extinction
+    ).
+
+adjust(KB, learned(Code, N, R), Delta, Params) :-
     (   retract(learned_(KB, Code, N, R, F0))
     ->  clamp(Params, F0 + Delta, F),
         assertz(learned_(KB, Code, N, R, F))
     ;   true
     ).
-adjust(KB, authored(Id), Active, Delta, Rate, Params) :-
+adjust(KB, authored(Id), Delta, Params) :-
     (   retract(authored_(KB, Id, A, R, N-F0))
-    ->  (   N == Active
-        ->  D = Delta
-        ;   D is -Rate
-        ),
-        clamp(Params, F0 + D, F),
+    ->  clamp(Params, F0 + Delta, F),
         assertz(authored_(KB, Id, A, R, N-F))
     ;   true
     ).
@@ -227,27 +276,63 @@ relrl_engine:learner_save(contingency, KB, S) :-
 
 relrl_engine:learner_policy_term(contingency, learned_behaviour(_, _, _, _)).
 
-%   Rebuild the rules from policy terms read as data. A learned rule's antecedent is
-%   state(Code); any other antecedent must be one the domain itself authored (a policy file
-%   never brings a goal of its own to run).
+%   Rebuild the rules from policy terms read as data, checked as a whole before anything
+%   changes. A learned rule's antecedent is state(Code), Code a state of the domain's
+%   features; any other antecedent must be one the domain itself authored (a policy file
+%   never brings a goal of its own to run). Responses and necessities (or none) are the
+%   domain's, a fitness is a finite number >= 0, and no rule is given twice.
 relrl_engine:learner_restore(contingency, KB, Terms) :-
-    findall(behaviour(A, R, N, F), member(learned_behaviour(A, R, N, F), Terms), Rules),
-    maplist(check_rule(KB), Rules),
+    engine_config(KB, features, Features),
+    length(Features, NF),
+    engine_config(KB, responses, Responses),
+    engine_config(KB, necessities, Necessities),
+    include(is_rule_term, Terms, RuleTerms),       % the terms read, not copies
+    maplist(check_rule(KB, NF, Responses, [none|Necessities]), RuleTerms),
+    include(is_learned_rule, RuleTerms, Learned),
+    map_list_to_pairs(rule_key, Learned, Keyed),
+    msort(Keyed, Sorted),
+    (   append(_, [K-_, K-Twice|_], Sorted)
+    ->  policy_refuse(Twice, "this learned rule is given twice (its fitness would count \c
+                             twice)", [])
+    ;   true
+    ),
+    findall(behaviour(A, R, N, F), member(learned_behaviour(A, R, N, F), RuleTerms), Rules),
     contingency_restore(KB, Rules).
 
-check_rule(KB, behaviour(A, R, N, F)) :-
+is_rule_term(learned_behaviour(_, _, _, _)).
+
+is_learned_rule(learned_behaviour(state(_), _, _, _)).
+
+rule_key(learned_behaviour(A, R, N, _), rule(A, R, N)).
+
+check_rule(KB, NF, Responses, Necessities, T) :-
+    T = learned_behaviour(A, R, N, F),
     (   A = state(Code)
-    ->  must_be(nonneg, Code)
+    ->  (   integer(Code), Code >= 0, Code < 1 << NF
+        ->  true
+        ;   policy_refuse(T, "~q is not a state of this domain (its ~d features give codes \c
+                              0 to 2^~d - 1)", [A, NF, NF])
+        )
     ;   behaviour_rule(KB, A0, R0, N0, _), A0 =@= A, R0 =@= R, N0 =@= N
     ->  true
-    ;   domain_error(authored_behaviour_rule, behaviour(A, R, N))
+    ;   policy_refuse(T, "~q is neither state(Code) nor the antecedent of one of the \c
+                          domain's behaviour rules for ~q (a policy brings no goal of its \c
+                          own)", [A, R])
     ),
-    (   kb_response(KB, R0), R0 =@= R
+    (   member(R1, Responses), R1 =@= R
     ->  true
-    ;   domain_error(response, R)
+    ;   policy_refuse(T, "~q is not a response of this domain", [R])
     ),
-    must_be(atom, N),
-    must_be(number, F).
+    (   member(N1, Necessities), N1 == N
+    ->  true
+    ;   policy_refuse(T, "~q is not a necessity of this domain (nor none)", [N])
+    ),
+    policy_number(T, "the fitness", F),
+    (   F >= 0
+    ->  true
+    ;   policy_refuse(T, "the fitness ~q is negative (a fitness is a slice of the \c
+                          roulette wheel, >= 0)", [F])
+    ).
 
 relrl_engine:learner_snapshot(contingency, KB, matched(Matches)) :-
     (   matched_(KB, Matches0)

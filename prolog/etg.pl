@@ -14,6 +14,7 @@
 :- use_module(declarations).
 :- use_module(rules).
 :- use_module(gvar).
+:- use_module(policy, [policy_refuse/3, policy_number/3]).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Economic TG (ETG)
@@ -324,49 +325,183 @@ relrl_engine:learner_save(etg, KB, S) :-
 relrl_engine:learner_policy_term(etg, etg_tests(_)).
 relrl_engine:learner_policy_term(etg, etg_node(_, _)).
 
-%   Rebuild the tree from policy terms read as data: the tests must be this domain's, and
-%   every node well formed (no goal from the file is ever run).
+%   Rebuild the tree from policy terms read as data, checked as a whole before anything
+%   changes (no goal from the file is ever run): the tests must be this domain's; the nodes
+%   must form one tree (below); each leaf's representative a state of these tests that
+%   sorts to it; each entry a response and a necessity (or none) of the domain with a
+%   finite Q. A leaf's entries are put in decreasing Q, as the learner keeps them.
 relrl_engine:learner_restore(etg, KB, Terms) :-
     qtree_tests(KB, Mine),
-    (   memberchk(etg_tests(Tests), Terms)
+    include(is_tests, Terms, TestTerms),          % the terms read, not copies
+    (   TestTerms = [TestTerm]
     ->  true
-    ;   existence_error(policy_term, etg_tests/1)
+    ;   TestTerms = []
+    ->  existence_error(policy_term, etg_tests/1)
+    ;   TestTerms = [_, TestTerm|_],
+        policy_refuse(TestTerm, "etg_tests/1 is given twice", [])
     ),
+    TestTerm = etg_tests(Tests),
     (   Tests =@= Mine
     ->  true
-    ;   domain_error(policy_tests(Mine), Tests)
+    ;   policy_refuse(TestTerm, "the tests are not this domain's (a policy of another \c
+                                 domain?)", [])
     ),
-    findall(Id-Node, member(etg_node(Id, Node), Terms), Nodes),
-    maplist(check_node(Tests), Nodes),
+    include(is_node, Terms, NodeTerms),
+    check_tree(KB, Mine, TestTerm, NodeTerms, Nodes),
     qtree_restore(KB, Tests, Nodes).
 
-check_node(Tests, Id-Node) :-
-    must_be(nonneg, Id),
-    (   Node = test(I, Goal, Yes, No)
-    ->  must_be(nonneg, I),
-        (   nth0(I, Tests, Test), Test =@= Goal
+%   The nodes are a tree: ids 0 .. N-1 for N nodes, each once; every branch nil or the id
+%   of a node; no branch to the root (0); no node with two parents; every node reached from
+%   the root. Reached from the root with one parent each, the nodes hold no cycle. Linear
+%   in the size of the policy: nodes are looked up by id in a term of N arguments.
+check_tree(KB, Tests, TestTerm, NodeTerms, Nodes) :-
+    length(NodeTerms, N),
+    (   N > 0
+    ->  true
+    ;   policy_refuse(TestTerm, "no etg_node/2: a tree has at least its root, node 0", [])
+    ),
+    functor(ById, nodes, N),
+    maplist(place_node(ById, N), NodeTerms),
+    TestsTerm =.. [tests|Tests],
+    length(Tests, NT),
+    engine_config(KB, responses, Responses),
+    engine_config(KB, necessities, Necessities),
+    functor(Parents, parents, N),
+    maplist(check_node(TestsTerm, NT, N, Parents, [none|Necessities], Responses), NodeTerms,
+            Nodes),
+    functor(Seen, seen, N),
+    reach([0-0-0], ById, Seen),
+    (   between(1, N, I), arg(I, Seen, S), var(S)
+    ->  arg(I, ById, Stray),
+        Id is I - 1,
+        policy_refuse(Stray, "node ~d cannot be reached from the root (node 0): the nodes \c
+                              do not form one tree", [Id])
+    ;   true
+    ).
+
+place_node(ById, N, T) :-
+    T = etg_node(Id, _),
+    (   integer(Id), Id >= 0, Id < N
+    ->  I is Id + 1,
+        arg(I, ById, Slot),
+        (   var(Slot)
+        ->  Slot = T
+        ;   policy_refuse(T, "node ~d is defined twice", [Id])
+        )
+    ;   Last is N - 1,
+        policy_refuse(T, "node id ~q is out of range: this policy has ~d nodes, ids 0 to ~d",
+                      [Id, N, Last])
+    ).
+
+check_node(Tests, NT, N, Parents, Necessities, Responses, T, Id-Node) :-
+    T = etg_node(Id, Node0),
+    (   Node0 = test(I, Goal, Yes, No)
+    ->  (   integer(I), I >= 0, I < NT
         ->  true
-        ;   domain_error(etg_test(I), Goal)
+        ;   LastTest is NT - 1,
+            policy_refuse(T, "node ~d tests test ~q, but the domain has tests 0 to ~d",
+                          [Id, I, LastTest])
         ),
-        maplist(check_branch, [Yes, No])
-    ;   Node = leaf(Rep, Entries)
+        I1 is I + 1,
+        arg(I1, Tests, Test),
+        (   Test =@= Goal
+        ->  true
+        ;   policy_refuse(T, "node ~d: test ~d is ~q in this domain, not ~q",
+                          [Id, I, Test, Goal])
+        ),
+        check_branch(T, Id, N, Parents, yes, Yes),
+        check_branch(T, Id, N, Parents, no, No),
+        Node = Node0
+    ;   Node0 = leaf(Rep, Entries0)
     ->  (   Rep == none
         ->  true
-        ;   must_be(nonneg, Rep)
+        ;   integer(Rep), Rep >= 0, Rep < 1 << NT
+        ->  true
+        ;   policy_refuse(T, "leaf ~d: its state ~q is not a state of this domain's ~d tests \c
+                              (none, or 0 to 2^~d - 1)", [Id, Rep, NT, NT])
         ),
-        must_be(list, Entries),
-        maplist(check_entry, Entries)
-    ;   domain_error(etg_node, Node)
+        (   is_list(Entries0)
+        ->  true
+        ;   policy_refuse(T, "leaf ~d: its entries are not a list", [Id])
+        ),
+        maplist(check_entry(T, Id, Necessities, Responses), Entries0),
+        map_list_to_pairs(entry_key, Entries0, Keyed),
+        (   msort(Keyed, Sorted), append(_, [K-_, K-_|_], Sorted)
+        ->  K = A-Nec,
+            policy_refuse(T, "leaf ~d holds two entries for ~q under ~q", [Id, A, Nec])
+        ;   true
+        ),
+        sort(2, @>=, Entries0, Entries),
+        Node = leaf(Rep, Entries)
+    ;   policy_refuse(T, "node ~q is neither test(Index, Test, Yes, No) nor \c
+                          leaf(State, Entries)", [Id])
     ).
 
-check_branch(B) :-
-    (   B == nil
+check_branch(T, Id, N, Parents, Branch, Child) :-
+    (   Child == nil
     ->  true
-    ;   must_be(nonneg, B)
+    ;   integer(Child), Child > 0, Child < N
+    ->  I is Child + 1,
+        arg(I, Parents, Parent),
+        (   var(Parent)
+        ->  Parent = Id
+        ;   policy_refuse(T, "node ~d is reached from node ~d and from node ~d: a node of a \c
+                              tree has one parent", [Child, Parent, Id])
+        )
+    ;   Child == 0
+    ->  policy_refuse(T, "node ~d's ~w-branch leads back to the root (a cycle)", [Id, Branch])
+    ;   policy_refuse(T, "node ~d's ~w-branch leads to node ~q, which this policy does not \c
+                          hold (a dangling branch)", [Id, Branch, Child])
     ).
 
-check_entry(E) :-
-    (   E = e(A, Q, N), callable(A), number(Q), atom(N)
-    ->  true
-    ;   domain_error(etg_entry, E)
+check_entry(T, Id, Necessities, Responses, E) :-
+    (   E = e(A, Q, Nec)
+    ->  (   member(R, Responses), R == A
+        ->  true
+        ;   policy_refuse(T, "leaf ~d: ~q is not a response of this domain", [Id, A])
+        ),
+        (   member(N1, Necessities), N1 == Nec
+        ->  true
+        ;   policy_refuse(T, "leaf ~d: ~q is not a necessity of this domain (nor none)",
+                          [Id, Nec])
+        ),
+        format(string(What), "leaf ~d: the Q of ~q", [Id, A]),
+        policy_number(T, What, Q)
+    ;   policy_refuse(T, "leaf ~d: ~q is not an entry e(Response, Q, Necessity)", [Id, E])
     ).
+
+entry_key(e(A, _, N), A-N).
+
+is_node(etg_node(_, _)).
+
+is_tests(etg_tests(_)).
+
+%   Walk the tree from the root, marking each node reached in Seen: Stack holds Id-Yes-No,
+%   the tests known to hold (Yes) and to fail (No) on the way to node Id, as bit masks. A
+%   leaf's representative must agree with them (a state that reaches the leaf).
+reach([], _, _).
+reach([Id-Yes-No|Stack], ById, Seen) :-
+    I is Id + 1,
+    arg(I, Seen, true),
+    arg(I, ById, T),
+    T = etg_node(_, Node),
+    (   Node = test(Test, _, YesChild, NoChild)
+    ->  Bit is 1 << Test,
+        Yes1 is Yes \/ Bit,
+        No1 is No \/ Bit,
+        push(YesChild, Yes1, No, Stack, Stack1),
+        push(NoChild, Yes, No1, Stack1, Stack2),
+        reach(Stack2, ById, Seen)
+    ;   Node = leaf(Rep, _),
+        (   Rep == none
+        ->  true
+        ;   Rep /\ Yes =:= Yes, Rep /\ No =:= 0
+        ->  true
+        ;   policy_refuse(T, "leaf ~d: its state ~d does not reach it (the tests on the path \c
+                              from the root disagree)", [Id, Rep])
+        ),
+        reach(Stack, ById, Seen)
+    ).
+
+push(nil, _, _, Stack, Stack) :- !.
+push(Id, Yes, No, Stack, [Id-Yes-No|Stack]).

@@ -238,6 +238,7 @@ python_api(relrl_engine:engine_learner/2).
 python_api(relrl_engine:engine_relational_state/2).
 python_api(relrl_policy:policy_learner/2).
 python_api(relrl_policy:policy_load/2).
+python_api(relrl_policy:policy_max_number/1).
 python_api(relrl_memory:wm_insert/2).
 python_api(relrl_memory:wm_elements/2).
 python_api(relrl_memory:wm_clear/1).

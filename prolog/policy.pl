@@ -1,10 +1,14 @@
 :- module(relrl_policy,
           [ policy_learner/2,     % +File, -Learner
-            policy_load/2         % +KB, +File
+            policy_load/2,        % +KB, +File
+            policy_refuse/3,      % +Term, +Format, +Args
+            policy_number/3,      % +Term, +What, +Number
+            policy_max_number/1   % -Max
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(library(occurs)).
 :- use_module(engine).
 
 /** <module> Reading a saved policy as data
@@ -16,10 +20,17 @@ This module reads it term by term with read_term/3 and accepts only
   - first, relrl_policy(Learner, Info), Info listing the features and responses of the
     domain it was learned in (they must be the loaded domain's);
   - then terms the learner declares its own (learner_policy_term/2), which the learner
-    rebuilds its knowledge from (learner_restore/3) after checking them.
+    rebuilds its knowledge from (learner_restore/3) after checking them as a whole.
+
+Every number in the file must be an integer or a finite float (no infinity, NaN or rational
+such as 1r3). A learner checks the rest before it changes anything: node ids in range, a
+tree (one root, one parent per node, no cycle, no stray node), responses and necessities of
+the loaded domain, values finite and at most policy_max_number/1 in magnitude (so that no
+update can overflow). It refuses with policy_refuse/3, naming the term at fault; this
+module finds the term's line.
 
 Anything else — a directive, a clause of another predicate, a syntax error, a policy of
-another learner or another domain — raises
+another learner or another domain, a term a learner refuses — raises
 
     error(relrl_policy_error(File, Line, Message), _)
 
@@ -60,7 +71,71 @@ policy_load(KB, File) :-
     maplist(check_term(File, Learner), Terms),
     pairs_values_(Terms, Values),
     catch(learner_restore_(Learner, KB, Values), error(Formal, _),
-          restore_error(File, Formal)).
+          restore_error(File, Terms, Formal)).
+
+%!  policy_refuse(+Term, +Format, +Args) is det.
+%
+%   A learner's restore hook refuses the policy because of Term, a term read from the
+%   policy file or a part of one: the error names the file and the line of the term that
+%   holds it, with the message Format/Args (~q shows a variable of Args as _ or A, B ...).
+%
+%   @error relrl_policy_refused(Term, Message), always.
+
+policy_refuse(Term, Format, Args) :-
+    copy_term(Args, Shown),                      % variables shown as _, A, B ...
+    numbervars(Shown, 0, _, [singletons(true)]),
+    format(string(Message), Format, Shown),
+    throw(error(relrl_policy_refused(Term, Message), _)).
+
+%!  policy_max_number(-Max) is det.
+%
+%   The largest magnitude a learned value (a Q-value, a fitness, a count) of a policy may
+%   have: far above any value learning reaches, and far enough below the largest float that
+%   no update can overflow.
+
+policy_max_number(1.0e15).
+
+%!  policy_number(+Term, +What, +Number) is det.
+%
+%   Number, the value What of policy term Term, is an integer or a finite float of
+%   magnitude at most policy_max_number/1.
+%
+%   @error relrl_policy_refused(Term, Message) otherwise (see policy_refuse/3).
+
+policy_number(Term, What, X) :-
+    (   in_range(X)
+    ->  true
+    ;   number(X)
+    ->  policy_max_number(Max),
+        shown(X, Shown),
+        policy_refuse(Term, "~w ~w is out of range: a policy's values are finite numbers of \c
+                             magnitude at most ~g", [What, Shown, Max])
+    ;   policy_refuse(Term, "~w ~q is not a number", [What, X])
+    ).
+
+%   A number as text, an integer of more than 20 digits by its length.
+shown(X, Shown) :-
+    (   integer(X),
+        format(string(Digits), "~d", [X]),
+        string_length(Digits, L),
+        L > 20
+    ->  format(string(Shown), "(an integer of ~d digits)", [L])
+    ;   format(string(Shown), "~q", [X])
+    ).
+
+in_range(X) :-
+    policy_max_number(Max),
+    (   integer(X)
+    ->  abs(X) =< integer(Max)
+    ;   finite_float(X),
+        abs(X) =< Max
+    ).
+
+finite_float(X) :-
+    float(X),
+    float_class(X, Class),
+    Class \== nan,
+    Class \== infinite.
 
 learner_restore_(Learner, KB, Values) :-
     (   relrl_engine:learner_restore(Learner, KB, Values)
@@ -68,10 +143,21 @@ learner_restore_(Learner, KB, Values) :-
     ;   existence_error(policy_restore, Learner)
     ).
 
+%   A policy is read whole before it is checked: a file larger than 1/32 of Prolog's stack
+%   limit (16 MB with relrl's 512 MB) is refused before reading, so that no policy can
+%   exhaust the stack (a term takes up to about 12 times its text).
 open_policy(File, S) :-
     (   exists_file(File)
-    ->  open(File, read, S, [encoding(utf8)])
+    ->  true
     ;   policy_error(File, 0, "no such policy file", [])
+    ),
+    size_file(File, Size),
+    current_prolog_flag(stack_limit, Stack),
+    Max is Stack // 32,
+    (   Size =< Max
+    ->  open(File, read, S, [encoding(utf8)])
+    ;   policy_error(File, 0, "~D bytes, larger than a policy relrl reads (at most ~D bytes, \c
+                     1/32 of Prolog's stack limit)", [Size, Max])
     ).
 
 pairs_values_([], []).
@@ -155,6 +241,7 @@ first_difference([X|_], [], X, nothing).
 first_difference([], [], nothing, nothing).
 
 check_term(File, Learner, Line-T) :-
+    check_numbers(File, Line, T),
     (   T = (:- _)
     ->  policy_error(File, Line, "a directive in a policy file is refused (a policy is \c
                      data and never runs anything)", [])
@@ -172,12 +259,68 @@ check_term(File, Learner, Line-T) :-
         )
     ).
 
-restore_error(File, Formal) :-
-    (   memberchk(Formal, [type_error(_, _), domain_error(_, _), existence_error(_, _),
+%   Every number of a policy term is an integer or a finite float: no learner writes
+%   infinities, NaN or rationals (1r3), and none reads them.
+check_numbers(File, Line, T) :-
+    (   bad_number(T, X)
+    ->  (   float(X)
+        ->  policy_error(File, Line, "~q is not a finite number (a policy holds finite \c
+                                     numbers only)", [X])
+        ;   policy_error(File, Line, "~q is a rational number (a policy holds integers and \c
+                                     floats only)", [X])
+        )
+    ;   true
+    ).
+
+%   X is the first number of T that is neither an integer nor a finite float. A walk over
+%   the arguments, the last one a tail call (a list of millions is walked in constant
+%   stack).
+bad_number(T, X) :-
+    (   number(T)
+    ->  \+ integer(T),
+        \+ finite_float(T),
+        X = T
+    ;   compound(T)
+    ->  compound_name_arity(T, _, N),
+        bad_number_arg(1, N, T, X)
+    ).
+
+bad_number_arg(I, N, T, X) :-
+    arg(I, T, A),
+    (   I =:= N
+    ->  bad_number(A, X)
+    ;   bad_number(A, X)
+    ->  true
+    ;   I1 is I + 1,
+        bad_number_arg(I1, N, T, X)
+    ).
+
+%   A learner refused the policy: name the line of the term it refused (for an ISO error,
+%   of the first term holding the culprit; line 0 when none does).
+restore_error(File, Terms, Formal) :-
+    (   Formal = relrl_policy_refused(Culprit, Message)
+    ->  culprit_line(Terms, Culprit, Line),
+        policy_error(File, Line, "~w", [Message])
+    ;   memberchk(Formal, [type_error(_, _), domain_error(_, _), existence_error(_, _),
                            instantiation_error])
-    ->  message_to_codes_(Formal, Text),
-        policy_error(File, 0, "bad policy: ~s", [Text])
+    ->  (   memberchk(Formal, [type_error(_, Culprit), domain_error(_, Culprit)])
+        ->  culprit_line(Terms, Culprit, Line)
+        ;   Line = 0
+        ),
+        message_to_codes_(Formal, Text),
+        policy_error(File, Line, "bad policy: ~s", [Text])
     ;   throw(error(Formal, _))
+    ).
+
+culprit_line(Terms, Culprit, Line) :-
+    (   member(Line0-T, Terms),
+        T =@= Culprit
+    ->  Line = Line0
+    ;   member(Line0-T, Terms),
+        sub_term(S, T),
+        S =@= Culprit
+    ->  Line = Line0
+    ;   Line = 0
     ).
 
 message_to_codes_(Formal, Codes) :-

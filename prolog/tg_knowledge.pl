@@ -15,6 +15,7 @@
 :- use_module(library(occurs)).
 :- use_module(tg_bias).
 :- use_module(tg_tree).
+:- use_module(policy, [policy_refuse/3, policy_number/3]).
 
 /** <module> The TG tree as knowledge a person reads
 
@@ -336,6 +337,11 @@ tg_restore(KB, Terms) :-
     ;   domain_error(tg_tree_unique_ids, Ids)
     ),
     max_list(Ids, MaxId),
+    (   MaxId =< U                                   % ids 1 .. U, as the learner numbers
+    ->  true
+    ;   policy_refuse(tg_tree(Saved), "node id ~d is out of range: the tree has ~d nodes, \c
+                                       ids 1 to ~d", [MaxId, U, U])
+    ),
     Cap is max(16, MaxId),
     tg_empty_leaves(Cap, Leaves),
     foldl(place_leaf(Leaves), Stats, _, _),
@@ -357,6 +363,8 @@ restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) 
     ->  true
     ;   domain_error(tg_tree, leaf(Id, Q, N))
     ),
+    restored_number(leaf(Id, Q, N), "Q", Q),
+    restored_number(leaf(Id, Q, N), "example count", N),
     refinements(Bias, Path, Vars, Cands),
     length(Cands, K),
     tg_new_stats(Q, N, K, 0, L).
@@ -367,6 +375,11 @@ restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN
     ->  true
     ;   domain_error(tg_tree, node(Id, Lits, New))
     ),
+    (   member(Lit, Lits), \+ bias_literal(Bias, Lit)
+    ->  policy_refuse(node(Id, Lits, New, Y, N), "node ~d: ~q is not a literal of the \c
+                      domain's language bias (rmode/1)", [Id, Lit])
+    ;   true
+    ),
     append(Path, Lits, Path1),
     append(Vars, New, Vars1),
     restored(Y, Bias, Path1, Vars1, RY, SY),
@@ -374,6 +387,30 @@ restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN
     append([Id-test|SY], SN, Stats).
 restored(Other, _, _, _, _, _) :-
     domain_error(tg_tree, Other).
+
+%   Lit has the shape of one of the bias's modes (a variable or a constant where the mode
+%   has +T, -T or #T): a literal of the domain's relations, action/1 or necessity/1.
+bias_literal(bias(Modes, _), Lit) :-
+    member(Mode, Modes),
+    mode_shape(Mode, Lit),
+    !.
+
+mode_shape(Mode, X) :-
+    (   Mode =.. [Marker, Type], memberchk(Marker, [+, -, #]), atom(Type)
+    ->  ( var(X) -> true ; atomic(X) )
+    ;   compound(Mode)
+    ->  compound(X),
+        compound_name_arguments(Mode, F, Ms),
+        compound_name_arguments(X, F, Xs),
+        maplist(mode_shape, Ms, Xs)
+    ;   X == Mode
+    ).
+
+%   A learned number of a leaf read from a policy (policy_number/3 says which are sane).
+restored_number(Leaf, What, X) :-
+    arg(1, Leaf, Id),
+    format(string(Text), "leaf ~d: ~w", [Id, What]),
+    policy_number(Leaf, Text, X).
 
 place_leaf(Leaves, Id-L, _, _) :-
     (   L == test

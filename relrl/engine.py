@@ -30,11 +30,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from relrl.errors import RelrlError
+from relrl.errors import PolicyError, QueryTimeout, RelrlError
 from relrl.kb import Cached, KnowledgeBase
 from relrl.terms import Term, Var
 
-__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult", "mask_indices"]
+__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult", "mask_indices",
+           "POLICY_BYTES_PER_POSITION", "POLICY_SECONDS_PER_MB"]
+
+#: seconds a policy load may take per megabyte of the file, on top of the knowledge base's
+#: time limit (a policy runs no rule of its own: its load is bounded by its size; about
+#: five times what a loaded 2-core machine needs).
+POLICY_SECONDS_PER_MB = 2.0
+#: what a position of learned knowledge (a node, an entry, a rule) takes in a policy file,
+#: at most, for the time a save may take (measured: 35 to 60 bytes).
+POLICY_BYTES_PER_POSITION = 100
 
 #: Every goal of relrl's Prolog that Python calls: short name -> "module:predicate".
 GOALS: dict[str, str] = {
@@ -58,6 +67,7 @@ GOALS: dict[str, str] = {
     # policies, read as data (prolog/policy.pl)
     "policy_learner": "relrl_policy:policy_learner",
     "policy_load": "relrl_policy:policy_load",
+    "policy_max_number": "relrl_policy:policy_max_number",
     # working memory (prolog/memory.pl)
     "wm_insert": "relrl_memory:wm_insert",
     "wm_elements": "relrl_memory:wm_elements",
@@ -251,17 +261,40 @@ class Engine:
     # -- files ------------------------------------------------------------------------------
 
     def save(self, path: str | Path, header: str) -> Path:
-        """Write the learned knowledge as a readable policy file (atomic)."""
-        call(self.kb, "save", self.module, str(path), header)
+        """Write the learned knowledge as a readable policy file (atomic).
+
+        Writing is linear in what was learned: it may take the knowledge base's time limit
+        plus :data:`POLICY_SECONDS_PER_MB` per megabyte the policy is expected to take
+        (:data:`POLICY_BYTES_PER_POSITION` per position of :meth:`size`).
+        """
+        megabytes = self.size()[0] * POLICY_BYTES_PER_POSITION / 1e6
+        call(self.kb, "save", self.module, str(path), header,
+             timeout=self.kb.timeout + POLICY_SECONDS_PER_MB * megabytes)
         return Path(path)
 
     def load_policy(self, path: str | Path) -> None:
         """Replace the learned knowledge by the policy at ``path``, read as data.
 
+        Reading and checking a policy is linear in its size (at most 16 MB, see
+        prolog/policy.pl), so it may take the knowledge base's time limit plus
+        :data:`POLICY_SECONDS_PER_MB` for each megabyte of the file.
+
         Raises:
-            PolicyError: the file is not this learner's policy for this domain (file:line).
+            PolicyError: the file is not this learner's policy for this domain (file:line),
+                or reading it took longer than that.
         """
-        call(self.kb, "policy_load", self.module, str(path))
+        try:
+            size = Path(path).stat().st_size
+        except OSError:
+            size = 0  # policy_load names the missing file
+        limit = self.kb.timeout + POLICY_SECONDS_PER_MB * size / 1e6
+        try:
+            call(self.kb, "policy_load", self.module, str(path), timeout=limit)
+        except QueryTimeout as exc:
+            if exc.rule is not None:   # a rule of the domain never ended: its message names it
+                raise
+            raise PolicyError(f"{path}: reading the policy took longer than {limit:.0f} s "
+                              f"({size / 1e6:.1f} MB); nothing was loaded") from None
 
     # -- evaluation without side effects ----------------------------------------------------
 

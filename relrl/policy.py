@@ -14,7 +14,7 @@ from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from relrl.loop import Agent
 from relrl.shell import Shell, command
-from relrl.terms import format_term
+from relrl.terms import Term, format_term
 
 __all__ = ["policy_learner", "load_policy", "attach_learner"]
 
@@ -32,10 +32,28 @@ def policy_learner(path: str | Path, kb: KnowledgeBase) -> str:
 
 
 def attach_learner(shell: Shell, name: str) -> Agent:
-    """Give the shell an agent with a fresh learner called ``name``."""
+    """Give the shell an agent with a fresh learner called ``name``.
+
+    A new learner starts a run, which empties working memory and restarts the necessity
+    units; the shell then puts working memory back as it was, every element at its age, so
+    that ``:explain`` and ``:step`` see what ``:add`` put there.
+    """
+    memory = shell.kb.memory()
     agent = Agent(shell.kb, make_learner(name), seed=0)
+    restore_memory(shell.kb, memory)
     shell.policy = agent
     return agent
+
+
+def restore_memory(kb: KnowledgeBase, memory: list[tuple[int, Term]]) -> None:
+    """Put ``memory`` (``(age, element)`` pairs, as :meth:`KnowledgeBase.memory` gives them)
+    back into an empty working memory: one insertion per age from the oldest, so that each
+    element has its age again."""
+    if not memory:
+        return
+    oldest = max(age for age, _ in memory)
+    for age in range(oldest, -1, -1):
+        kb.insert([element for a, element in memory if a == age])
 
 
 def load_policy(shell: Shell, path: str | Path) -> Agent:
@@ -54,10 +72,15 @@ def _agent(shell: Shell) -> Agent:
     return shell.policy
 
 
-@command("learner", ":learner NAME", "start a fresh learner (etg, tg, contingency, qlearning)")
+@command("learner", ":learner NAME",
+         "start a fresh learner (etg, tg, contingency, qlearning); working memory is kept, "
+         "the necessity units start afresh")
 def _learner(shell: Shell, text: str) -> None:
-    attach_learner(shell, text.strip() or "etg")
-    shell.print(f"learner {text.strip() or 'etg'} ready")
+    name = text.strip() or "etg"
+    attach_learner(shell, name)
+    size = len(shell.kb.memory())
+    shell.print(f"learner {name} ready (working memory kept: {size} element"
+                f"{'s' if size != 1 else ''}; the necessity units start afresh)")
 
 
 @command("tree", ":tree", "draw the learner's tree (etg, tg)")

@@ -22,6 +22,7 @@ import math
 import os
 import re
 import sys
+import tempfile
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +49,8 @@ _HELP = ("  ; (n, r, space, tab): next answer   c (a, Enter, .): stop\n"
          "  w: write the answer's terms whole    p: print them to depth 10\n"
          "  h (?): this help")
 
+#: [user] and consult(user): clauses typed after them, as at swipl's toplevel.
+_USER = re.compile(r"^(\[\s*'?user'?\s*\]|consult\(\s*'?user'?\s*\))$")
 #: spy(Spec) and nospy(Spec): trace points instead of spy points.
 _SPY = re.compile(r"^(no)?spy\((.+)\)$", re.S)
 #: goals that switch swipl's interactive debugger on or off: answered by the shell.
@@ -150,6 +153,9 @@ class Shell:
         self.interactive = False
         self.policy = None  # set by relrl.policy when a learned policy is loaded
         self.loaded: dict[Path, float] = {}   # domain files -> their modification time
+        #: where the lines typed after [user] come from (set by the loops; None: nowhere)
+        self.more_lines: Callable[[], str | None] | None = None
+        self._user_dir: tempfile.TemporaryDirectory | None = None   # holds user.pl
         for path in kb.files:
             self._note_loaded(path)
 
@@ -178,6 +184,8 @@ class Shell:
                     self._debugger(_DEBUGGER[goal])
                 elif _SPY.match(goal):
                     self._spy(goal)
+                elif _USER.match(goal):
+                    self.consult_user()
                 else:
                     self._query(text)
         except RelrlError as exc:
@@ -288,6 +296,37 @@ class Shell:
         self.kb.load(path)
         self._note_loaded(path)
 
+    def consult_user(self) -> None:
+        """``[user].``: read clauses from the input up to its end (Ctrl-D at a terminal) or a
+        line ``end_of_file.``, then load them into the domain all or nothing, as a file
+        named ``user`` (typed again, they replace the clauses typed before, as in swipl).
+
+        Raises:
+            UserError: no input to read clauses from.
+            PrologLoadError: the clauses have an error (nothing is loaded); it names
+                ``user`` and the line.
+        """
+        if self.more_lines is None:
+            raise UserError("[user] reads clauses from the input, and this shell has none")
+        if self.interactive:
+            self.print("% type clauses; end with Ctrl-D or end_of_file.")
+        lines = []
+        while (line := self.more_lines()) is not None and line.strip() != "end_of_file.":
+            lines.append(line if line.endswith("\n") else line + "\n")
+        if self._user_dir is None:
+            self._user_dir = tempfile.TemporaryDirectory(prefix="relrl-user-")
+        path = Path(self._user_dir.name) / "user.pl"
+        path.write_text("".join(lines))
+        try:
+            self._check_files([*(p for p in self.loaded if p.exists()), path], "nothing loaded")
+            self.kb.load(path)
+        except PrologLoadError as exc:
+            shown = str(path)
+            raise PrologLoadError("user", exc.line, exc.text.replace(shown, "user"),
+                                  [("user" if f == shown else f, n, t.replace(shown, "user"))
+                                   for f, n, t in exc.problems]) from None
+        self._answer_line("true.")
+
     def make(self) -> list[Path]:
         """Reload the loaded domain files that changed on disk (swipl's ``make/0``).
 
@@ -386,7 +425,9 @@ class Shell:
     def run_lines(self, lines: Iterable[str]) -> None:
         """Execute inputs from an iterable of lines (piped input, a script)."""
         buffer = ""
-        for line in lines:
+        source = iter(lines)
+        self.more_lines = lambda: next(source, None)
+        for line in source:
             stripped = line.strip()
             if not buffer and stripped.startswith(":"):
                 self.execute(stripped)
@@ -421,6 +462,7 @@ class Shell:
             except OSError:
                 pass
         self.interactive = True
+        self.more_lines = _typed_line
         self.print(f"relrl shell on {self.kb} — :help for commands, :quit to leave")
         buffer = ""
         try:
@@ -461,6 +503,14 @@ _DOMAIN_PREDICATE = ("current_predicate(N/A), functor(H, N, A), "
                      "; \\+ relrl_declarations:declaration_predicate(N/A) )")
 _TRACE_ALL = f"forall(({_DOMAIN_PREDICATE}), trace(N/A, +all))"
 _TRACE_NONE = "notraceall"
+
+
+def _typed_line() -> str | None:
+    """A line typed after ``[user].`` (at swipl's ``|:`` prompt); None at end of input."""
+    try:
+        return input("|: ")
+    except EOFError:
+        return None
 
 
 def _shown(path: Path) -> str:

@@ -1,12 +1,18 @@
-"""``relrl check DOMAIN.pl``: load a domain, validate it and list its declarations."""
+"""``relrl check DOMAIN.pl [--policy FILE]``: load a domain, validate it and list its
+declarations; with ``--policy``, also check a saved policy against it as a whole."""
 
 from __future__ import annotations
 
 import argparse
 import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from relrl.kb import KnowledgeBase
 
 HELP = "load and validate a domain file; list its stimuli and facts with their codes"
-EXAMPLE = "relrl check examples/domains/fruits.pl"
+EXAMPLE = ("relrl check examples/domains/fruits.pl\n"
+           "  relrl check examples/domains/fruits.pl --policy runs/hello/hello-policy.pl")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -15,6 +21,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="domain file(s) to load, in order")
     parser.add_argument("-q", "--quiet", action="store_true",
                         help="print only problems, not the declarations")
+    parser.add_argument("--policy", action="append", default=[], metavar="FILE",
+                        help="also check a saved policy (.pl or .npz) against the domain, as "
+                             "a run or the shell would load it (repeatable)")
     from perception.vocabulary import WORLDS
 
     parser.add_argument("--world", choices=list(WORLDS),
@@ -49,14 +58,36 @@ def run(args: argparse.Namespace) -> int:
             problems.extend(world_warnings(kb, args.world))
         if not args.quiet:
             print(describe(kb))
+        checked = [] if problems else [_check_policy(kb, p, problems) for p in args.policy]
         if problems:
             _print_problems(problems)
             return 2
         if not args.quiet:
             print(f"ok: {', '.join(args.domain)} is valid")
+            for line in checked:
+                print(line)
         return 0
     finally:
         kb.close()
+
+
+def _check_policy(kb: KnowledgeBase, path: str, problems: list[str]) -> str:
+    """Load the policy at ``path`` into a fresh learner of its kind (every check a load
+    makes); a problem is appended to ``problems``. Returns the line that says it is ok."""
+    from relrl.errors import UserError
+    from relrl.learners import make_learner
+    from relrl.loop import Agent
+    from relrl.policy import policy_learner
+
+    try:
+        name = policy_learner(path, kb)
+        agent = Agent(kb, make_learner(name), seed=0)
+        agent.learner.load(path)
+    except UserError as exc:
+        problems.append(str(exc))
+        return ""
+    positions = agent.learner.size()["positions"]
+    return f"ok: {path} is a valid {name} policy for it ({positions} positions)"
 
 
 def _print_problems(problems: list[str]) -> None:

@@ -11,10 +11,14 @@ EXAMPLE = "relrl demo --out runs/demo"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl demo``."""
+    from relrl.experiments.sis import PRESETS
     from relrl.outdir import add_out_options
 
     add_out_options(parser, default="runs/demo", what="output folder")
     parser.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    parser.add_argument("--preset", default=None, choices=sorted(PRESETS),
+                        help="run a named setting instead of relrl's fixed task (as "
+                             "relrl experiment sis --preset)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -27,10 +31,12 @@ def run(args: argparse.Namespace) -> int:
 
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
-    config = SISConfig(points=4, eval_runs=5)
-    print("relrl demo: Experiment 1 (da Silva & Romero 2012) on the Social Interactive "
-          "Simulator,\n  short version: 3 learners x 5 evaluation points x 5 runs of 500 "
-          "time units")
+    config = SISConfig.from_preset(args.preset, points=4, eval_runs=5)
+    print(f"relrl demo: Experiment 1 (da Silva & Romero 2012) on the Social Interactive "
+          f"Simulator,\n  short version: {len(config.learners)} learners "
+          f"({', '.join(config.learners)}) x {config.points + 1} evaluation points x "
+          f"{config.eval_runs} runs of {config.eval_steps} time units\n"
+          f"  setting: {config.setting()}")
     t0 = time.perf_counter()
     with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
                       default="runs/demo") as out:
@@ -43,5 +49,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"done in {time.perf_counter() - t0:.1f} s; results, CSVs and plots in {out.path}/:")
     for f in files:
         print(f"  {f}")
-    print("The full experiment: relrl experiment sis --out runs/exp1")
+    preset = f" --preset {config.preset}" if config.preset else ""
+    print(f"The full experiment: relrl experiment sis{preset} --out runs/exp1")
     return 0

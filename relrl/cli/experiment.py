@@ -79,7 +79,8 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
                    help="with --engine ray: the cluster to join (ray://HEAD:10001, "
                         "HOST:6379 or auto); default: a local Ray instance with --workers "
                         "CPUs")
-    p.add_argument("--caregiver", default="paper", help="caregiver model (default paper)")
+    p.add_argument("--caregiver", default=None,
+                   help="caregiver model (default paper, or the preset's)")
     p.add_argument("--caregiver-param", type=_caregiver_param, action="append", default=[],
                    metavar="NAME=VALUE", help="override a caregiver parameter (repeatable)")
     p.add_argument("--param", type=_param, action="append", default=[],
@@ -103,6 +104,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                          description="The paper's Experiment 1: learning curves (CGI), eye "
                                      "contacts and memory of each learner in the simulator.")
     _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
+    from relrl.experiments.sis import PRESETS
+
+    sis.add_argument("--preset", default=None, choices=sorted(PRESETS),
+                     help="start from a named setting; the other options override it. "
+                          + " ".join(f"{k}: {v['doc']}." for k, v in PRESETS.items())
+                          + " Default: relrl's fixed task (docs/experiment1.md)")
     sis.add_argument("--points", type=int, default=None,
                      help="evaluation points after the first (default 20; --quick: 4)")
     sis.add_argument("--train-places", default=None, metavar="P,P,...",
@@ -169,7 +176,8 @@ def _check_common(args: argparse.Namespace, config, learners_known) -> None:
     if len(set(config.seeds)) != len(config.seeds) or any(s < 0 for s in config.seeds):
         raise ConfigError(f"--seeds must be distinct whole numbers >= 0, not {args.seeds!r}")
     config.eval_policy = args.eval_policy
-    config.caregiver = args.caregiver
+    if args.caregiver is not None:
+        config.caregiver = args.caregiver
     config.caregiver_params.update(dict(args.caregiver_param))
     for learner, name, value in args.param:
         if learner not in learners:
@@ -193,7 +201,7 @@ def build_config(args: argparse.Namespace):
     from relrl.learners import LEARNERS
     from relrl.sim.caregiver import make_caregiver
 
-    config = SISConfig(seeds=_ints(args.seeds or "0", "--seeds"))
+    config = SISConfig.from_preset(args.preset, seeds=_ints(args.seeds or "0", "--seeds"))
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
     config.eval_steps = args.eval_steps if args.eval_steps is not None else 500
@@ -201,7 +209,11 @@ def build_config(args: argparse.Namespace):
     if config.points < 1:
         raise ConfigError(f"--points must be at least 1, not {config.points}")
     _check_common(args, config, LEARNERS)
+    config.learner_params = {k: v for k, v in config.learner_params.items()
+                             if k in config.learners}
     make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker
+    make_caregiver(config.caregiver, {**config.caregiver_params,
+                                      **config.eval_caregiver_params})
     config.train_places = _places("--train-places", args.train_places)
     config.eval_places = _places("--eval-places", args.eval_places)
     if args.domain:
@@ -281,13 +293,19 @@ def run(args: argparse.Namespace) -> int:
 
     if args.name == "scaling":
         return _run_scaling(args)
+    from relrl.experiments.sis import claims_table
+
     config = build_config(args)
+    print(f"setting: {config.setting()}")
     with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
                       default="runs/exp1") as out:
         results, files = sis_main.run_sis(config, out.path, workers=args.workers,
                                           engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
     print(summary_table(results["summary"]))
+    if any(c["held"] is not None for c in results.get("claims", {}).values()):
+        print("\nthe paper's claims (docs/experiment1.md):")
+        print(claims_table(results["claims"]))
     return _finish(results, files, out.path)
 
 

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
+from head.tomlfile import MAX_NESTING, read_limited, too_deep
 from perception.vocabulary import OBJECT_PLACES, PLACES
 from relrl.errors import UserError
 
@@ -149,6 +150,8 @@ class Episode:
 # ---- locating keys in the text -----------------------------------------------------------------
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+#: a key at the start of a line (``name =``, ``"quoted name" =``): what comes before ``=``
+_KEY = re.compile(r"^\s*([^\s=][^=]*?)\s*=")
 #: the most evaluation runs per point, and naming executions, a script may ask for.
 MAX_RUNS = 10_000
 #: problems listed in full before the rest are counted.
@@ -171,6 +174,8 @@ class _Lines:
                 self.headers.setdefault(m.group(2), []).append(i)
                 starts.append(i)
         self.section_end = dict(zip(starts, [*starts[1:], len(self.lines)], strict=False))
+        #: each section's keys -> their first line (0-based), made when first asked for
+        self._keys: dict[int, dict[str, int]] = {}
         #: lines examined by :meth:`locate` (checking stays linear in the text)
         self.scanned = 0
 
@@ -184,12 +189,23 @@ class _Lines:
             return 1
         start = starts[index]
         if rest:
-            key = re.compile(rf"^\s*{re.escape(str(rest[0]))}\s*=")
+            line = self._section_keys(start).get(str(rest[0]))
+            if line is not None:
+                return line + 1
+        return start + 1
+
+    def _section_keys(self, start: int) -> dict[str, int]:
+        """The keys of the section whose header is on line ``start`` (scanned once)."""
+        keys = self._keys.get(start)
+        if keys is None:
+            keys = {}
             for j in range(start + 1, self.section_end[start]):
                 self.scanned += 1
-                if key.match(self.lines[j]):
-                    return j + 1
-        return start + 1
+                m = _KEY.match(self.lines[j])
+                if m:
+                    keys.setdefault(m.group(1), j)
+            self._keys[start] = keys
+        return keys
 
 
 class _Checker:
@@ -298,6 +314,10 @@ def parse_episode(text: str, path: str | Path = "<episode>") -> Episode:
             TOML syntax error stops at the first).
     """
     path = Path(path)
+    deep = too_deep(text)
+    if deep is not None:
+        raise EpisodeError(f"{path}:{deep}: arrays or inline tables nested more than "
+                           f"{MAX_NESTING} deep")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -534,7 +554,7 @@ def load_episode(path: str | Path) -> Episode:
     if path.is_dir():
         raise EpisodeError(f"{path}: is a folder, not an episode script (.toml)")
     try:
-        raw = path.read_bytes()
+        raw = read_limited(path)
     except FileNotFoundError:
         raise EpisodeError(f"{path}: no such episode script") from None
     except OSError as exc:

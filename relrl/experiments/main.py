@@ -8,7 +8,7 @@ from typing import Any
 
 from relrl.experiments.report import aggregate, write_outputs
 from relrl.experiments.runner import raise_kept, run_jobs
-from relrl.experiments.sis import PAPER, SISConfig, job_from_curve, run_job
+from relrl.experiments.sis import PAPER, SISConfig, job_from_curve, paper_claims, run_job
 from relrl.machine import machine_info
 
 __all__ = ["run_sis"]
@@ -74,6 +74,7 @@ def run_sis(config: SISConfig, out_dir: str | Path, *, workers: int = 1,
         "jobs": raw,
         "paper": PAPER,
     }
+    results["claims"] = paper_claims(results["summary"])
     if outcome.interrupted:
         results["interrupted_by"] = outcome.interrupted
     if outcome.error:

@@ -18,6 +18,13 @@ pooled correct shifts over shifts).
 
 One *job* is one learner with one seed; jobs are independent and run in worker processes
 (each holds one Prolog engine).
+
+Two settings (docs/experiment1.md): the default is relrl's fixed task — the simulator's
+caregiver, which attends at most once per eye-contact opportunity, and the learners'
+defaults; it is the benchmark's task. ``preset="paper-2012"`` (:data:`PRESETS`) is the
+paper's 2012 protocol as relrl reads it: the caregiver attends in every time unit of mutual
+gaze, the evaluation gives one look per trial, and the contingency learner's fitness is an
+execution probability.
 """
 
 from __future__ import annotations
@@ -30,7 +37,8 @@ import numpy as np
 
 from relrl.resources import example
 
-__all__ = ["SISConfig", "run_job", "job_from_curve", "DEFAULT_DOMAIN", "PAPER"]
+__all__ = ["CLAIMS", "DEFAULT_DOMAIN", "PAPER", "PRESETS", "SISConfig", "claims_table",
+           "job_from_curve", "paper_claims", "run_job"]
 
 #: the SIS domain shipped with relrl (package data).
 DEFAULT_DOMAIN = example("domains/sis.pl")
@@ -43,6 +51,86 @@ PAPER: dict[str, Any] = {
     "memory_positions": {"qlearning": 3150, "etg": 396,
                          "etg_detail": "68 nodes, 29 leaves, 328 stored actions"},
 }
+
+
+#: Named settings of the whole experiment: what each sets (recorded in results.json under
+#: ``config``) and why. The reasons are argued, with the paper's words, in docs/engine.md
+#: (the contingency learner) and docs/experiment1.md (the caregiver and the protocol).
+PRESETS: dict[str, dict[str, Any]] = {
+    "paper-2012": {
+        "doc": "the paper's 2012 protocol: attention in every time unit of mutual gaze, one "
+               "look per evaluation trial, the contingency learner's fitness an execution "
+               "probability",
+        "caregiver": "paper_2012",
+        "caregiver_params": {},
+        # "the human initially kept the focus on the robot until it establishes eye
+        # contact"; "Once the robot turns its head to any direction, the simulator verifies
+        # ... This procedure takes 1 time unit. Afterward, the objects are then removed".
+        "eval_caregiver_params": {"contact_timeout": None, "single_look": True},
+        # "updating the execution probability of existing ones": fitness is at most 1.
+        # Q-learning and ETG: alpha 0.2, gamma 0.9, epsilon 0.05 and rewards +10 / -1 are
+        # the paper's values and already the learners' defaults.
+        "learner_params": {"contingency": {"max_fitness": 1.0}},
+    },
+}
+
+
+#: The paper's three claims about Experiment 1 (section 5.1, Figs. 4 and 5) as checks on a
+#: results summary: what the paper says, and the criterion relrl holds a run to.
+CLAIMS: dict[str, dict[str, str]] = {
+    "after_first_run": {
+        "paper": "After the first run, all algorithms improve the robot knowledge attaining "
+                 "near of 80% of maximum CGI value",
+        "criterion": "every learner's CGI after run 1 within 0.65-0.95"},
+    "later": {
+        "paper": "the contingency learning do not get to improve its knowledge until the end "
+                 "... ETG and Q-learning algorithms improve their learning",
+        "criterion": "contingency's final CGI within 0.1 of its run-1 value; ETG's and "
+                     "Q-learning's final CGI at least their run-1 value + 0.05"},
+    "eye_contacts": {
+        "paper": "the contingency learning algorithm established a greater number of eye "
+                 "contact than others ... the Q-Learning established a lower number",
+        "criterion": "eye contacts in the first 125 opportunities, mean over seeds: "
+                     "contingency > ETG > Q-learning"},
+}
+
+_PAPERS_THREE = ("contingency", "etg", "qlearning")
+
+
+def paper_claims(summary: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Check the paper's three claims (:data:`CLAIMS`) on an aggregated summary.
+
+    Returns, per claim, the paper's words, the criterion, the figures it was judged on and
+    ``held`` (True or False; None when the run lacks one of the paper's three learners or an
+    evaluation point after learning).
+    """
+    have = all(name in summary and summary[name]["cgi_after_first_run"] is not None
+               for name in _PAPERS_THREE)
+    first = {n: summary[n]["cgi_after_first_run"] for n in _PAPERS_THREE if n in summary}
+    final = {n: summary[n]["cgi_final"] for n in _PAPERS_THREE if n in summary}
+    eyes = {n: summary[n]["eye_contacts"]["mean"] for n in _PAPERS_THREE if n in summary}
+    held: dict[str, bool | None] = dict.fromkeys(CLAIMS)
+    if have:
+        held["after_first_run"] = all(0.65 <= first[n] <= 0.95 for n in _PAPERS_THREE)
+        held["later"] = (abs(final["contingency"] - first["contingency"]) <= 0.1
+                         and all(final[n] >= first[n] + 0.05 for n in ("etg", "qlearning")))
+        held["eye_contacts"] = eyes["contingency"] > eyes["etg"] > eyes["qlearning"]
+    values = {"after_first_run": {"cgi_after_first_run": first},
+              "later": {"cgi_after_first_run": first, "cgi_final": final},
+              "eye_contacts": {"eye_contacts_mean": eyes}}
+    return {k: {**CLAIMS[k], "held": held[k], "values": values[k]} for k in CLAIMS}
+
+
+def claims_table(claims: dict[str, dict[str, Any]]) -> str:
+    """The claims' verdicts as a few lines of text."""
+    lines = []
+    for key, c in claims.items():
+        verdict = {True: "held", False: "not held", None: "not judged"}[c["held"]]
+        figures = "; ".join(
+            f"{what.replace('_', ' ')} " + ", ".join(f"{n} {v:.2f}" for n, v in sorted(d.items()))
+            for what, d in c["values"].items())
+        lines.append(f"{key:<16} {verdict:<10} {figures}")
+    return "\n".join(lines)
 
 
 def _all_learners() -> list[str]:
@@ -79,6 +167,48 @@ class SISConfig:
     train_places: list[str] | None = None
     #: toy places of the evaluation's targets and distractors (None: all of them).
     eval_places: list[str] | None = None
+    #: overrides of the caregiver's parameters while evaluating only (on top of
+    #: ``caregiver_params``).
+    eval_caregiver_params: dict[str, Any] = field(default_factory=dict)
+    #: the named setting this configuration started from (:data:`PRESETS`), or None for
+    #: relrl's fixed task.
+    preset: str | None = None
+
+    @classmethod
+    def from_preset(cls, name: str | None, **fields: Any) -> SISConfig:
+        """A configuration with a preset's settings (``None``: the fixed task), then
+        ``fields``. Learner parameters are kept for the configuration's learners only.
+
+        Raises:
+            ConfigError: unknown preset (the message suggests the closest).
+        """
+        config = cls(**fields)
+        if name is None:
+            return config
+        if name not in PRESETS:
+            from relrl.errors import ConfigError
+            from relrl.sim.errors import did_you_mean
+
+            raise ConfigError(f"unknown preset {name!r}{did_you_mean(str(name), PRESETS)} "
+                              f"(presets: {', '.join(PRESETS)})")
+        preset = PRESETS[name]
+        config.preset = name
+        config.caregiver = preset["caregiver"]
+        config.caregiver_params = {**preset["caregiver_params"], **config.caregiver_params}
+        config.eval_caregiver_params = {**preset["eval_caregiver_params"],
+                                        **config.eval_caregiver_params}
+        for learner, params in preset["learner_params"].items():
+            if learner in config.learners:
+                config.learner_params[learner] = {**params,
+                                                  **config.learner_params.get(learner, {})}
+        return config
+
+    def setting(self) -> str:
+        """One line saying which setting this is (the preset's or the fixed task's)."""
+        if self.preset is not None:
+            return f"preset {self.preset}: {PRESETS[self.preset]['doc']}"
+        return ("the fixed task (relrl's default and the benchmark's): the caregiver attends "
+                "at most once per eye-contact opportunity")
 
     def jobs(self) -> list[tuple[str, int]]:
         """Every (learner, seed) pair, learners first."""
@@ -91,6 +221,11 @@ class SISConfig:
         out = asdict(self)
         out["caregiver_resolved"] = make_caregiver(self.caregiver,
                                                    self.caregiver_params).params.to_dict()
+        if self.eval_caregiver_params:
+            out["eval_caregiver_resolved"] = make_caregiver(
+                self.caregiver, {**self.caregiver_params, **self.eval_caregiver_params}
+            ).params.to_dict()
+        out["setting"] = self.setting()
         return out
 
     def place_split(self) -> tuple[dict[str, Any], dict[str, Any], tuple[str, ...] | None,
@@ -99,7 +234,8 @@ class SISConfig:
         the place groups reported apart (empty without held-out places)."""
         from relrl.sim.places import TOY_PLACES
 
-        learn, evaluation = dict(self.caregiver_params), dict(self.caregiver_params)
+        learn = dict(self.caregiver_params)
+        evaluation = {**self.caregiver_params, **self.eval_caregiver_params}
         if self.train_places:
             learn["placement"] = {p: 1.0 for p in self.train_places}
         if not (self.train_places or self.eval_places):

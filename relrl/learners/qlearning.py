@@ -127,29 +127,112 @@ class QLearner(Learner):
         return write_atomic(path, buf.getvalue())  # temp file + rename, mode 0644
 
     def load(self, path: str | Path) -> None:
-        """Load a table saved by :meth:`save` (its responses must match the domain's)."""
-        import zipfile
+        """Load a table saved by :meth:`save`, checked as a whole before it replaces this
+        one: the domain's responses (in order), one row per (state, necessity), each state a
+        code of the domain's features and each necessity the domain's (or ``none``), every
+        Q finite and no larger in magnitude than a policy's values may be
+        (``relrl_policy:policy_max_number/1``). Array shapes are read from the file's
+        headers before any array, so a table larger than the domain allows is refused
+        without being read.
 
-        try:
-            data = np.load(path, allow_pickle=False)
-            fields = {k: data[k] for k in ("q", "codes", "necessities", "responses")}
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-            raise PolicyError(f"{path}: not a relrl Q-table (.npz): {exc}") from None
-        if not (fields["q"].ndim == 2 and np.issubdtype(fields["q"].dtype, np.number)
-                and len(fields["q"]) == len(fields["codes"]) == len(fields["necessities"])):
-            raise PolicyError(f"{path}: not a relrl Q-table (.npz): inconsistent arrays")
-        data = fields
-        responses = [str(r) for r in data["responses"]]
+        Raises:
+            PolicyError: not a relrl Q-table of this domain (names the file and what is
+                wrong).
+        """
+        from relrl.engine import one
+
+        path = Path(path)
+        engine = self._engine()
         mine = [format_term(r) for r in self.responses]
-        if responses != mine or fields["q"].shape[1] != len(mine):
+        necessities = [*engine.necessities, "none"]
+        states = 1 << len(self.kb.features())
+        arrays = _read_table(path, max_rows=states * len(necessities), width=len(mine))
+        q, codes, names = arrays["q"], arrays["codes"], arrays["necessities"]
+        responses = [str(r) for r in arrays["responses"]]
+        if responses != mine:
             raise PolicyError(f"{path}: learned for another domain: the table's responses "
                               f"{responses} are not the domain's {mine}")
-        try:
-            self._rows = {(int(c), str(n)): i for i, (c, n) in
-                          enumerate(zip(data["codes"], data["necessities"], strict=True))}
-        except ValueError as exc:
-            raise PolicyError(f"{path}: not a relrl Q-table (.npz): {exc}") from None
-        self._q = np.array(data["q"], dtype=float)
-        if len(self._q) == 0:
-            self._q = np.full((64, len(self.responses)), self.params["q_init"])
+        rows: dict[tuple[int, str], int] = {}
+        for i, (code_text, necessity) in enumerate(zip(codes, names, strict=True)):
+            code = _state_code(str(code_text))
+            if code is None or not 0 <= code < states:
+                raise PolicyError(f"{path}: row {i}: state {str(code_text)[:40]!r} is not a "
+                                  f"state code of this domain (0 to 2^{states.bit_length() - 1}"
+                                  " - 1)")
+            if str(necessity) not in necessities:
+                raise PolicyError(f"{path}: row {i}: {str(necessity)[:40]!r} is not a necessity "
+                                  f"of this domain ({', '.join(necessities)})")
+            key = (code, str(necessity))
+            if key in rows:
+                raise PolicyError(f"{path}: rows {rows[key]} and {i} are both state {code} "
+                                  f"under {necessity}")
+            rows[key] = i
+        values = np.asarray(q, dtype=float)
+        bound = float(one(self.kb, "policy_max_number"))
+        bad = np.flatnonzero(~(np.abs(values) <= bound).all(axis=1))
+        if len(bad):
+            i = int(bad[0])
+            j = int(np.flatnonzero(~(np.abs(values[i]) <= bound))[0])
+            raise PolicyError(f"{path}: row {i}: the Q of {mine[j]} is {float(values[i, j])!r}: a "
+                              f"policy's values are finite numbers of magnitude at most "
+                              f"{bound:g}")
+        self._rows = rows
+        self._q = values if len(values) else np.full((64, len(mine)), self.params["q_init"])
         self._prev = None
+
+
+#: the arrays of a saved Q-table and the kinds of values they may hold (numpy dtype kinds).
+_TABLE = {"q": "fiu", "codes": "Uiu", "necessities": "U", "responses": "U"}
+#: the longest text a code, necessity or response of a table may be (characters).
+_MAX_TEXT = 1024
+
+
+def _state_code(text: str) -> int | None:
+    """A state code written as decimal digits (None for anything else)."""
+    return int(text) if text.isascii() and text.isdigit() and len(text) <= 4096 else None
+
+
+def _read_table(path: Path, *, max_rows: int, width: int) -> dict[str, np.ndarray]:
+    """The arrays of the Q-table at ``path``, their shapes and kinds checked from the
+    headers first (at most ``max_rows`` rows of ``width`` responses).
+
+    Raises:
+        PolicyError: not a .npz of the four arrays of a Q-table, or larger than allowed.
+    """
+    import zipfile
+
+    def bad(why: str) -> PolicyError:
+        return PolicyError(f"{path}: not a relrl Q-table (.npz): {why}")
+
+    try:
+        with zipfile.ZipFile(path) as archive:
+            shapes = {}
+            for name in _TABLE:
+                try:
+                    member = archive.open(f"{name}.npy")
+                except KeyError:
+                    raise bad(f"no array {name!r}") from None
+                with member:
+                    version = np.lib.format.read_magic(member)
+                    read = np.lib.format.read_array_header_1_0 if version == (1, 0) \
+                        else np.lib.format.read_array_header_2_0
+                    shape, _, dtype = read(member)
+                if dtype.kind not in _TABLE[name] or (dtype.kind == "U"
+                                                      and dtype.itemsize > 4 * _MAX_TEXT):
+                    raise bad(f"array {name!r} holds {dtype}")
+                shapes[name] = shape
+            rows = shapes["q"][0] if len(shapes["q"]) == 2 else -1
+            if shapes["q"] != (rows, width) or shapes["codes"] != (rows,) \
+                    or shapes["necessities"] != (rows,) or shapes["responses"] != (width,):
+                if len(shapes["responses"]) == 1 and shapes["responses"] != (width,):
+                    raise PolicyError(f"{path}: learned for another domain: the table has "
+                                      f"{shapes['responses'][0]} responses, the domain "
+                                      f"{width}")
+                raise bad(f"inconsistent arrays {shapes}")
+            if rows > max_rows:
+                raise bad(f"{rows} rows, more than the domain's {max_rows} (state, "
+                          "necessity) pairs")
+        with np.load(path, allow_pickle=False) as data:
+            return {name: data[name] for name in _TABLE}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise bad(str(exc)) from None

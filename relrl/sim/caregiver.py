@@ -13,7 +13,10 @@ cycle of three phases:
     time units. Each entry into this phase is one *eye-contact opportunity*. The caregiver
     gives attention **at most once per opportunity**: when eye contact is established
     (``attention_on_contact``, the default), or already in the first time unit the robot
-    looks at its face (``attention_during_gaze``). If eye contact is not established within
+    looks at its face (``attention_during_gaze``). The 2012 caregiver
+    (``attention_per_unit``, the ``paper_2012`` model) attends instead in every time unit of
+    mutual gaze while it waits, as the paper's figures imply; looking away and back then
+    farms attention. If eye contact is not established within
     ``contact_timeout`` time units the opportunity is missed and a new one starts (the
     caregiver keeps looking at the robot; toys only come after eye contact).
 ``present``
@@ -134,6 +137,11 @@ class CaregiverParams:
             the robot), as Triesch et al.'s caregiver rewards looking at its face. Either way
             the caregiver attends at most once per opportunity: looking away and back cannot
             farm attention.
+        attention_per_unit: give attention in every time unit of mutual gaze while waiting
+            for eye contact (the robot on the caregiver's face, the caregiver looking at the
+            robot), with no limit per opportunity: the paper's 2012 caregiver, under which
+            looking at the face pays at once and looking away and back farms attention.
+            Supersedes ``attention_during_gaze``; eye contact itself gives nothing more.
         single_look: end a trial (no attention) at the robot's first look, after the turn, at
             anything but the face or the target — one try per trial, as the paper's
             evaluation reads.
@@ -154,6 +162,7 @@ class CaregiverParams:
     contact_timeout: int | None = 10
     attention_on_contact: bool = True
     attention_during_gaze: bool = False
+    attention_per_unit: bool = False
     single_look: bool = False
     target_sequence: tuple[str, ...] | None = None
 
@@ -365,7 +374,8 @@ class ProtocolCaregiver(Caregiver):
         phase = self.phase
         if phase == ENGAGE:
             self._streak = self._streak + 1 if focus == CENTRE else 0
-            if p.attention_during_gaze and focus == CENTRE and not self._attended:
+            if focus == CENTRE and (p.attention_per_unit or (p.attention_during_gaze
+                                                             and not self._attended)):
                 self.attention = self._attended = True
             if self._streak >= p.contact_hold:
                 self.contact = True
@@ -499,5 +509,7 @@ register_caregiver("unreliable", ProtocolCaregiver, CaregiverParams(reliability=
                    "the paper's protocol, looking at the target only half the time")
 register_caregiver("random", ProtocolCaregiver, CaregiverParams(reliability=0.2),
                    "the paper's protocol with an uninformative gaze (any toy place alike)")
+register_caregiver("paper_2012", ProtocolCaregiver, CaregiverParams(attention_per_unit=True),
+                   "the 2012 paper's caregiver: attention in every time unit of mutual gaze")
 register_caregiver("one_toy", ProtocolCaregiver, CaregiverParams(n_toys=1),
                    "the paper's protocol with one toy, as in the head experiment")

@@ -55,13 +55,15 @@ from relrl.sim.render import render_rgb, render_text
 from relrl.sim.reward import PAPER_REWARD
 from relrl.sim.world import World
 
-__all__ = ["ENV_ID", "ENV_ID_V1", "OBSERVATION_FIELDS", "POSES", "RESPONSES",
+__all__ = ["ENV_ID", "ENV_ID_V1", "OBSERVATION_FIELDS", "POSES", "RESET_OPTIONS", "RESPONSES",
            "SharedAttentionEnv", "SharedAttentionEnvV1", "observation_fields"]
 
 #: the registered Gymnasium id (focus-only observation).
 ENV_ID = "relrl/SharedAttention-v0"
 #: the successor: the observation adds the toy's kind and the whole scene.
 ENV_ID_V1 = "relrl/SharedAttention-v1"
+#: the options ``reset(options=...)`` takes (any other is refused, with a suggestion).
+RESET_OPTIONS: tuple[str, ...] = ("focus", "sequence_offset")
 #: action index -> response term (the paper's world).
 RESPONSES: tuple[tuple[str, str], ...] = tuple(("look", p) for p in PLACES)
 #: caregiver gaze (place index) -> the face's pose as the robot perceives it in the paper's
@@ -161,9 +163,10 @@ class SharedAttentionEnv(gym.Env, Environment):
         self._index = {p: i for i, p in enumerate(self.places)}
         self.responses: tuple[tuple[str, str], ...] = tuple(("look", p) for p in self.places)
         self._poses: tuple[str, ...] = ("frontal",) + self.places[1:]
+        #: the responses as terms and as text (indices go through the action space)
         self._actions: dict[Any, int] = {}
         for i, term in enumerate(self.responses):
-            self._actions.update({i: i, term: i, f"look({term[1]})": i})
+            self._actions.update({term: i, f"look({term[1]})": i})
         self.initial_focus = self._place(initial_focus)
         self.render_mode = render_mode
         self.max_steps = max_steps
@@ -230,9 +233,22 @@ class SharedAttentionEnv(gym.Env, Environment):
 
         Returns:
             The first observation and ``info`` (``percepts``, ``record``, ``toy_angles``).
+
+        Raises:
+            SimError: ``options`` is not a mapping (or None), names an unknown option, or
+                gives a bad value.
         """
+        if options is None:
+            options = {}
+        elif not isinstance(options, Mapping):
+            raise SimError(f"options={options!r}: use a dict such as {{'focus': 'centre'}} "
+                           f"(options: {', '.join(RESET_OPTIONS)}) or None")
+        for key in options:
+            if key not in RESET_OPTIONS:
+                raise SimError(f"unknown reset option {key!r}"
+                               f"{did_you_mean(str(key), RESET_OPTIONS)} (the options: "
+                               f"{', '.join(RESET_OPTIONS)})")
         super().reset(seed=seed)
-        options = options or {}
         focus = self._place(options.get("focus"))
         if focus is None:
             focus = self.initial_focus
@@ -251,22 +267,22 @@ class SharedAttentionEnv(gym.Env, Environment):
         return obs, info
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        """Emit a response (action index or ``look(P)`` term) and advance one time unit.
+        """Emit a response and advance one time unit.
+
+        Args:
+            action: anything :attr:`action_space` contains (an int, a numpy integer, a 0-d
+                integer array such as Stable-Baselines3's ``predict`` returns), or a
+                response as a term (``("look", "left")``) or text (``"look(left)"``).
 
         Returns:
             ``(observation, reward, terminated, truncated, info)``; ``terminated`` is always
             False; ``info`` holds ``percepts``, ``record`` and ``toy_angles``, and at
             truncation the episode's metrics (see the module documentation).
+
+        Raises:
+            InvalidResponse: anything else.
         """
-        try:
-            focus = self._actions[action]
-        except (KeyError, TypeError):
-            looks = [f"look({p})" for p in self.places]
-            shown = ", ".join(looks) if len(looks) <= 10 else f"{looks[0]} ... {looks[-1]}"
-            raise InvalidResponse(
-                f"not a response of the SIS: {action!r}"
-                f"{did_you_mean(str(action), looks)}; use an action index "
-                f"0-{len(looks) - 1} or one of {shown}") from None
+        focus = self._focus_of(action)
         if self._record is None:
             raise SimError("call reset() before step()")
         self._t += 1
@@ -331,6 +347,23 @@ class SharedAttentionEnv(gym.Env, Environment):
         return tuple((place, row[self._index[place]]) for place, _ in self.caregiver.toys)
 
     # ---- internals -------------------------------------------------------------------------
+
+    def _focus_of(self, action: Any) -> int:
+        """The place index of ``action`` (see :meth:`step`)."""
+        if self.action_space.contains(action):
+            return int(action) - int(self.action_space.start)
+        if isinstance(action, (str, tuple)):
+            try:
+                return self._actions[action]
+            except (KeyError, TypeError):   # a tuple may hold what cannot be hashed
+                pass
+        looks = [f"look({p})" for p in self.places]
+        shown = ", ".join(looks) if len(looks) <= 10 else f"{looks[0]} ... {looks[-1]}"
+        raise InvalidResponse(
+            f"not a response of the SIS: {action!r}"
+            f"{did_you_mean(str(action), looks)}; use an action index "
+            f"0-{len(looks) - 1} (an int, a numpy integer or a 0-d integer array) or one "
+            f"of {shown}")
 
     def _place(self, name: str | None) -> int | None:
         if name is None:

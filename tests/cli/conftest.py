@@ -85,7 +85,102 @@ def corpus(tmp_path_factory) -> Path:
     }
     for name, text in eps.items():
         (d / name).write_text(text)
+    hostile_policies(d)
+    hostile_tomls(d)
     return d
+
+
+def hostile_tomls(d: Path) -> None:
+    """Episode scripts and calibrations nested 3,000 deep, or naming a device."""
+    from head.calibration import DEFAULT_CALIBRATION
+
+    deep = {"array": "[" * 3000 + "]" * 3000, "table": "{ a = " * 3000 + "1" + " }" * 3000}
+    cal = DEFAULT_CALIBRATION.read_text()
+    for name, nest in deep.items():
+        (d / f"deep_{name}.toml").write_text(episode_text() + f"[learner]\nx = {nest}\n")
+        (d / f"cal_deep_{name}.toml").write_text(cal + f"\n[extra]\nx = {nest}\n")
+    (d / "dev_zero.toml").symlink_to("/dev/zero")
+    (d / "cal_scripts_dev_zero.toml").write_text(
+        cal.replace("[head]\n", '[head]\nscripts = "/dev/zero"\n', 1))
+
+
+#: a hand-made ETG tree over the fruits domain's tests: {q} is the Q of the one entry.
+_TREE = ("etg_node(0, test(0, stimulus(face), 1, 2)).\n"
+         "etg_node(1, leaf(none, [])).\n"
+         "etg_node(2, leaf(none, [e({response}, {q}, {necessity})])).\n")
+
+
+def hostile_policies(d: Path) -> None:
+    """Policies for the fruits domain that must be refused whole, one line naming the file
+    and line: node ids out of range, trees that are not trees, numbers that are not finite
+    or too large, responses and necessities the domain does not have; for every learner.
+    ``p_*.pl`` are ETG policies, ``c_*`` contingency, ``t_*`` tg, ``q_*`` Q-tables; episodes
+    ``load_*.toml`` load one into a run."""
+    import numpy as np
+
+    from relrl.kb import KnowledgeBase
+    from relrl.learners import make_learner
+    from relrl.loop import Agent
+
+    good: dict[str, str] = {}
+    with KnowledgeBase(FRUITS) as kb:
+        for name in ("etg", "contingency", "tg", "qlearning"):
+            agent = Agent(kb, make_learner(name), seed=0)
+            for percepts in ([("see", "face")], [("see", "face"), ("hear", "attention")],
+                             [("see", "object")]):
+                agent.step(percepts)
+            suffix = "npz" if name == "qlearning" else "pl"
+            path = agent.learner.save(d / f"good_{name}.{suffix}")
+            if suffix == "pl":
+                good[name] = path.read_text()
+    head = good["etg"].split("etg_node(")[0]
+
+    def tree(response: str = "look(left)", q: str = "1.5", necessity: str = "socialize") -> str:
+        return head + _TREE.format(response=response, q=q, necessity=necessity)
+
+    ok = tree()
+    etg = {
+        "id1e9": ok.replace("1, 2)).", "1, 1000000000)).").replace(
+            "etg_node(2,", "etg_node(1000000000,"),
+        "id1e40": ok.replace("1, 2)).", f"1, {10**40})).").replace(
+            "etg_node(2,", f"etg_node({10**40},"),
+        "dangling": ok.replace("1, 2)).", "1, 7))."),
+        "cycle": ok.replace("etg_node(1, leaf(none, [])).",
+                            "etg_node(1, test(1, stimulus(object), 0, nil))."),
+        "q_inf": tree(q="1.0Inf"),
+        "q_400_digits": tree(q=str(10**400)),
+        "q_rational": tree(q="1r3"),
+        "halt": tree(response="halt"),
+        "look_var": tree(response="look(_)"),
+        "script": tree(response="'<script>'"),
+        "necessity": tree(necessity="'<script>'"),
+    }
+    for name, text in etg.items():
+        (d / f"p_{name}.pl").write_text(text)
+    rule = "learned_behaviour(state(1), {r}, socialize, {f}).\n"
+    contingency = {"halt": rule.format(r="halt", f="1.0"),
+                   "inf": rule.format(r="look(left)", f="1.0Inf"),
+                   "state_1e40": rule.format(r="look(left)", f="1.0").replace(
+                       "state(1)", f"state({10**40})")}
+    for name, extra in contingency.items():
+        (d / f"c_{name}.pl").write_text(good["contingency"] + extra)
+    tg_head = good["tg"].split("tg_tree(")[0]
+    (d / "t_halt.pl").write_text(tg_head + "tg_tree(node(1, [halt], [], leaf(2, 1.0, 1), "
+                                           "leaf(3, 2.0, 1))).\n")
+    (d / "t_id1e9.pl").write_text(tg_head + "tg_tree(node(1, [sees(object)], [], "
+                                            "leaf(1000000000, 1.0, 1), leaf(3, 2.0, 1))).\n")
+    with np.load(d / "good_qlearning.npz") as table:
+        arrays = {k: table[k] for k in table.files}
+    arrays["q"] = arrays["q"].copy()
+    arrays["q"][0, 0] = np.inf
+    np.savez(d / "q_inf.npz", **arrays)
+    # a million clauses (34 MB): refused from its size, before reading
+    with open(d / "p_million.pl", "w") as fh:
+        fh.write(head)
+        fh.writelines(f"etg_node({i}, leaf(none, [])).\n" for i in range(1_000_000))
+    for name in ("cycle", "halt"):
+        (d / f"load_{name}.toml").write_text(episode_text(
+            head=f'learner = "etg"\npolicy_load = "p_{name}.pl"\npolicy_save = "again.pl"'))
 
 
 def one_line_exit_2(capsys, argv: list[str], *needles: str) -> str:

@@ -1,9 +1,11 @@
-"""The bad-input corpus of issue 14, every subcommand: one line naming the value, exit 2.
+"""The bad-input corpus, every subcommand: one line naming the value, exit 2.
 
-Each case is ``relrl ARGV`` run in this process (an escaping exception fails the test with its
-traceback) and the words the one line must contain. ``{d}`` is the corpus folder
-(``conftest.corpus``), ``{fruits}`` the fruits domain. Outputs that must *not* be written are
-checked in ``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
+It holds 118 cases in :data:`CASES` (a test checks this count), and the tests below it for
+inputs whose answer is more than one line. Each case is ``relrl ARGV`` run in this process
+(an escaping exception fails the test with its traceback) and the words the one line must
+contain. ``{d}`` is the corpus folder (``conftest.corpus``: hostile files, policies and TOML
+included), ``{fruits}`` the fruits domain. Outputs that must *not* be written are checked in
+``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
 """
 
 from __future__ import annotations
@@ -153,6 +155,63 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("tree-format", ["tree", "{d}/afile", "--domain", "{fruits}", "--out", "{d}/t.gif"],
      ["t.gif", "format"]),
     ("examples-copy-file", ["examples", "--copy", "{d}/afile"], ["afile", "not a folder"]),
+    # ---- policies: refused whole, naming the file and line (conftest.hostile_policies) ----
+    ("tree-policy-id-1e9", ["tree", "{d}/p_id1e9.pl", "--domain", "{fruits}"],
+     ["p_id1e9.pl:", "node id 1000000000 is out of range"]),
+    ("tree-policy-id-1e40", ["tree", "{d}/p_id1e40.pl", "--domain", "{fruits}"],
+     ["p_id1e40.pl:", "is out of range"]),
+    ("tree-policy-dangling-branch", ["tree", "{d}/p_dangling.pl", "--domain", "{fruits}"],
+     ["p_dangling.pl:", "node 7", "dangling branch"]),
+    ("tree-policy-cycle", ["tree", "{d}/p_cycle.pl", "--domain", "{fruits}"],
+     ["p_cycle.pl:", "back to the root (a cycle)"]),
+    ("shell-policy-q-inf", ["shell", "{fruits}", "--policy", "{d}/p_q_inf.pl"],
+     ["p_q_inf.pl:", "1.0Inf is not a finite number"]),
+    ("shell-policy-q-400-digits", ["shell", "{fruits}", "--policy", "{d}/p_q_400_digits.pl"],
+     ["p_q_400_digits.pl:", "an integer of 401 digits", "out of range"]),
+    ("shell-policy-q-rational", ["shell", "{fruits}", "--policy", "{d}/p_q_rational.pl"],
+     ["p_q_rational.pl:", "1r3 is a rational number"]),
+    ("shell-policy-halt", ["shell", "{fruits}", "--policy", "{d}/p_halt.pl"],
+     ["p_halt.pl:", "halt is not a response of this domain"]),
+    ("shell-policy-look-var", ["shell", "{fruits}", "--policy", "{d}/p_look_var.pl"],
+     ["p_look_var.pl:", "look(_) is not a response of this domain"]),
+    ("shell-policy-script", ["shell", "{fruits}", "--policy", "{d}/p_script.pl"],
+     ["p_script.pl:", "'<script>' is not a response of this domain"]),
+    ("shell-policy-necessity", ["shell", "{fruits}", "--policy", "{d}/p_necessity.pl"],
+     ["p_necessity.pl:", "'<script>' is not a necessity of this domain"]),
+    ("shell-policy-contingency-halt", ["shell", "{fruits}", "--policy", "{d}/c_halt.pl"],
+     ["c_halt.pl:", "halt is not a response of this domain"]),
+    ("shell-policy-contingency-inf", ["shell", "{fruits}", "--policy", "{d}/c_inf.pl"],
+     ["c_inf.pl:", "1.0Inf is not a finite number"]),
+    ("shell-policy-contingency-state", ["shell", "{fruits}", "--policy",
+                                        "{d}/c_state_1e40.pl"],
+     ["c_state_1e40.pl:", "is not a state of this domain"]),
+    ("tree-policy-tg-halt", ["tree", "{d}/t_halt.pl", "--domain", "{fruits}"],
+     ["t_halt.pl:", "halt is not a literal of the domain's language bias"]),
+    ("tree-policy-tg-id-1e9", ["tree", "{d}/t_id1e9.pl", "--domain", "{fruits}"],
+     ["t_id1e9.pl:", "node id 1000000000 is out of range"]),
+    ("shell-policy-qtable-inf", ["shell", "{fruits}", "--policy", "{d}/q_inf.npz"],
+     ["q_inf.npz", "the Q of", "inf"]),
+    ("shell-policy-million-clauses", ["shell", "{fruits}", "--policy", "{d}/p_million.pl"],
+     ["p_million.pl", "larger than a policy relrl reads"]),
+    ("run-policy-load-cycle", ["run", "{d}/load_cycle.toml", "--out", "{d}/out-cycle"],
+     ["p_cycle.pl:", "a cycle"]),
+    ("run-policy-load-halt", ["run", "{d}/load_halt.toml", "--out", "{d}/out-halt"],
+     ["p_halt.pl:", "halt is not a response"]),
+    # ---- TOML nested 3,000 deep, or a device (conftest.hostile_tomls) ----------------------
+    ("run-nested-arrays", ["run", "{d}/deep_array.toml"],
+     ["deep_array.toml:", "nested more than 32 deep"]),
+    ("run-nested-inline-tables", ["run", "{d}/deep_table.toml"],
+     ["deep_table.toml:", "nested more than 32 deep"]),
+    ("run-dev-zero", ["run", "{d}/dev_zero.toml"], ["dev_zero.toml", "not a regular file"]),
+    ("head-calibration-nested-arrays", ["head", "--calibration", "{d}/cal_deep_array.toml",
+                                        "status"],
+     ["cal_deep_array.toml:", "nested more than 32 deep"]),
+    ("head-calibration-nested-tables", ["head", "--calibration", "{d}/cal_deep_table.toml",
+                                        "status"],
+     ["cal_deep_table.toml:", "nested more than 32 deep"]),
+    ("head-calibration-scripts-dev-zero", ["head", "--calibration",
+                                           "{d}/cal_scripts_dev_zero.toml", "status"],
+     ["cal_scripts_dev_zero.toml", "head.scripts", "/dev/zero", "not a regular file"]),
     # ---- demo ------------------------------------------------------------------------------
     ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
@@ -174,6 +233,10 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
     needles = [n.format(d=corpus) for n in needles]
     one_line_exit_2(capsys, argv, *needles)
+
+
+def test_the_corpus_says_how_many_cases_it_holds():
+    assert f"It holds {len(CASES)} cases" in " ".join(__doc__.split())
 
 
 def test_every_subcommand_is_in_the_corpus():
@@ -227,3 +290,44 @@ def test_an_image_path_that_is_a_device(capsys, tmp_path):
     (tmp_path / "zero.png").symlink_to("/dev/zero")
     one_line_exit_2(capsys, ["perceive", str(tmp_path / "zero.png")], "zero.png",
                     "not a regular file")
+
+
+@pytest.mark.parametrize("name", ["good_etg.pl", "good_contingency.pl", "good_tg.pl",
+                                  "good_qlearning.npz"])
+def test_check_a_good_policy(capsys, corpus, name):
+    assert main(["check", str(FRUITS), "--policy", str(corpus / name)]) == 0
+    assert f"ok: {corpus / name} is a valid" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name, words", [
+    ("p_cycle.pl", "back to the root (a cycle)"), ("p_dangling.pl", "dangling branch"),
+    ("c_halt.pl", "halt is not a response"), ("t_halt.pl", "halt is not a literal"),
+    ("q_inf.npz", "the Q of")])
+def test_check_a_policy_that_is_refused(capsys, corpus, name, words):
+    """``relrl check --policy`` makes every check a load makes: the problem, then a count."""
+    assert main(["check", "-q", str(FRUITS), "--policy", str(corpus / name)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith(str(corpus / name)) and words in err[0], err
+    assert err[1:] == ["1 problem"]
+
+
+def test_a_refused_policy_is_never_saved_again(capsys, corpus):
+    """A cyclic tree is refused before the run starts: nothing learned, nothing re-saved
+    (it used to loop until the time limit, then be written back as a partial policy)."""
+    out = corpus / "out-cycle-again"
+    one_line_exit_2(capsys, ["run", str(corpus / "load_cycle.toml"), "--out", str(out)],
+                    "p_cycle.pl:", "a cycle")
+    assert not (out / "again.pl").exists() and not (out / "summary.json").exists()
+
+
+def test_user_clauses_piped_into_the_shell(capfd, monkeypatch):
+    """``[user].`` then clauses, piped: loaded as a file named user; a bad clause is one
+    line naming user and its line, nothing loaded, exit 2."""
+    monkeypatch.setattr(sys, "stdin", io.StringIO("[user].\nok(1).\nend_of_file.\nok(X).\n"))
+    assert main(["shell", str(FRUITS)]) == 0
+    assert capfd.readouterr().out == "true.\nX = 1.\n"
+    monkeypatch.setattr(sys, "stdin", io.StringIO("[user].\nok(1).\nbad(\n"))
+    assert main(["shell", str(FRUITS)]) == 2
+    captured = capfd.readouterr()
+    assert captured.out.startswith("error: user:2: Syntax error")
+    assert "iri_scheme" not in captured.err and "Traceback" not in captured.err

@@ -108,3 +108,78 @@ def test_bad_place_options_one_line_exit_2(args, message, tmp_path: Path, capsys
     assert main(["experiment", "sis", *args, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_preset_paper_2012_is_recorded_in_results(tmp_path: Path, capsys) -> None:
+    out = tmp_path / "p"
+    assert main(["experiment", "sis", "--preset", "paper-2012", "--learners", "contingency,etg",
+                 *SMALL, "--param", "contingency.influence=0.25", "--out", str(out),
+                 "--workers", "1"]) == 0
+    assert "setting: preset paper-2012" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    cfg = results["config"]
+    assert cfg["preset"] == "paper-2012" and cfg["setting"].startswith("preset paper-2012")
+    assert cfg["caregiver"] == "paper_2012"
+    learning, evaluation = cfg["caregiver_resolved"], cfg["eval_caregiver_resolved"]
+    assert learning["attention_per_unit"] and evaluation["attention_per_unit"]
+    assert not learning["single_look"] and learning["contact_timeout"] == 10
+    assert evaluation["single_look"] and evaluation["contact_timeout"] is None
+    # the preset's learner parameters for the learners run only; an option overrides them
+    assert cfg["learner_params"] == {"contingency": {"max_fitness": 1.0, "influence": 0.25}}
+    params = {j["learner"]: j["params"] for j in results["jobs"]}
+    assert params["contingency"]["max_fitness"] == 1.0
+    assert params["contingency"]["influence"] == 0.25
+    assert params["etg"]["alpha"] == 0.2 and params["etg"]["epsilon"] == 0.05
+    # the claims need the paper's three learners: not judged here
+    assert set(results["claims"]) == {"after_first_run", "later", "eye_contacts"}
+    assert all(c["held"] is None for c in results["claims"].values())
+
+
+def test_fixed_task_is_the_default_setting() -> None:
+    cfg = SISConfig.from_preset(None)
+    assert cfg.preset is None and cfg.caregiver == "paper" and not cfg.eval_caregiver_params
+    d = cfg.to_dict()
+    assert "eval_caregiver_resolved" not in d and d["setting"].startswith("the fixed task")
+    assert not d["caregiver_resolved"]["attention_per_unit"]
+    learn, evaluation, _, _ = SISConfig.from_preset("paper-2012").place_split()
+    assert learn == {} and evaluation == {"contact_timeout": None, "single_look": True}
+
+
+def test_claims_judged_on_a_summary() -> None:
+    from relrl.experiments.sis import paper_claims
+
+    def learner(first: float, final: float, eyes: float) -> dict:
+        return {"cgi_after_first_run": first, "cgi_final": final,
+                "eye_contacts": {"mean": eyes}}
+
+    paperlike = {"contingency": learner(0.8, 0.82, 120), "etg": learner(0.78, 0.9, 110),
+                 "qlearning": learner(0.81, 0.92, 100)}
+    claims = paper_claims(paperlike)
+    assert [c["held"] for c in claims.values()] == [True, True, True]
+    paperlike["contingency"] = learner(0.47, 0.97, 115)
+    claims = paper_claims(paperlike)
+    assert [c["held"] for c in claims.values()] == [False, False, True]
+    assert claims["later"]["values"]["cgi_final"]["contingency"] == 0.97
+
+
+@pytest.mark.parametrize("preset", [None, "paper-2012"])
+def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_path: Path,
+                                                     capsys, monkeypatch) -> None:
+    import relrl.experiments.main as experiments_main
+    from relrl.learners import LEARNERS
+
+    ran = []
+
+    def fake_run_sis(config, out, **kwargs):   # the banner is the test, not the run
+        ran.append(config)
+        return {"summary": {}}, []
+
+    monkeypatch.setattr(experiments_main, "run_sis", fake_run_sis)
+    args = ["demo", "--out", str(tmp_path / "d")] + (["--preset", preset] if preset else [])
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert f"{len(LEARNERS)} learners ({', '.join(LEARNERS)})" in out
+    assert f"setting: {ran[0].setting()}" in out
+    assert ran[0].preset == preset
+    assert ("setting: preset paper-2012" in out) == (preset == "paper-2012")
+    assert ("setting: the fixed task" in out) == (preset is None)

@@ -169,3 +169,35 @@ def test_a_script_defined_twice_is_an_error(tmp_path: Path, fast_toml):
     (tmp_path / "cal.toml").write_text(text)
     with pytest.raises(CalibrationError, match="more.toml.*also defined"):
         load_calibration(tmp_path / "cal.toml")
+
+
+@pytest.mark.parametrize("scripts", ["/dev/zero", "fifo.toml", "adir", "p\u0000.toml"])
+def test_a_scripts_file_that_is_no_file_is_refused_before_reading(tmp_path: Path, fast_toml,
+                                                                   scripts: str):
+    """``scripts = "/dev/zero"`` used to read without end (MemoryError); a pipe would block."""
+    os.mkfifo(tmp_path / "fifo.toml")
+    (tmp_path / "adir").mkdir()
+    name = scripts.replace("\x00", "\\u0000")   # a NUL written as TOML's escape
+    text = fast_toml.replace('name = "fast test head"',
+                             f'name = "fast test head"\nscripts = "{name}"')
+    (tmp_path / "cal.toml").write_text(text)
+    with pytest.raises(CalibrationError, match=r"cal\.toml: head\.scripts: .*cannot read: "
+                                               r"(not a regular file|is a folder|a file "
+                                               r"name cannot hold a NUL)"):
+        load_calibration(tmp_path / "cal.toml")
+
+
+@pytest.mark.parametrize("nest", ["[" * 3000 + "]" * 3000, "{ a = " * 3000 + "1" + " }" * 3000])
+def test_a_calibration_nested_3000_deep_names_its_line(tmp_path: Path, fast_toml, nest: str):
+    """It used to end in a RecursionError inside tomllib."""
+    (tmp_path / "cal.toml").write_text(fast_toml + f"\n[extra]\nx = {nest}\n")
+    line = fast_toml.count("\n") + 3
+    with pytest.raises(CalibrationError, match=rf"cal\.toml:{line}: arrays or inline tables "
+                                               r"nested more than 32 deep"):
+        load_calibration(tmp_path / "cal.toml")
+
+
+def test_a_calibration_larger_than_16_mb_is_refused(tmp_path: Path, fast_toml):
+    (tmp_path / "cal.toml").write_text(fast_toml + "# " + "x" * (16 * 1024 * 1024) + "\n")
+    with pytest.raises(CalibrationError, match=r"cal\.toml: cannot read: larger than 16 MB"):
+        load_calibration(tmp_path / "cal.toml")

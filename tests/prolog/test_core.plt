@@ -70,7 +70,7 @@ test(mediator_threshold, [true(Active == socialize)]) :-
 :- begin_tests(contingency).
 
 contingency_params([default_fitness=1.0, influence=0.5, min_fitness=0.05,
-                    max_fitness=10.0]).
+                    max_fitness=10.0, default_always=0.0, extinction=1.0, satiation=0.0]).
 
 %   A response with no rule creates one from the default fitness moved by the consequence.
 test(new_rule_from_consequence, [Rules == [behaviour(state(5), a, hunger, 1.5)]]) :-
@@ -109,6 +109,94 @@ test(roulette_proportional, [true(abs(Share - 0.75) < 0.02)]) :-
     include(==(a), As, AsA),
     length(AsA, NA),
     Share is NA / 4000.
+
+%   A hand-made stream in state 1 under `hunger`: response a emitted four times and
+%   reinforced three of them (in the order +, +, -, +), b emitted twice and never
+%   reinforced, c never emitted. Each step forces the response (it is the only one allowed)
+%   and learns from the given consequence.
+stream_fitness(Params, Fitness, Probabilities) :-
+    stream_kb(Params, KB),
+    relrl_contingency:contingency_rules(KB, Rules),
+    findall(R-F, member(behaviour(state(1), R, hunger, F), Rules), Fitness),
+    relrl_contingency:contingency_probabilities(KB, 1, hunger, [a, b, c], Params,
+                                                Probabilities).
+
+stream_kb(Params, KB) :-
+    kb_with('tests/data/tiny.pl', KB),
+    relrl_contingency:contingency_init(KB),
+    forall(member(R-Reinforced, [a-true, a-true, a-false, a-true, b-false, b-false]),
+           ( relrl_contingency:contingency_choose(KB, 1, hunger, [R], Params, R),
+             relrl_contingency:contingency_update(KB, 1, R, hunger, Reinforced, Params) )).
+
+probabilities_close(Expected, Actual) :-
+    pairs_keys(Expected, Rs), pairs_keys(Actual, Rs),
+    maplist([_-E, _-A]>>close_to(E, A), Expected, Actual).
+
+%   The fixed task's reading: a's rule 1.5, 2.0, 1.5, 2.0; b's 0.5 then 0.05 (the lower
+%   bound); c keeps the default 1: execution probabilities 2/3.05, 0.05/3.05, 1/3.05.
+test(execution_probabilities_fixed_task,
+     [Fitness-Ok == [a-2.0, b-0.05]-true]) :-
+    contingency_params(P),
+    stream_fitness(P, Fitness, Probabilities),
+    (   probabilities_close([a-(2/3.05), b-(0.05/3.05), c-(1/3.05)], Probabilities)
+    ->  Ok = true
+    ;   Ok = Probabilities
+    ).
+
+%   Fitness is an execution probability (max_fitness 1, the paper-2012 preset): a's rule
+%   cannot rise above 1 (1, 1, 0.5, 1); b falls to 0.05: probabilities 1/2.05, 0.05/2.05,
+%   1/2.05 - a wrong response that failed twice keeps 1/(1 + 0.05 k) of the right one's
+%   chances against k of them.
+test(execution_probabilities_as_probabilities,
+     [Fitness-Ok == [a-1.0, b-0.05]-true]) :-
+    contingency_params(P0),
+    selectchk(max_fitness=_, P0, max_fitness=1.0, P),
+    stream_fitness(P, Fitness, Probabilities),
+    (   probabilities_close([a-(1/2.05), b-(0.05/2.05), c-(1/2.05)], Probabilities)
+    ->  Ok = true
+    ;   Ok = Probabilities
+    ).
+
+%   The default kept in every slice: a rule starts from nothing moved by its consequence
+%   (a: 0.5, 1.0, 0.5, 1.0; b: 0.05, 0.05) and adds to the default 1: slices 2, 1.05, 1.
+test(execution_probabilities_default_always,
+     [Fitness-Ok == [a-1.0, b-0.05]-true]) :-
+    contingency_params(P0),
+    selectchk(default_always=_, P0, default_always=1.0, P),
+    stream_fitness(P, Fitness, Probabilities),
+    (   probabilities_close([a-(2/4.05), b-(1.05/4.05), c-(1/4.05)], Probabilities)
+    ->  Ok = true
+    ;   Ok = Probabilities
+    ).
+
+%   The letter of the necessity clauses: no reinforcer leaves a rule as it is (extinction
+%   0), a reinforcer when no necessity is active lowers it (satiation 1).
+test(no_extinction_and_satiation, [Fs == [a-1.5, b-1.0, c-0.5]]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    contingency_params(P0),
+    selectchk(extinction=_, P0, extinction=0.0, P1),
+    selectchk(satiation=_, P1, satiation=1.0, P),
+    relrl_contingency:contingency_init(KB),
+    forall(member(R-N-Reinforced, [a-hunger-true, b-hunger-false, c-none-true]),
+           ( relrl_contingency:contingency_choose(KB, 1, N, [R], P, R),
+             relrl_contingency:contingency_update(KB, 1, R, N, Reinforced, P) )),
+    relrl_contingency:contingency_rules(KB, Rules),
+    findall(R-F, member(behaviour(state(1), R, _, F), Rules), Fs).
+
+%   The roulette draws with those probabilities: 20,000 choices from the first stream's
+%   rules land on each response within 0.01 of its execution probability.
+test(roulette_draws_the_execution_probabilities, [true(Worst < 0.01)]) :-
+    contingency_params(P),
+    stream_kb(P, KB),
+    relrl_contingency:contingency_probabilities(KB, 1, hunger, [a, b, c], P, Probabilities),
+    set_random(seed(5)),
+    N = 20000,
+    findall(A, ( between(1, N, _),
+                 relrl_contingency:contingency_choose(KB, 1, hunger, [a, b, c], P, A) ), As),
+    findall(D, ( member(R-Pr, Probabilities),
+                 aggregate_all(count, member(R, As), C),
+                 D is abs(C / N - Pr) ), Ds),
+    max_list(Ds, Worst).
 
 :- end_tests(contingency).
 

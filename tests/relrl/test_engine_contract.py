@@ -310,16 +310,28 @@ def test_a_directive_in_a_policy_is_refused_and_never_runs(tmp_path: Path) -> No
 
 
 @pytest.mark.parametrize("extra,message", [
-    ("evil(X) :- shell(X).", r"p\.pl:\d+: evil/1 is not part of a etg policy \(refused\)"),
-    ("etg_node(9, leaf(abc, [])).", r"bad policy: Type error: `nonneg' expected, found `abc'"),
-    ("etg_node(9, leaf(none, [e(a, high, hunger)])).", r"bad policy: Domain error"),
-    ("etg_node(9, test(0, shell(rm), nil, nil)).", r"bad policy: Domain error: `etg_test\(0\)'"),
+    ("evil(X) :- shell(X).", r"p\.pl:{line}: evil/1 is not part of a etg policy \(refused\)"),
+    ("etg_node({n}, leaf(abc, [])).", r"p\.pl:{line}: leaf {n}: its state abc is not a state"),
+    ("etg_node({n}, leaf(none, [e(a, high, hunger)])).",
+     r"p\.pl:{line}: leaf {n}: the Q of a high is not a number"),
+    ("etg_node({n}, leaf(none, [e(halt, 1.0, hunger)])).",
+     r"p\.pl:{line}: leaf {n}: halt is not a response of this domain"),
+    ("etg_node({n}, leaf(none, [e(a, 1.0, thirst)])).",
+     r"p\.pl:{line}: leaf {n}: thirst is not a necessity of this domain"),
+    ("etg_node({n}, test(0, shell(rm), nil, nil)).",
+     r"p\.pl:{line}: node {n}: test 0 is stimulus\(light\) in this domain, not shell\(rm\)"),
+    ("etg_node(9, leaf(none, [])).", r"p\.pl:{line}: node id 9 is out of range: this policy "
+                                     r"has {n1} nodes, ids 0 to {n}"),
 ])
 def test_foreign_or_malformed_policy_terms_are_refused(tmp_path: Path, extra: str,
                                                        message: str) -> None:
+    """Each bad term is refused with the line it is on ({n}: the next node id)."""
     kb, agent, path = _etg_policy(tmp_path)
-    path.write_text(path.read_text() + extra + "\n")
-    with pytest.raises(PolicyError, match=message):
+    text = path.read_text()
+    n = text.count("etg_node(")
+    path.write_text(text + extra.format(n=n) + "\n")
+    line = len(text.splitlines()) + 1
+    with pytest.raises(PolicyError, match=message.format(line=line, n=n, n1=n + 1)):
         agent.learner.load(path)
     kb.close()
 

@@ -54,6 +54,27 @@ def test_contingency_prefers_the_rewarded_responses() -> None:
     agent.kb.close()
 
 
+def test_contingency_as_execution_probabilities_reaches_its_cap() -> None:
+    """With fitness read as an execution probability (max_fitness 1, the paper-2012 preset)
+    no rule rises above 1, wrong responses fall to the lower bound, and the right response
+    is chosen with the wheel's cap, 1 / (1 + 2 x 0.05) = 0.91 among three responses."""
+    agent = trained("contingency", max_fitness=1.0)
+    fitness = [f for _, _, _, f in agent.learner.rules()]
+    assert max(fitness) == 1.0 and min(fitness) == 0.05
+    assert greedy_accuracy(agent, 2000) == pytest.approx(1 / 1.1, abs=0.03)
+    agent.kb.close()
+
+
+@pytest.mark.parametrize("params,message", [
+    ({"default_always": 0.5}, "default_always must be 0 or 1"),
+    ({"satiation": 2}, "satiation must be 0 or 1"),
+    ({"extinction": -1}, "extinction must be in [0, 1]"),
+])
+def test_contingency_readings_are_checked(params: dict, message: str) -> None:
+    with pytest.raises(ConfigError, match=message.replace("[", r"\[").replace("]", r"\]")):
+        make_learner("contingency", **params)
+
+
 def test_untrained_learner_is_near_chance() -> None:
     agent = trained("etg", steps=0)
     acc = greedy_accuracy(agent, 600)

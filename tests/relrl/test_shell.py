@@ -341,3 +341,56 @@ def test_terminal_ctrl_c_stops_the_query_at_once(tmp_path: Path) -> None:
         if terminal.proc.poll() is None:
             terminal.proc.kill()
             terminal.close()
+
+
+# -- [user] and :learner ----------------------------------------------------------------------
+
+def test_clauses_typed_after_user_load_as_a_file_named_user(shell, capfd) -> None:
+    """``[user].`` reads the clauses that follow (to end_of_file. or the end of input) and
+    loads them; it used to print "ERROR: iri_scheme `user' does not exist" first and leave
+    the lines to run as queries."""
+    sh, out = shell
+    sh.run_lines(["[user].\n", "foo(1).\n", "foo(2).\n", "end_of_file.\n", "foo(X).\n",
+                  "consult(user).\n", "foo(3).\n"])
+    sh.run_lines(["foo(X).\n"])
+    assert out.getvalue() == "true.\nX = 1 ;\nX = 2.\ntrue.\nX = 3.\n"
+    assert sh.errors == 0 and "iri_scheme" not in capfd.readouterr().err
+
+
+def test_user_clauses_with_an_error_load_nothing_and_name_the_line(shell) -> None:
+    sh, out = shell
+    sh.run_lines(["[user].\n", "bar(1).\n", "bar(2\n"])
+    sh.run_lines(["bar(X).\n"])
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("error: user:2: Syntax error") and "(nothing loaded)" in lines[0]
+    assert lines[1].startswith("error: Unknown procedure: bar/1"), lines
+
+
+def test_user_without_input_is_one_error(shell) -> None:
+    sh, out = shell
+    sh.execute("[user].")
+    assert out.getvalue() == "error: [user] reads clauses from the input, and this shell " \
+                             "has none\n"
+
+
+def test_a_fresh_learner_keeps_working_memory_at_its_ages() -> None:
+    """``:learner NAME`` starts a run, which empties working memory: the shell puts it
+    back, each element at its age (it used to leave memory empty, and :explain showed
+    state 0), and says so; :help says so too."""
+    from relrl import policy  # noqa: F401  (registers :learner)
+
+    with KnowledgeBase(ROOT / "tests" / "data" / "memory_facts.pl") as kb:
+        out = io.StringIO()
+        sh = Shell(kb, out, timeout=5)
+        sh.run_lines([":add see(s)\n", ":add see(t)\n", ":memory\n"])
+        before = out.getvalue().split("inserted 1 element\n")[-1]
+        code = kb.state_code()
+        out.truncate(0)
+        out.seek(0)
+        sh.run_lines([":learner etg\n", ":memory\n", ":explain\n", ":help\n"])
+        text = out.getvalue()
+        assert "learner etg ready (working memory kept: 2 elements; the necessity units " \
+               "start afresh)" in text
+        assert before and before in text
+        assert f"state {code} " in text and code != 0
+        assert "working memory is kept" in text.split(":learner NAME")[1].splitlines()[0]

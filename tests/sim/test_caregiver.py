@@ -145,6 +145,28 @@ def test_looking_away_and_back_cannot_farm_attention(during_gaze: bool) -> None:
     assert bool(per_opportunity) == during_gaze   # without it, no eye contact: no attention
 
 
+def test_the_2012_caregiver_attends_every_time_unit_of_mutual_gaze() -> None:
+    """``attention_per_unit`` (the ``paper_2012`` model): looking at the face pays at once,
+    in every time unit of the wait for eye contact, and looking away and back pays again."""
+    cg = ProtocolCaregiver(make_caregiver("paper_2012").params)
+    cg.reset(np.random.default_rng(0), 1)
+    assert cg.params.attention_per_unit
+    attended = []
+    for focus in (C, 2, C, C, C):       # on the face, away, back for three units: contact
+        cg.update(focus)
+        attended.append(cg.attention)
+    assert attended == [True, False, True, True, True] and cg.contact
+    cg.update(C)                        # toys out, the caregiver turns: nothing for the face
+    assert cg.phase == ATTEND and not cg.attention
+    cg.update(cg.target)                # gaze following is rewarded as before
+    assert cg.attention
+    farmed = []
+    for t in range(100):                # the loophole is open again: half the time units pay
+        cg.update(C if t % 2 == 0 else 3)
+        farmed.append(cg.attention)
+    assert sum(farmed) == 50 and cg.opportunity > 1
+
+
 def test_looking_away_breaks_the_streak() -> None:
     cg = start(focus=C)
     cg.update(C)

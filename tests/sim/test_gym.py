@@ -125,3 +125,69 @@ def test_the_tabular_example_learns_and_reports_the_protocols_cgi() -> None:
     result = module.main(["--steps", "20000", "--seed", "1"])
     assert result["cgi"] > 0.8 and result["rows"] > 5
     assert np.isfinite(result["cgi_literal"])
+
+
+#: what a Discrete action space contains besides a Python int: numpy integers and 0-d
+#: integer arrays (Stable-Baselines3's ``model.predict(obs)`` returns ``np.array(a)``), bool.
+CONTAINED = [np.array(0), np.array(3, dtype=np.int32), np.array(5, dtype=np.int8),
+             np.int64(2), np.int16(4), np.uint8(1), True, 1]
+
+
+@pytest.mark.parametrize("env_id", [ENV_ID, ENV_ID_V1])
+def test_step_takes_everything_the_action_space_contains(env_id: str) -> None:
+    """Through ``gym.make`` (its checker and wrappers) as a training loop calls it."""
+    env = gym.make(env_id)
+    env.reset(seed=0)
+    places = env.unwrapped.places
+    for action in CONTAINED:
+        assert env.action_space.contains(action), action
+        env.step(action)
+        assert env.unwrapped.focus == places[int(action)], action
+
+
+def test_a_stable_baselines3_style_loop_runs() -> None:
+    """The loop of SB3's documentation: ``action, _ = model.predict(obs)`` gives a 0-d
+    integer array for one observation, stepped as it is (it used to raise)."""
+    def predict(obs: np.ndarray) -> tuple[np.ndarray, None]:  # SB3's predict, its shapes
+        batch = np.asarray([int(obs[0]) % 6])                 # one action per observation
+        return batch.squeeze(axis=0), None
+
+    env = gym.make(ENV_ID, max_steps=50)
+    obs, _ = env.reset(seed=1)
+    for _ in range(50):
+        action, _states = predict(obs)
+        assert isinstance(action, np.ndarray) and action.shape == ()
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            obs, _ = env.reset()
+    check_env(env.unwrapped, skip_render_check=True)
+
+
+@pytest.mark.parametrize("bad", [1.0, np.array([0]), np.array(0.0), np.uint64(1), 6,
+                                 np.array(6), None])
+def test_what_the_action_space_does_not_contain_is_refused(bad) -> None:
+    from relrl.sim.errors import InvalidResponse
+
+    env = gym.make(ENV_ID)
+    env.reset(seed=0)
+    assert not env.action_space.contains(bad)
+    with pytest.raises(InvalidResponse, match="not a response of the SIS"):
+        env.step(bad)
+
+
+@pytest.mark.parametrize("options, message", [
+    (5, r"options=5: use a dict such as \{'focus': 'centre'\}"),
+    ("focus", r"options='focus': use a dict"),
+    ({"fokus": "left"}, r"unknown reset option 'fokus'; did you mean 'focus'\?"),
+])
+def test_reset_options_that_are_not_a_dict_of_known_options(options, message: str) -> None:
+    """``reset(options=5)`` used to end in an AttributeError; a misspelt option was ignored."""
+    from relrl.sim.errors import SimError
+
+    env = gym.make(ENV_ID)
+    with pytest.raises(SimError, match=message):
+        env.reset(seed=0, options=options)
+    env.reset(seed=0, options={"focus": "left"})
+    assert env.unwrapped.focus == "left"
+    env.reset(seed=0, options=None)
+    env.reset(seed=0, options={})

@@ -21,6 +21,7 @@ params = st.builds(
     contact_timeout=st.one_of(st.none(), st.integers(4, 12)),
     attention_on_contact=st.booleans(),
     attention_during_gaze=st.booleans(),
+    attention_per_unit=st.booleans(),
     single_look=st.booleans(),
     target_sequence=st.one_of(st.none(), st.lists(st.sampled_from(TOY_PLACES), min_size=1,
                                                   max_size=5).map(tuple)),
@@ -46,7 +47,8 @@ def test_invariants(p: CaregiverParams, actions: list[int], seed: int) -> None:
             assert rec.gaze == "frontal" and rec.toys == ()
         if rec.attention:   # attention only for the face (once) or for looking at the target
             assert ((rec.contact and p.attention_on_contact)
-                    or (p.attention_during_gaze and rec.focus == "centre")
+                    or ((p.attention_during_gaze or p.attention_per_unit)
+                        and rec.focus == "centre")
                     or rec.focus == rec.target)
         if rec.contact:
             assert rec.phase == "engage" and rec.focus == "centre"
@@ -55,7 +57,10 @@ def test_invariants(p: CaregiverParams, actions: list[int], seed: int) -> None:
         if p.reliability == 1.0 and rec.phase == "attend":
             assert rec.gaze == rec.target
     face_attention = Counter(r.opportunity for r in trace if r.attention and r.phase == "engage")
-    assert all(n == 1 for n in face_attention.values())   # at most once per opportunity
+    if not p.attention_per_unit:   # at most once per opportunity (the 2012 caregiver: each unit)
+        assert all(n == 1 for n in face_attention.values())
+    else:
+        assert all(r.attention for r in trace[1:] if r.phase == "engage" and r.focus == "centre")
     m = GazeMetrics(hold=p.contact_hold).extend(trace)
     contacts = sum(r.contact for r in trace)
     assert m.eye_contacts().established == contacts   # the metric agrees with the caregiver
