@@ -20,6 +20,10 @@ A recorded session (``--out DIR --record``) is one MCAP file beside the run's ou
     domain.pl        the domain
     trace.jsonl      one StepView per time unit (``--out``; the frame index when one was
                      recorded)
+    events.out.tfevents.relrl
+                     the time units' scalars for TensorBoard (``--out``: reward, the
+                     necessity units' outputs, running CGI, eye contacts, working memory;
+                     each evaluation's CGI, each naming execution's outcomes)
     summary.json, timing.json, policy, plots, run.log
 
 ``relrl replay DIR`` (or ``relrl replay DIR/session.mcap``) serves the monitor's page over
@@ -39,6 +43,7 @@ from typing import Any
 from relrl.episodes.provenance import provenance
 from relrl.monitor.tap import TreeWatch, leaf_of
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
+from relrl.tensorboard import EVENT_FILE, ScalarLog
 
 __all__ = ["RECORDING", "SessionTap", "write_manifest"]
 
@@ -64,6 +69,15 @@ class _Rate:
     def took(self) -> None:
         if self.rate > 0:
             self._next = time.perf_counter() + 1.0 / self.rate
+
+
+def _scalars(row: dict[str, Any]) -> dict[str, Any]:
+    """A trace row's numbers for TensorBoard (what is not a number is left out there)."""
+    metrics = row.get("metrics") or {}
+    return {"reward": row.get("reward"), "memory/working_memory": row.get("memory_size"),
+            **{f"necessity/{k}": v for k, v in (row.get("activation") or {}).items()},
+            **{f"gaze/{k}": metrics.get(k) for k in ("cgi", "shifts", "eye_contacts",
+                                                     "opportunities")}}
 
 
 def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
@@ -116,6 +130,7 @@ class SessionTap:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
         self.trace = open(out / "trace.jsonl", "w", encoding="utf-8") \
             if out is not None else None  # noqa: SIM115
+        self.scalars = ScalarLog(out / EVENT_FILE) if out is not None else None
         self.recording = record and out is not None
         self.recorder, self._own = recorder, False
         self.quality = int(record_quality)
@@ -205,6 +220,7 @@ class SessionTap:
         if self.trace is not None:
             self.trace.write(line + "\n")
             self.trace.flush()
+            self.scalars.add(run.t, _scalars(row))
         if publish:
             hub.publish(dict(row), frame)
         if sent:  # the writer process encodes the channels from the line
@@ -228,7 +244,15 @@ class SessionTap:
             self.recorder.tree(t, self.tree.graph)
 
     def event(self, kind: str, **data: Any) -> None:
-        """A session event (evaluation, naming execution) for the monitor and the recording."""
+        """A session event (evaluation, naming execution) for the monitor, the recording and
+        TensorBoard (an evaluation at its time unit, a naming execution at its number)."""
+        if self.scalars is not None:
+            if kind == "evaluation":
+                self.scalars.add(self.run.t, {"evaluation/cgi_mean": data.get("cgi_mean"),
+                                              "evaluation/cgi_std": data.get("cgi_std")})
+            elif kind == "naming":
+                self.scalars.add(data.get("execution", 0), {
+                    f"naming/{k}": v for k, v in (data.get("counts") or {}).items()})
         if self.hub is not None:
             self.hub.event(kind, t=self.run.t, **data)
         if self.recorder is not None:
@@ -270,3 +294,5 @@ class SessionTap:
                 self.recorder.close()
             if self.trace is not None and not self.trace.closed:
                 self.trace.close()
+            if self.scalars is not None:
+                self.scalars.close()

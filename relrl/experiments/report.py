@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 __all__ = ["aggregate", "cgi_figure", "plot", "pyplot_or_note", "skip_plots", "summary_table",
-           "write_json_atomic", "write_outputs"]
+           "tensorboard_runs", "write_json_atomic", "write_outputs"]
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -160,8 +160,38 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
                                             else f"{groups[g][p]:.6f}"
                                             for g in ("trained", "held_out")])
         written.append(places)
+    written += tensorboard_runs(out_dir, results)
     written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
+
+
+def _curve_scalars(c: dict[str, Any]) -> dict[str, Any]:
+    """An evaluation point's scalars for TensorBoard."""
+    memory = c.get("memory") or {}
+    return {"cgi/mean": c["cgi_mean"], "cgi/std": c.get("cgi_std"),
+            "cgi_literal/mean": c["cgi_literal_mean"],
+            **{f"memory/{k}": v for k, v in memory.items()}}
+
+
+def tensorboard_runs(out_dir: Path, results: dict[str, Any]) -> list[Path]:
+    """The curves as TensorBoard runs (``tensorboard --logdir OUT/tensorboard``): one per
+    learner, pooled over seeds (CGI at each evaluation point by learning time units, the
+    cumulative eye contacts by opportunity), and one per job, ``LEARNER-seedS`` (its CGI
+    and memory at each point)."""
+    from relrl.tensorboard import write_event_file
+
+    base = out_dir / "tensorboard"
+    files = []
+    for name, s in results["summary"].items():
+        points = [(c["learning_steps"], _curve_scalars(c)) for c in s["curve"]]
+        points += [(i, {"eye_contacts/cumulative": v}) for i, v in
+                   enumerate(s["eye_contacts"]["cumulative_mean"], start=1)]
+        files.append(write_event_file(base / name, points))
+    for job in results["jobs"]:
+        files.append(write_event_file(base / f"{job['learner']}-seed{job['seed']}",
+                                      [(c["learning_steps"], _curve_scalars(c))
+                                       for c in job["curve"]]))
+    return files
 
 
 def skip_plots(out_dir: Path) -> list[Path]:
