@@ -51,38 +51,30 @@ def _world(values: dict[str, Any]) -> str:
 #: per experiment: a config field -> (the option's dest, its recorded value as the option's
 #: parsed value); fields put back as recorded unless their option (the dest named, if any)
 #: is typed -- the domain's path as written, not resolved again; fields derived from others.
+_PARAMS = ("param", lambda v: [(lr, k, x) for lr, ps in v.items() for k, x in ps.items()])
+#: the settings both experiments have (``relrl.cli.experiment._common``'s options).
+_COMMON: dict[str, tuple[str, Any]] = {
+    "learners": ("learners", _joined), "seeds": ("seeds", _joined),
+    "block": ("block", None), "eval_runs": ("eval_runs", None),
+    "eval_steps": ("eval_steps", None), "caregiver": ("caregiver", None),
+    "caregiver_params": ("caregiver_param", lambda v: list(v.items())),
+    "learner_params": _PARAMS, "eval_policy": ("eval_policy", None),
+    "timeout": ("timeout", None),
+}
 RECORDABLE: dict[str, dict[str, Any]] = {
     "sis": {
-        "options": {
-            "learners": ("learners", _joined), "seeds": ("seeds", _joined),
-            "points": ("points", None), "block": ("block", None),
-            "eval_runs": ("eval_runs", None), "eval_steps": ("eval_steps", None),
-            "caregiver": ("caregiver", None),
-            "caregiver_params": ("caregiver_param", lambda v: list(v.items())),
-            "learner_params": ("param", lambda v: [(lr, k, x) for lr, ps in v.items()
-                                                   for k, x in ps.items()]),
-            "eval_policy": ("eval_policy", None), "timeout": ("timeout", None),
-            "train_places": ("train_places", _joined),
-            "eval_places": ("eval_places", _joined), "preset": ("preset", None),
-        },
+        "options": {**_COMMON, "points": ("points", None),
+                    "train_places": ("train_places", _joined),
+                    "eval_places": ("eval_places", _joined), "preset": ("preset", None)},
         "kept": {"opportunities": None, "eval_caregiver_params": None, "domain": "domain"},
         "derived": ("caregiver_resolved", "eval_caregiver_resolved", "setting"),
     },
     "scaling": {
-        "options": {
-            "learners": ("learners", _joined), "seeds": ("seeds", _joined),
-            "sizes": ("sizes", _joined), "world": ("world", _world),
-            "caregiver": ("caregiver", None),
-            "caregiver_params": ("caregiver_param", lambda v: list(v.items())),
-            "learner_params": ("param", lambda v: [(lr, k, x) for lr, ps in v.items()
-                                                   for k, x in ps.items()]),
-            "budget": ("budget", None), "block": ("block", None),
-            "eval_runs": ("eval_runs", None), "eval_steps": ("eval_steps", None),
-            "threshold": ("threshold", None), "patience": ("patience", None),
-            "eval_policy": ("eval_policy", None), "timeout": ("timeout", None),
-            "transfer": ("transfer", None), "transfer_sizes": ("transfer_sizes", _joined),
-            "holdout": ("holdout", None),
-        },
+        "options": {**_COMMON, "sizes": ("sizes", _joined), "world": ("world", _world),
+                    "budget": ("budget", None), "threshold": ("threshold", None),
+                    "patience": ("patience", None), "transfer": ("transfer", None),
+                    "transfer_sizes": ("transfer_sizes", _joined),
+                    "holdout": ("holdout", None)},
         "kept": {},
         "derived": ("worlds", "caregiver_resolved"),
     },
