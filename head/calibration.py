@@ -324,6 +324,8 @@ def load_calibration(path: str | Path | None = None) -> Calibration:
     if scripts_file is not None:
         if not isinstance(scripts_file, str):
             fail("head.scripts", f"{scripts_file!r} must be a file name")
+        if "\0" in scripts_file:
+            fail("head.scripts", f"{scripts_file!r} holds a NUL character; no file name can")
         spath = path.parent / scripts_file
         try:
             sdata = _read_toml(spath)

@@ -250,11 +250,13 @@ rule_listing(KB, Rules) :-
 
 %!  bias_listing(+KB, -Listing) is det.
 %
-%   Listing is bias(Relations, Refinements): the relation/1 templates of KB written as
-%   text, and the candidate tests the tg learner's refinement operator gives for an empty
-%   tree (strings), or bias([], []) for a domain without a language bias.
+%   Listing is bias(Relations, Refinements, Warnings): the relation/1 templates of KB
+%   written as text, the candidate tests the tg learner's refinement operator gives for an
+%   empty tree (strings), or [] for a domain without a language bias, and the warnings
+%   about the bias (tg_bias:bias_warning/2: a #Type whose constants grow with the world),
+%   problem(File, Line, Message) terms.
 
-bias_listing(KB, bias(Relations, Refinements)) :-
+bias_listing(KB, bias(Relations, Refinements, Warnings)) :-
     findall(S, ( declared(KB, relation(T)),
                  copy_term(T, T1),
                  term_variables(T1, Vs),
@@ -265,4 +267,5 @@ bias_listing(KB, bias(Relations, Refinements)) :-
     (   declared(KB, rmode(_))
     ->  root_refinements(KB, Refinements)
     ;   Refinements = []
-    ).
+    ),
+    findall(W, bias_warning(KB, W), Warnings).

@@ -7,7 +7,7 @@
             engine_graph/2,           % +KB, -Graph
             engine_knowledge/2,       % +KB, -Terms
             engine_size/2,            % +KB, -Size
-            engine_save/3,            % +KB, +File, +Header
+            engine_policy/3,          % +KB, +Header, -Text
             engine_snapshot/2,        % +KB, -Snapshot
             engine_restore/2,         % +KB, +Snapshot
             engine_keep/2,            % +KB, +Slot
@@ -18,8 +18,10 @@
             engine_param/3,           % +KB, ?Name, ?Value
             engine_params/2,          % +KB, -Params
             engine_config/3,          % +KB, ?Key, ?Value
+            engine_policy_info/2,     % +KB, -Info
             engine_learner/2,         % +KB, -Learner
             engine_responses/2,       % +KB, -Responses
+            engine_all_allowed/2,     % +KB, +Allowed
             engine_necessities/2,     % +KB, -Necessities
             engine_holds/2,           % +KB, +Goal
             engine_relational_state/2 % +KB, -Facts
@@ -55,6 +57,7 @@ touches its own file and one line of learners.pl.
 
   | learner(Name)                                   | registers Name                         |
   | learner_property(Name, external)                | Python chooses (Q-learning over numpy) |
+  | learner_property(Name, view(relational))        | reads the relational view only: no state code is computed for it (a step reports code 0) |
   | learner_init(Name, KB, Params)                  | start afresh                           |
   | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
   | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
@@ -64,6 +67,7 @@ touches its own file and one line of learners.pl.
   | learner_save(Name, KB, Stream)                  | write the learned knowledge as clauses |
   | learner_policy_term(Name, Term)                 | Term may appear in Name's policy file  |
   | learner_restore(Name, KB, Terms)                | rebuild from policy terms (data)       |
+  | learner_policy_info(Name, KB, Info)             | optional: what a policy is tied to in the domain (default: its features and responses) |
   | learner_text(Name, KB, Text)                    | optional: the knowledge as text        |
   | learner_graph(Name, KB, graph(Nodes, Edges))    | optional: a tree as a graph            |
   | learner_knowledge(Name, KB, Terms)              | optional: the knowledge as terms       |
@@ -104,6 +108,7 @@ gateway can name the rule.
     learner_save/3,
     learner_policy_term/2,
     learner_restore/3,
+    learner_policy_info/3,
     learner_text/3,
     learner_graph/3,
     learner_knowledge/3,
@@ -115,7 +120,9 @@ gateway can name the rule.
 %   so one KB never sees another's), holding engine(Run, Prev, Random):
 %     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
 %               Necessities, Plan) — fixed for a run, read without copying; Plan is the
-%               state code's plan (relrl_state:state_plan/4)
+%               state code's plan (relrl_state:state_plan/4), or relational(Plan) for a
+%               learner that reads the relational view only (the plan then only tells
+%               whether a reinforcer is sensed)
 %     Prev    prev(State, Necessity) of the last step, or none
 %     Random  the KB's random state, while the generator does not hold it (see
 %             random_owner/1: while it does, the generator's state is the KB's)
@@ -247,6 +254,18 @@ engine_config(KB, Key, Value) :-
 engine_responses(KB, Responses) :-
     run(KB, run(_, _, _, Responses, _, _, _, _, _)).
 
+%!  engine_all_allowed(+KB, +Allowed:list) is semidet.
+%
+%   Allowed, the allowed responses a learner hook was given, is the engine's own list of
+%   every response of KB (no constraint rule forbids one this step): a test in constant
+%   time (the same term), for a learner that need not look at the responses one by one
+%   then. Fails when it is not, or when KB has no engine.
+
+engine_all_allowed(KB, Allowed) :-
+    engine_key(KB, Key),
+    nb_current(Key, engine(run(_, _, _, Responses, _, _, _, _, _), _, _)),
+    Responses == Allowed.
+
 %!  engine_necessities(+KB, -Necessities:list) is det.
 %
 %   The necessities in declaration order (the order of a step's unit outputs).
@@ -279,12 +298,14 @@ engine_configure(KB, Learner, Params, Seed) :-
     state_mark(StateMark),                            % once this one is in place
     motivation_units(KB, Units0),
     motivation_compiled(KB, Units0, Units),
-    state_plan(KB, Features, Reinforcers, Plan),
+    state_plan(KB, Features, Reinforcers, Plan0),
+    (   learner_property(Learner, view(relational))
+    ->  Plan = relational(Plan0)
+    ;   Plan = Plan0
+    ),
     (   has_constraints(KB)
     ->  Constraints = true
-    ;   findall(I, nth0(I, Responses, _), AllIx),     % no constraint rules: all allowed,
-        foldl(set_bit, AllIx, 0, AllMask),            % always (computed once)
-        Constraints = none(AllIx, AllMask)
+    ;   Constraints = none                            % no constraint rules: all allowed
     ),
     fresh_random(Seed, Random),
     engine_key(KB, Key),
@@ -378,9 +399,11 @@ engine_forget(KB) :-
 %   explain (the learner's explanation for this step's state).
 %
 %   Out = step(Code, Necessity, Ys, Reward, Reinforced, Allowed, Action, Extras): the state
-%   code, the active necessity (or none), the necessity units' outputs (a list in
+%   code (0 for a learner with learner_property(L, view(relational)), which never reads
+%   it), the active necessity (or none), the necessity units' outputs (a list in
 %   declaration order), the reward for the previous response, true/false, the allowed
-%   responses as a bit mask (bit i set when response i is allowed), the index of the
+%   responses as a bit mask (bit i set when response i is allowed; -1 when every response
+%   is, as always in a domain without constraint rules), the index of the
 %   learner's choice (-1 for a learner outside Prolog, or when nothing is allowed), and
 %   Extras, a list of Key-Value pairs for Want.
 
@@ -400,7 +423,7 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
         wm_insert(KB, [emitted(Emitted)|Percepts])
     ;   wm_insert(KB, Percepts)
     ),
-    plan_code(KB, Plan, Code, Reinforced),
+    view_code(KB, Plan, Code, Reinforced),
     learner_view(Learner, KB, Code, State),
     motivation_values(KB, Units, _, Ys, Active),
     (   Reinforced == true
@@ -424,6 +447,15 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
     ),
     extras(Want, KB, Learner, State, Active, Extras).
 
+%   The state code and whether a reinforcer is sensed; for a learner that reads the
+%   relational view only, no code (0): the engine does not compute what no one reads.
+view_code(KB, Plan, Code, Reinforced) :-
+    (   Plan = relational(Plan0)
+    ->  Code = 0,
+        plan_reinforced(KB, Plan0, Reinforced)
+    ;   plan_code(KB, Plan, Code, Reinforced)
+    ).
+
 learner_view(Learner, KB, Code, State) :-
     (   learner_state(Learner, KB, Code, State0)
     ->  State = State0
@@ -443,10 +475,12 @@ extra(KB, Learner, State, N, explain, [explain-E|T], T) :- !,
 extra(_, _, _, _, What, _, _) :-
     domain_error(step_report, What).
 
+%   Mask is -1 when every response is allowed (no constraint rules): a world with many
+%   responses does not pay for a mask of as many bits every step.
 allowed(KB, Constraints, Responses, Allowed, Mask) :-
-    (   Constraints = none(_, AllMask)
+    (   Constraints == none
     ->  Allowed = Responses,
-        Mask = AllMask
+        Mask = -1
     ;   allowed_(Responses, KB, 0, Allowed, 0, Mask)
     ).
 
@@ -460,9 +494,6 @@ allowed_([R|Rs], KB, I, Allowed, Mask0, Mask) :-
     ),
     I1 is I + 1,
     allowed_(Rs, KB, I1, Allowed1, Mask1, Mask).
-
-set_bit(I, M0, M) :-
-    M is M0 \/ (1 << I).
 
 forbidden(KB, R) :-
     engine_holds(KB, forbidden(R)).
@@ -500,7 +531,7 @@ engine_explain(KB, When, Explanation) :-
     (   When == last,
         engine(KB, engine(_, prev(State, N), _))
     ->  true
-    ;   plan_code(KB, Plan, Code),
+    ;   view_code(KB, Plan, Code, _),
         learner_view(Learner, KB, Code, State),
         motivation_peek(KB, Units, _, N)
     ),
@@ -609,30 +640,46 @@ engine_resume(KB, Slot) :-
 slot_key(KB, Slot, Key) :-
     atomic_list_concat(['$relrl_snap:', KB, ':', Slot], Key).
 
-%!  engine_save(+KB, +File, +Header:string) is det.
+%!  engine_policy_info(+KB, -Info:list) is det.
 %
-%   Write KB's learned knowledge to File: a comment, relrl_policy(Learner, Info) with the
-%   domain's features and responses, then the learner's own clauses. Plain swipl consults
-%   the file; relrl reads it back as data (policy.pl). The file is written next to File
-%   and renamed into place, so a reader never sees half a policy.
+%   What a policy of KB's learner is tied to in the domain, Key(Value) terms written in the
+%   policy's header (engine_policy/3) and compared with the loaded domain's when a policy is
+%   read (policy.pl): the learner's learner_policy_info/3 (a relational learner: its
+%   relations and language bias, the same in every world of a family, so its policy loads
+%   in any of them), else [features(Features), responses(Responses)]. Each Key(Value) has
+%   one argument.
 
-engine_save(KB, File, Header) :-
+engine_policy_info(KB, Info) :-
     run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
-    atom_concat(File, '.tmp', Tmp),
-    setup_call_cleanup(
-        open(Tmp, write, S, [encoding(utf8)]),
-        write_policy(S, KB, Learner, Features, Responses, Header),
-        close(S)),
-    rename_file(Tmp, File).
+    (   learner_policy_info(Learner, KB, Info0)
+    ->  Info = Info0
+    ;   Info = [features(Features), responses(Responses)]
+    ).
 
-write_policy(S, KB, Learner, Features, Responses, Header) :-
+%!  engine_policy(+KB, +Header:text, -Text:string) is det.
+%
+%   Text is KB's learned knowledge as a policy file: a comment, relrl_policy(Learner, Info)
+%   with what the policy is tied to in the domain (engine_policy_info/2), then the learner's
+%   own clauses. Plain swipl consults the file; relrl reads it back as data (policy.pl).
+%   Python writes Text to disk through relrl's one writer (atomic, never through a link).
+
+engine_policy(KB, Header, Text) :-
+    must_be(text, Header),
+    engine_learner(KB, Learner),
+    engine_policy_info(KB, Info),
+    with_output_to(string(Text),
+                   (   current_output(S),
+                       write_policy(S, KB, Learner, Info, Header)
+                   )).
+
+write_policy(S, KB, Learner, Info, Header) :-
     split_string(Header, "\n", "", Lines),
     forall(member(L, Lines), format(S, "% ~w~n", [L])),
     format(S, "% Consult in plain swipl, or load with: relrl shell DOMAIN.pl --policy FILE~n",
            []),
     format(S, "% relrl reads this file as data: a directive or a foreign clause is refused.~n~n",
            []),
-    portray_clause(S, relrl_policy(Learner, [features(Features), responses(Responses)])),
+    portray_clause(S, relrl_policy(Learner, Info)),
     nl(S),
     (   learner_save(Learner, KB, S)
     ->  true

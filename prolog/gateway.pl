@@ -228,7 +228,7 @@ python_api(relrl_engine:engine_text/2).
 python_api(relrl_engine:engine_graph/2).
 python_api(relrl_engine:engine_knowledge/2).
 python_api(relrl_engine:engine_size/2).
-python_api(relrl_engine:engine_save/3).
+python_api(relrl_engine:engine_policy/3).
 python_api(relrl_engine:engine_keep/2).
 python_api(relrl_engine:engine_resume/2).
 python_api(relrl_engine:engine_reseed/2).

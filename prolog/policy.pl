@@ -13,12 +13,15 @@
 
 /** <module> Reading a saved policy as data
 
-A policy file (written by engine_save/3) is Prolog that plain swipl can consult, but relrl
+A policy file (the text of engine_policy/3) is Prolog that plain swipl can consult, but relrl
 never consults it: a policy is data labs exchange, and loading one must never run anything.
 This module reads it term by term with read_term/3 and accepts only
 
-  - first, relrl_policy(Learner, Info), Info listing the features and responses of the
-    domain it was learned in (they must be the loaded domain's);
+  - first, relrl_policy(Learner, Info), Info listing what the policy is tied to in the
+    domain it was learned in (relrl_engine:engine_policy_info/2: its features and
+    responses, or a relational learner's relations and language bias, rmodes and rconsts);
+    they must be the
+    loaded domain's;
   - then terms the learner declares its own (learner_policy_term/2), which the learner
     rebuilds its knowledge from (learner_restore/3) after checking them as a whole.
 
@@ -210,25 +213,29 @@ read_error(File, S, E) :-
     ;   throw(E)
     ).
 
+%   The file's Info must hold every Key(Value) of the loaded domain's
+%   (relrl_engine:engine_policy_info/2: features and responses, or what the learner's
+%   policy is tied to), each the same up to variable names.
 check_info(KB, File, Line, Info) :-
-    engine_config(KB, features, Features),
-    engine_config(KB, responses, Responses),
-    (   memberchk(features(F), Info), memberchk(responses(R), Info)
+    engine_policy_info(KB, Ours),
+    maplist(check_info_item(File, Line, Info), Ours).
+
+check_info_item(File, Line, Info, Item) :-
+    Item =.. [Key, Value],
+    Theirs0 =.. [Key, Theirs],
+    (   memberchk(Theirs0, Info)
     ->  true
-    ;   policy_error(File, Line, "relrl_policy/2 does not list the domain's features and \c
-                     responses (a policy of an older relrl?)", [])
+    ;   policy_error(File, Line, "relrl_policy/2 does not list the domain's ~w (a policy \c
+                     of an older relrl?)", [Key])
     ),
-    (   F =@= Features
+    (   Theirs =@= Value
     ->  true
-    ;   first_difference(F, Features, Theirs, Ours),
-        policy_error(File, Line, "learned for another domain: its features differ from the \c
-                     loaded domain's (~q in the policy, ~q in the domain)", [Theirs, Ours])
-    ),
-    (   R =@= Responses
-    ->  true
-    ;   first_difference(R, Responses, Theirs, Ours),
-        policy_error(File, Line, "learned for another domain: its responses differ from the \c
-                     loaded domain's (~q in the policy, ~q in the domain)", [Theirs, Ours])
+    ;   is_list(Theirs), is_list(Value)
+    ->  first_difference(Theirs, Value, T1, O1),
+        policy_error(File, Line, "learned for another domain: its ~w differ from the \c
+                     loaded domain's (~q in the policy, ~q in the domain)", [Key, T1, O1])
+    ;   policy_error(File, Line, "learned for another domain: its ~w differ from the \c
+                     loaded domain's", [Key])
     ).
 
 first_difference([X|Xs], [Y|Ys], A, B) :-

@@ -9,6 +9,7 @@
             state_plan/4,         % +KB, +Features, +Reinforcers, -Plan
             plan_code/3,          % +KB, +Plan, -Code
             plan_code/4,          % +KB, +Plan, -Code, -Reinforced
+            plan_reinforced/3,    % +KB, +Plan, -Reinforced
             state_mark/1,         % -Mark
             state_forget/1,       % +KB
             state_forget/2,       % +KB, +Mark
@@ -337,6 +338,20 @@ plan_code(KB, plan(Id, Program, Goals, Checked), Code, Reinforced) :-
         program_mask(Program, Code0, Code)
     ;   scan(Pairs, Id, Clock, false, 0, Code0, false, Reinforced),
         program_mask(Goals, Code0, Code)
+    ).
+
+%!  plan_reinforced(+KB, +Plan, -Reinforced) is det.
+%
+%   Reinforced is what plan_code/4 gives, without the state code: for an engine whose
+%   learner never reads the code.
+
+plan_reinforced(KB, plan(Id, _, _, _), Reinforced) :-
+    wm_stamped(KB, Clock, Pairs),
+    (   member(E-Stamp, Pairs),
+        Stamp =:= Clock,
+        plan_reinforcer_(Id, E)
+    ->  Reinforced = true
+    ;   Reinforced = false
     ).
 
 %   The pass over memory: the bits of the stimuli each element perceives and (Facts ==

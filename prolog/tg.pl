@@ -7,7 +7,8 @@
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
             tg_size/2,            % +KB, -Size
-            tg_candidates/3       % +KB, ?LeafId, -Texts
+            tg_candidates/3,      % +KB, ?LeafId, -Texts
+            tg_policy_info/2      % +KB, -Info
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -18,7 +19,9 @@
 :- use_module(tg_bias).
 :- use_module(tg_stats).
 :- use_module(tg_tree).
+:- use_module(tg_classes).
 :- reexport(tg_knowledge).
+:- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> TG: a first-order incremental regression-tree Q-learner
 
@@ -47,8 +50,11 @@ drift the leaf's own Q follows is not in the TD errors, so a split answers "is t
 estimate wrong on one side of this test?" rather than "were the targets on that side from
 another time?".
 
-Q(s, a) for each allowed response comes from sorting (s, a) down the tree; each step one
-example with Q-target r + gamma * max_a' Q(s', a') is inserted (no table of examples).
+Q(s, a) comes from sorting (s, a) down the tree. Choices and Q-targets are over classes of
+responses that no test of the bias tells apart in the state (tg_classes.pl), each scored by
+one representative: their number does not grow with the world. Each step one example with
+Q-target r + gamma * max_a' Q(s', a') is inserted; no table of examples is kept, only each
+leaf's last keep_examples examples, so that the children of a split start with statistics.
 
 The learner's state and the compiled tree are kept by tg_tree.pl; explanations, drawings,
 rules and policy files are tg_knowledge.pl's (re-exported here).
@@ -62,8 +68,8 @@ live in a global term per knowledge base and are updated in place (nb_setarg/3).
 Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise the rate
 is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
 epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus,
-half_life, novelty_bonus and novelty_confidence (see tg_choose/6); the engine's
-reward_positive and reward_negative.
+half_life, novelty_bonus and novelty_confidence (see tg_choose/6), keep_examples; the
+engine's reward_positive and reward_negative.
 */
 
 % ---- starting ------------------------------------------------------------------------------
@@ -77,21 +83,24 @@ tg_init(KB, Params) :-
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
                             min_examples, stale_bonus, half_life, novelty_bonus,
-                            novelty_confidence],
-            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf]),
+                            novelty_confidence, keep_examples],
+            [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf,
+             Keep0]),
+    Keep is max(0, round(Keep0)),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
     findall(R, kb_response(KB, R), Responses),
+    tg_response_index(Bias, Responses, Index),
     refinements(Bias, [], [], Cands),
     Root = leaf(1, [], [], Cands),
     length(Cands, K),
-    tg_new_stats(Qinit, 0, K, 0, L),
+    tg_new_stats(Qinit, 0, K, 0, Keep, L),
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
     atom_concat('$tg:', KB, DK),
     Half is max(0, round(Half0)),
     nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                       novelty(Beta, Conf)), Leaves0, none, 0, 0)),
+                       novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -125,14 +134,16 @@ tg_q(KB, Facts, Action, N, Q) :-
 
 %!  tg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
-%   Action is one of the Allowed responses. With Mode learn or explore: with temperature
-%   T > 0, drawn with probability proportional to exp(Q / T) (Boltzmann exploration);
-%   with T = 0, a random one with probability epsilon and otherwise a greedy one. With
-%   Mode greedy, one with the largest Q. Ties are broken at random. While learning (Mode
-%   learn), the Q of a leaf that no example has reached for the last K examples inserted
-%   in the tree counts as Q + stale_bonus * sqrt(K): a part of the Q-function that went
-%   stale while the rest moved is tried again (the exploration bonus of Sutton's Dyna-Q+,
-%   here per leaf).
+%   Action is one of the Allowed responses, chosen over the *classes* of responses no test
+%   of the language bias tells apart in the state Facts (tg_classes.pl): each class is
+%   scored by one representative, a class is chosen, and a member of it uniformly. With
+%   Mode learn or explore: with temperature T > 0, a class is drawn with probability
+%   proportional to exp(Q / T) (Boltzmann exploration); with T = 0, a random class with
+%   probability epsilon and otherwise a greedy one. With Mode greedy, one with the largest
+%   Q. Ties are broken at random. While learning (Mode learn), the Q of a leaf that no
+%   example has reached for the last K examples inserted in the tree counts as Q +
+%   stale_bonus * sqrt(K): a part of the Q-function that went stale while the rest moved is
+%   tried again (the exploration bonus of Sutton's Dyna-Q+, here per leaf).
 %
 %   Directed exploration (novelty_bonus Beta > 0, Mode learn): Q(s, a) counts as
 %   Q + tg_bonus/5, an upper confidence bound (UCB, optimism in the face of uncertainty)
@@ -149,29 +160,67 @@ tg_q(KB, Facts, Action, N, Q) :-
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     Allowed = [_|_],
     tg_data(KB, D),
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf)), Leaves, Cache,
-           Version, Clock),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
+           Version, Clock, Index),
+    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
+        A1 == Allowed
+    ->  Classes = Classes0, Ids = Ids0
+    ;   classes(KB, Index, Facts, Allowed, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  random_member(Action, Allowed)
-    ;   (   Cache = last(F1, N1, A1, Ids, Version), F1 == Facts, N1 == N, A1 == Allowed
-        ->  true
-        ;   maplist(sorted_leaf(KB, Facts, N), Allowed, Ids)
-        ),
-        (   Mode == learn, Beta > 0
-        ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)), Allowed,
-                    Ids, Qs)
+    ->  random_member(Class, Classes),
+        Noted = none
+    ;   (   Mode == learn, Beta > 0
+        ->  maplist(novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock)),
+                    Classes, Ids, Qs, Items)
         ;   Mode == learn, Kappa > 0
-        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
-        ;   maplist(leaf_q(Leaves), Ids, Qs)
+        ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs),
+            Items = Classes
+        ;   maplist(leaf_q(Leaves), Ids, Qs),
+            Items = Classes
         ),
         max_list(Qs, Best),
         (   Mode \== greedy, Tau > 0
-        ->  softmax_member(Qs, Allowed, Best, Tau, Action)
-        ;   ties(Qs, Allowed, Best, Ties),
-            random_member(Action, Ties)
+        ->  softmax_member(Qs, Items, Best, Tau, Item)
+        ;   ties(Qs, Items, Best, Ties),
+            random_member(Item, Ties)
+        ),
+        (   Item = hits(Class, Leaf, Hits)
+        ->  Noted = chose(Action, Leaf, Hits)
+        ;   Class = Item,
+            Noted = none
         )
+    ),
+    tg_class_member(Index, Class, Action),
+    (   Noted == none
+    ->  true
+    ;   note_choice(Cache, Facts, N, Version, Noted)
     ).
+
+%   The chosen action with the leaf and candidate hits of its class, found for its bonus,
+%   noted in the cache the update of this step made (Cache, for the same state and tree):
+%   the next update inserts this step's example — if the action emitted is the one chosen —
+%   which sorts to that leaf and succeeds on those candidates (every member of a class
+%   does), without testing them again.
+note_choice(Cache, Facts, N, Version, Noted) :-
+    (   Cache = last(F1, N1, _, _, _, Version, _), F1 == Facts, N1 == N
+    ->  nb_setarg(7, Cache, Noted)
+    ;   true
+    ).
+
+%   The classes of the Allowed responses in the state Facts; when no constraint rule
+%   forbids a response (Allowed is the engine's own list of every response) they come from
+%   the index without a pass over the responses.
+classes(KB, Index, Facts, Allowed, Classes) :-
+    (   engine_all_allowed(KB, Allowed)
+    ->  tg_classes(Index, Facts, Allowed, true, Classes)
+    ;   tg_classes(Index, Facts, Allowed, false, Classes)
+    ).
+
+class_leaf(KB, Facts, N, cls(A, _), Leaf) :-
+    tg_sort_(KB, Facts, A, N, Leaf).
 
 leaf_q(Leaves, Id, Q) :-
     arg(Id, Leaves, L),
@@ -183,11 +232,13 @@ bonus_q(Leaves, Kappa, Clock, Id, Q) :-
     arg(7, L, Last),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)).
 
-novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), A, Id, Q) :-
+novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), Class, Id, Q,
+        hits(Class, Id, Hits)) :-
+    Class = cls(A, _),
     arg(Id, Leaves, L),
     arg(1, L, Q0),
     arg(7, L, Last),
-    novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus),
+    novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Hits, Bonus),
     Q is Q0 + Kappa * sqrt(max(0, Clock - Last)) + Bonus.
 
 %!  tg_bonus(+KB, +Facts, +Action, +Necessity, -Bonus:number) is det.
@@ -196,11 +247,12 @@ novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), A, Id, Q) :-
 %   (tg_choose/6; 0 when novelty_bonus is 0).
 
 tg_bonus(KB, Facts, A, N, Bonus) :-
-    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf)), Leaves, _, _, Clock)),
+    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf), _), Leaves, _, _, Clock,
+                   _)),
     (   Beta > 0
     ->  tg_sort_(KB, Facts, A, N, Id),
         arg(Id, Leaves, L),
-        novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus)
+        novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), _, Bonus)
     ;   Bonus = 0
     ).
 
@@ -208,9 +260,10 @@ tg_bonus(KB, Facts, A, N, Bonus) :-
 %   yes-side of every candidate test that succeeds on it. For each, the counts, sums and
 %   sums of squares the leaf keeps give n (today's weights), Mean and Var of its TD errors;
 %   its upper confidence bound is Mean + Conf * sqrt(Var / n), capped at Beta, and Beta
-%   when n < 2. The bonus is the largest bound, and 0 when all are below 0.
-novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Bonus) :-
-    L = l(_, _, M, S, SS, C, _, Base),
+%   when n < 2. The bonus is the largest bound, and 0 when all are below 0. Hits are the
+%   candidates that succeed on the example.
+novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Hits, Bonus) :-
+    L = l(_, _, M, S, SS, C, _, Base, _),
     (   Half =:= 0
     ->  W = 1
     ;   W is 2 ** ((Clock - Base) / Half)       % stored units / W = today's weights
@@ -268,24 +321,29 @@ pick([W|Ws], [A|As], X, Action) :-
 %
 %   Learn from transition(S0, A0, N0, Reward, Reinforced, S1, N1, Allowed1): insert the
 %   example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the responses
-%   Allowed1 (over every response when none is allowed).
+%   Allowed1 (over every response when none is allowed). The max is taken over one
+%   representative of each class of responses (tg_classes.pl): the members of a class have
+%   the same Q.
 
 tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _), Leaves, _, Version, _),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, Cache0, Version, _, Index),
+    (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
+        M0 == N0, B0 == A0
+    ->  Known = sorted(Leaf0, Hits0)            % the choice sorted this example already
+    ;   Known = none
+    ),
     (   Allowed1 == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
-    maplist(sorted_leaf(KB, S1, N1), Next, Ids),
+    classes(KB, Index, S1, Next, Classes),
+    maplist(class_leaf(KB, S1, N1), Classes, Ids),
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    nb_setarg(3, D, last(S1, N1, Allowed1, Ids, Version)),
-    insert(KB, D, S0, A0, N0, Target).
-
-sorted_leaf(KB, Facts, N, A, Leaf) :-
-    tg_sort_(KB, Facts, A, N, Leaf).
+    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none)),
+    insert(KB, D, S0, A0, N0, Known, Target).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
@@ -296,15 +354,21 @@ sorted_leaf(KB, Facts, N, A, Leaf) :-
 
 tg_insert(KB, Facts, A, N, Target) :-
     tg_data(KB, D),
-    insert(KB, D, Facts, A, N, Target).
+    insert(KB, D, Facts, A, N, none, Target).
 
-insert(KB, D, Facts, A, N, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _), Leaves, _, _, Clock0),
+%   Known is sorted(Leaf, Hits) when the choice of this example's action found its leaf and
+%   candidate hits (note_choice/5), else none.
+insert(KB, D, Facts, A, N, Known, Target) :-
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
-    tg_sort_(KB, Facts, A, N, Leaf),
+    (   Known = sorted(Leaf, Hits)
+    ->  true
+    ;   tg_sort_(KB, Facts, A, N, Leaf),
+        tg_cands_(KB, Leaf, Facts, A, N, Hits)
+    ),
     arg(Leaf, Leaves, L),
-    L = l(Q0, N0, _, _, _, C, _, _),
+    L = l(Q0, N0, _, _, _, C, _, _, Ring),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
     nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
@@ -315,8 +379,8 @@ insert(KB, D, Facts, A, N, Target) :-
     S is S0 + W * E,
     SS is SS0 + W * E * E,
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
-    tg_cands_(KB, Leaf, Facts, A, N, Hits),
     count_hits(Hits, C, W, E),
+    keep_example(Ring, ex(Facts, A, N, E, Clock)),
     (   N1 /\ 3 =:= 0,                              % every fourth example
         MinW is MinEx * W,                          % min_examples in stored units
         M >= 2 * MinW,
@@ -329,8 +393,9 @@ insert(KB, D, Facts, A, N, Target) :-
         Corrected is Level * 3 / Arity,             % Bonferroni: level / candidates
         f_significant(FStat, Dof, Corrected)
     ->  M2t is Mt - M1t,
-        QYes is Q + S1 / M1, QNo is Q + (S - S1) / (M - M1),
-        split(KB, D, Leaf, I, s(M1t, QYes), s(M2t, QNo))
+        DYes is S1 / M1, DNo is (S - S1) / (M - M1),  % the sides' mean TD errors
+        QYes is Q + DYes, QNo is Q + DNo,
+        split(KB, D, Leaf, I, s(M1t, QYes, DYes), s(M2t, QNo, DNo))
     ;   true
     ).
 
@@ -355,6 +420,18 @@ weight(L, Half, Clock, W) :-
             W = 1.0
         ;   W is 2 ** E
         )
+    ).
+
+%   The leaf's last Keep examples, in a ring (one slot written in place).
+keep_example(Ring, Ex) :-
+    functor(Ring, _, Arity),
+    (   Arity =:= 1
+    ->  true
+    ;   arg(1, Ring, Next),
+        Slot is Next + 1,
+        nb_setarg(Slot, Ring, Ex),
+        Next1 is Next mod (Arity - 1) + 1,
+        nb_setarg(1, Ring, Next1)
     ).
 
 rescale(L, Scale) :-
@@ -407,9 +484,14 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
 % ---- splitting -----------------------------------------------------------------------------
 
 %   Split leaf LeafId on its candidate I; the children start from their partitions:
-%   s(Weight, Q) each (today's weights; Q the leaf's estimate plus the mean TD error on
-%   that side).
-split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
+%   s(Weight, Q, MeanTDError) each (today's weights; Q the leaf's estimate plus the mean TD
+%   error on that side). Their statistics start from the leaf's kept examples (its ring):
+%   each is sorted to its side and counted in the child's own sums and in those of the
+%   child's candidates that succeed on it, with its TD error less the side's mean (the
+%   child's Q has taken that in) and its weight of today. The rest of what the leaf
+%   counted cannot be sorted (it kept only sums), so a child's statistics cover at most
+%   the kept examples.
+split(KB, D, LeafId, I, s(M1, QYes, DYes), s(M2, QNo, DNo)) :-
     tg_get_tree(KB, tree(Root0, Next0, Bias, Responses)),
     YesId = Next0, NoId is Next0 + 1, Next is Next0 + 2,
     replace_leaf(Root0, LeafId, Leaf, Node, Root),
@@ -425,9 +507,12 @@ split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     Node = node(LeafId, Lits, New, Yes, No),
     length(YesCands, KY), length(NoCands, KN),
     arg(5, D, Clock),
+    arg(1, D, Params), arg(8, Params, Half), arg(10, Params, Keep),
     NYes is max(1, round(M1)), NNo is max(1, round(M2)),
-    tg_new_stats(QYes, NYes, KY, Clock, LYes),
-    tg_new_stats(QNo, NNo, KN, Clock, LNo),
+    tg_new_stats(QYes, NYes, KY, Clock, Keep, LYes),
+    tg_new_stats(QNo, NNo, KN, Clock, Keep, LNo),
+    arg(2, D, Leaves0), arg(LeafId, Leaves0, L0), arg(9, L0, Ring0),
+    kept_sides(KB, LeafId, I, Ring0, YesEx, NoEx),
     put_leaf(D, LeafId, free),
     put_leaf(D, YesId, LYes),
     put_leaf(D, NoId, LNo),
@@ -438,7 +523,40 @@ split(KB, D, LeafId, I, s(M1, QYes), s(M2, QNo)) :-
     tg_forget_leaf(KB, LeafId),
     tg_compile_leaf(KB, Yes),
     tg_compile_leaf(KB, No),
-    tg_compile_tree(KB, Root).
+    tg_compile_tree(KB, Root),
+    arg(2, D, Leaves),                  % the live leaf terms (put_leaf/3 copied them)
+    arg(YesId, Leaves, LYes1), arg(NoId, Leaves, LNo1),
+    replay(YesEx, KB, YesId, LYes1, DYes, Half, Clock),
+    replay(NoEx, KB, NoId, LNo1, DNo, Half, Clock).
+
+%   The leaf's kept examples on the yes-side (candidate I succeeds) and on the no-side.
+kept_sides(KB, LeafId, I, Ring, YesEx, NoEx) :-
+    Ring =.. [ring, _|Slots],
+    exclude(==(none), Slots, Kept),
+    partition(on_yes_side(KB, LeafId, I), Kept, YesEx, NoEx).
+
+on_yes_side(KB, LeafId, I, ex(Facts, A, N, _, _)) :-
+    once(tg_cands_(KB, LeafId, Facts, A, N, Hits)),
+    memberchk(I, Hits).
+
+%   Count the kept examples Exs in the new leaf Id (l/9 term L, sums in units of Clock's
+%   weight, so an example of time T weighs 2^((T - Clock) / Half)) and keep them there.
+replay([], _, _, _, _, _, _).
+replay([ex(Facts, A, N, E0, T)|Exs], KB, Id, L, Shift, Half, Clock) :-
+    E is E0 - Shift,
+    (   Half =:= 0
+    ->  W = 1.0
+    ;   W is 2 ** ((T - Clock) / Half)
+    ),
+    arg(3, L, M0), arg(4, L, S0), arg(5, L, SS0),
+    M is M0 + W, S is S0 + W * E, SS is SS0 + W * E * E,
+    nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
+    arg(6, L, C),
+    once(tg_cands_(KB, Id, Facts, A, N, Hits)),
+    count_hits(Hits, C, W, E),
+    arg(9, L, Ring),
+    keep_example(Ring, ex(Facts, A, N, E, T)),
+    replay(Exs, KB, Id, L, Shift, Half, Clock).
 
 %   The no-branch of a test never needs the test again.
 same_cand(Lits, cand(Lits1, _)) :-
@@ -475,26 +593,40 @@ put_leaf(D, Id, L) :-
 %
 %   Size is size(Positions, Details). Positions = nodes + entries in the paper's sense: every
 %   node (test or leaf) and every stored Q value (one per leaf). Details:
-%   [nodes=, tests=, leaves=, entries=, candidates=, statistics=]; statistics counts the
-%   numbers kept only to decide splits: count, sum and sum of squares for each leaf and for
-%   each candidate of each leaf.
+%   [nodes=, tests=, leaves=, entries=, candidates=, candidates_max=, statistics=];
+%   candidates counts the candidate tests of every leaf, candidates_max those of the leaf
+%   with most; statistics counts the numbers kept only to decide splits: count, sum and sum
+%   of squares for each leaf and for each candidate of each leaf.
 
 tg_size(KB, size(Positions, [nodes=Nodes, tests=Tests, leaves=Leaves, entries=Leaves,
-                             candidates=Cands, statistics=Stats])) :-
+                             candidates=Cands, candidates_max=Max, statistics=Stats])) :-
     tg_get_tree(KB, tree(Root, _, _, _)),
-    tree_counts(Root, 0-0-0, Tests-Leaves-Cands),
+    tree_counts(Root, c(0, 0, 0, 0), c(Tests, Leaves, Cands, Max)),
     Nodes is Tests + Leaves,
     Positions is Nodes + Leaves,
     Stats is 3 * (Leaves + Cands).
 
-tree_counts(leaf(_, _, _, Cs), T-L0-C0, T-L-C) :-
+tree_counts(leaf(_, _, _, Cs), c(T, L0, C0, M0), c(T, L, C, M)) :-
     L is L0 + 1,
     length(Cs, K),
-    C is C0 + K.
-tree_counts(node(_, _, _, Y, N), T0-L0-C0, Out) :-
+    C is C0 + K,
+    M is max(M0, K).
+tree_counts(node(_, _, _, Y, N), c(T0, L0, C0, M0), Out) :-
     T1 is T0 + 1,
-    tree_counts(Y, T1-L0-C0, Mid),
+    tree_counts(Y, c(T1, L0, C0, M0), Mid),
     tree_counts(N, Mid, Out).
+
+%!  tg_policy_info(+KB, -Info:list) is det.
+%
+%   What a tg policy is tied to in the domain: [relations(Templates), rmodes(Modes),
+%   rconsts(Consts)], the relational view's templates and the language bias (tg_bias/2). A bias of typed
+%   variables names no place, toy or colour of the world, so these are the same in every
+%   world of a family (the generated worlds of the scaling benchmark, whatever their size)
+%   and a policy learned in one loads in any other.
+
+tg_policy_info(KB, [relations(Templates), rmodes(Modes), rconsts(Consts)]) :-
+    findall(T, declared(KB, relation(T)), Templates),
+    tg_get_tree(KB, tree(_, _, bias(Modes, Consts), _)).
 
 %!  tg_candidates(+KB, ?LeafId, -Texts:list) is nondet.
 %
@@ -511,6 +643,8 @@ tg_candidates(KB, LeafId, Texts) :-
 % ---- the engine's hooks (see engine.pl) ----------------------------------------------------
 
 relrl_engine:learner(tg).
+
+relrl_engine:learner_property(tg, view(relational)).
 
 relrl_engine:learner_init(tg, KB, Params) :-
     tg_init(KB, Params).
@@ -532,6 +666,9 @@ relrl_engine:learner_size(tg, KB, Size) :-
 
 relrl_engine:learner_save(tg, KB, Stream) :-
     tg_save(KB, Stream).
+
+relrl_engine:learner_policy_info(tg, KB, Info) :-
+    tg_policy_info(KB, Info).
 
 relrl_engine:learner_policy_term(tg, Term) :-
     tg_policy_term(Term).

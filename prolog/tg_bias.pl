@@ -6,6 +6,9 @@
             conj_goal/6,          % +Literals, +Facts, +Action, +Necessity, +Bound, -Goal
             literal_holds/4,      % +Literal, +Facts, +Action, +Necessity
             bias_problem/2,       % +KB, -Problem
+            bias_warning/2,       % +KB, -Warning
+            bias_constants/2,     % +Bias, -Constants
+            term_constant/2,      % +Term, ?Constant
             name_variables/2,     % +Vars, -Names
             conj_text/3           % +Literals, +Names, -Text
           ]).
@@ -326,6 +329,74 @@ mode_problem(KB, M, Msg) :-
         \+ ( declared(KB, rmode(M2)), mode_type(M2, -, T) )
     ->  format(string(Msg), "rmode ~w: +~q can never be bound (no rmode introduces a \c
                              variable of type ~q with -~q)", [MT, T, T, T])
+    ).
+
+%!  bias_warning(+KB, -Warning) is nondet.
+%
+%   Warning is problem(File, Line, Message) for a #T type whose constants grow with the
+%   world: more than 10 of them, or one for each of at least three responses (rconst(place,
+%   P) for every look(P)). Every #T literal is one candidate test per constant in every
+%   leaf, so such a bias makes the learner's work grow with the world, and a test on one
+%   ground place says nothing about the others. File and Line are those of the first rmode
+%   that uses #T. A domain with such a bias is valid; relrl check prints the warning.
+
+bias_warning(KB, problem(File, Line, Msg)) :-
+    findall(T, ( declared(KB, rmode(M)), mode_type(M, #, T), T \== necessity ), Ts0),
+    sort(Ts0, Ts),
+    member(T, Ts),
+    findall(C, declared(KB, rconst(T, C)), Cs0),
+    sort(Cs0, Cs),
+    length(Cs, K),
+    findall(C, ( member(C, Cs), once(( kb_response(KB, R), term_constant(R, C) )) ), Used),
+    length(Used, U),
+    (   U >= 3
+    ->  Used = [E1, E2|_],
+        format(string(Msg), "rconst type ~q has a constant for each of ~d responses' \c
+               arguments (~q, ~q, ...): its #~q tests grow with the world (one candidate \c
+               per constant in every leaf); use +~q/-~q variables and keep as constants \c
+               only the few the task distinguishes, as a type of their own",
+               [T, U, E1, E2, T, T, T])
+    ;   K > 10
+    ->  format(string(Msg), "rconst type ~q has ~d constants: every #~q literal is one \c
+               candidate test per constant in every leaf; if they grow with the world, use \c
+               +~q/-~q variables", [T, K, T, T, T])
+    ),
+    once(( declaration(KB, rmode(M), Ref), mode_type(M, #, T) )),
+    clause_where(Ref, File, Line).
+
+%!  bias_constants(+Bias, -Constants:list) is det.
+%
+%   Constants are the constants Bias (tg_bias/2) names: those of rconst/2 and of the
+%   necessities, and every atomic argument written in an rmode template. A test sees no
+%   other constant of the world than these and those of the example's state.
+
+bias_constants(bias(Modes, Consts), All) :-
+    findall(C, ( member(_-Cs, Consts), member(C, Cs), atomic(C) ), C1),
+    findall(C, ( member(M, Modes), template_constant(M, C) ), C2),
+    append(C1, C2, All).
+
+template_constant(M, C) :-
+    compound(M),
+    \+ mode_spec(M),
+    M =.. [_|Args],
+    member(A, Args),
+    (   atomic(A)
+    ->  C = A
+    ;   template_constant(A, C)
+    ).
+
+%!  term_constant(+Term, ?Constant) is nondet.
+%
+%   Constant is an atomic argument of Term, at any depth (not its principal functor):
+%   left_3 of look(left_3), of gaze(face, left_3).
+
+term_constant(T, C) :-
+    compound(T),
+    T =.. [_|Args],
+    member(X, Args),
+    (   atomic(X)
+    ->  C = X
+    ;   term_constant(X, C)
     ).
 
 %   A mode written with relrl's operators (#agent, not #(agent)).

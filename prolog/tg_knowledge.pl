@@ -84,7 +84,7 @@ tg_text(KB, Text) :-
     with_output_to(string(Text), text_node(KB, Root, [], "", "")).
 
 text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
     format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
 text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
     append(Vars, New, Vars1),
@@ -105,7 +105,7 @@ tg_graph(KB, graph(Nodes, Edges)) :-
     graph_node(KB, Root, [], Nodes, [], Edges, []).
 
 graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
     format(string(Label), "Q=~2f (n=~d)", [Q, N]).
 graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
            [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
@@ -160,7 +160,7 @@ leaf_rules(KB, Form, Rules) :-
     findall(R, leaf_clause(KB, Form, Root, [], [], [], R), Rules).
 
 leaf_clause(KB, Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
-    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000.0,
     Head = q(Action, Necessity, Q),
     foldl(positive(Action, Necessity), Pos, Goals0, []),
@@ -295,7 +295,7 @@ tg_save(KB, S) :-
     forall(member(C, Clauses), portray_clause(S, C)).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _)).
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)).
 saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
     append(Vars, New, Vars1),
     saved_tree(KB, Y, Vars1, SY, AY),
@@ -330,7 +330,10 @@ tg_restore(KB, Terms) :-
     ;   existence_error(tg_tree, Terms)
     ),
     tg_get_tree(KB, tree(_, _, Bias, Responses)),
-    restored(Saved, Bias, [], [], Root, Stats),
+    tg_data(KB, D),
+    arg(1, D, Params),
+    arg(10, Params, Keep),
+    restored(Saved, b(Bias, Keep), [], [], Root, Stats),
     pairs_keys(Stats, Ids),
     (   sort(Ids, Unique), length(Unique, U), length(Ids, U)
     ->  true
@@ -345,7 +348,6 @@ tg_restore(KB, Terms) :-
     Cap is max(16, MaxId),
     tg_empty_leaves(Cap, Leaves),
     foldl(place_leaf(Leaves), Stats, _, _),
-    tg_data(KB, D),
     nb_setarg(2, D, Leaves),
     nb_setarg(3, D, none),
     arg(4, D, Version0), Version is Version0 + 1, nb_setarg(4, D, Version),
@@ -357,7 +359,7 @@ tg_restore(KB, Terms) :-
     tg_compile_tree(KB, Root),
     check_rules(KB, Terms).
 
-restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) :-
+restored(leaf(Id, Q, N), b(Bias, Keep), Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) :-
     !,
     (   integer(Id), Id > 0, number(Q), integer(N), N >= 0
     ->  true
@@ -367,8 +369,9 @@ restored(leaf(Id, Q, N), Bias, Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) 
     restored_number(leaf(Id, Q, N), "example count", N),
     refinements(Bias, Path, Vars, Cands),
     length(Cands, K),
-    tg_new_stats(Q, N, K, 0, L).
-restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
+    tg_new_stats(Q, N, K, 0, Keep, L).
+restored(node(Id, Lits, New, Y, N), B, Path, Vars, node(Id, Lits, New, RY, RN), Stats) :-
+    B = b(Bias, _),
     !,
     (   integer(Id), Id > 0, is_list(Lits), Lits \== [], maplist(callable, Lits),
         is_list(New), maplist(typed_var, New)
@@ -382,8 +385,8 @@ restored(node(Id, Lits, New, Y, N), Bias, Path, Vars, node(Id, Lits, New, RY, RN
     ),
     append(Path, Lits, Path1),
     append(Vars, New, Vars1),
-    restored(Y, Bias, Path1, Vars1, RY, SY),
-    restored(N, Bias, Path, Vars, RN, SN),
+    restored(Y, B, Path1, Vars1, RY, SY),
+    restored(N, B, Path, Vars, RN, SN),
     append([Id-test|SY], SN, Stats).
 restored(Other, _, _, _, _, _) :-
     domain_error(tg_tree, Other).

@@ -3,7 +3,7 @@
             tg_get_tree/2,        % +KB, -Tree
             tg_put_tree/2,        % +KB, +Tree
             tg_leaf/3,            % +KB, +LeafId, -Stats
-            tg_new_stats/5,       % +Q, +N, +K, +Clock, -Stats
+            tg_new_stats/6,       % +Q, +N, +K, +Clock, +Keep, -Stats
             tg_empty_leaves/2,    % +Capacity, -Leaves
             tg_compile_tree/2,    % +KB, +Root
             tg_compile_leaf/2,    % +KB, +Leaf
@@ -39,20 +39,28 @@ explains, draws, saves and restores them.
 %                  tree changes, is explained, drawn or saved. Root is a leaf(Id, PathLits,
 %                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
 %                  along the path, as in the tree.
-%   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock), read in place on every step:
-%                  Params below;
-%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last, Base)
-%                  for leaf i (or `free`): the Q estimate and the examples counted in it
-%                  (its partition's and its own), the count, sum and sum of squares of the
-%                  TD errors since the leaf was made (tg.pl), C = c(M1, S1, SS1, M2, ...) the same
-%                  for each candidate, in order, the Clock (examples inserted in the tree so
-%                  far) when the leaf was last updated, and the Clock its sums are weighed
-%                  from (forgetting, tg.pl's weight/4); the numbers are updated with
-%                  nb_setarg/3. Params = p(Alpha, Gamma, Epsilon, Tau, Level, MinExamples,
-%                  Kappa, HalfLife, Beta) (Kappa the stale bonus, Beta the novelty bonus).
-%                  Cache = last(Facts, N, Allowed, LeafIds, Version): where the last update
-%                  sorted the next state's allowed actions, reused by the choice that
-%                  follows in the same step while the tree is unchanged (Version).
+%   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock, Index), read in place on every
+%                  step:
+%                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last, Base,
+%                  Ring) for leaf i (or `free`): the Q estimate and the examples counted in
+%                  it (its partition's and its own), the count, sum and sum of squares of
+%                  the TD errors of its own examples (tg.pl), C = c(M1, S1, SS1, M2, ...)
+%                  the same for each candidate, in order, the Clock (examples inserted in
+%                  the tree so far) when the leaf was last updated, the Clock its sums are
+%                  weighed from (forgetting, tg.pl's weight/4), and Ring = ring(Next, X1,
+%                  ..., XKeep) its last Keep examples, ex(Facts, Action, Necessity,
+%                  TDError, Clock) or `none` (a split sorts them into its children); the
+%                  numbers are updated with nb_setarg/3. Params = p(Alpha, Gamma, Epsilon,
+%                  Tau, Level, MinExamples, Kappa, HalfLife, novelty(Beta, Confidence),
+%                  Keep) (Kappa the stale bonus, Beta the novelty bonus). Cache =
+%                  last(Facts, N, Allowed, Classes, LeafIds, Version, Chose): the classes
+%                  of the next state's allowed responses (tg_classes.pl) and their leaves,
+%                  found by the last update and reused by the choice that follows in the
+%                  same step while the tree is unchanged (Version); Chose is
+%                  chose(Action, Leaf, Hits) once that choice has found the chosen class's
+%                  leaf and candidate hits (reused by the next update's insertion), or
+%                  none. Index is the response index
+%                  (tg_classes:tg_response_index/3).
 
 %!  tg_data(+KB, -Data) is det.
 %
@@ -88,10 +96,10 @@ tg_put_tree(KB, Tree) :-
 
 %!  tg_leaf(+KB, +LeafId, -Stats) is det.
 %
-%   Stats is the live l/8 term of leaf LeafId (above).
+%   Stats is the live l/9 term of leaf LeafId (above).
 
 tg_leaf(KB, Id, L) :-
-    tg_data(KB, tg(_, Leaves, _, _, _)),
+    tg_data(KB, tg(_, Leaves, _, _, _, _)),
     arg(Id, Leaves, L).
 
 %!  tg_empty_leaves(+Capacity, -Leaves) is det.
@@ -103,15 +111,18 @@ tg_empty_leaves(Cap, Leaves) :-
     maplist(=(free), Free),
     Leaves =.. [leaves|Free].
 
-%!  tg_new_stats(+Q, +N, +K, +Clock, -Stats) is det.
+%!  tg_new_stats(+Q, +N, +K, +Clock, +Keep, -Stats) is det.
 %
-%   Stats is a new leaf's l/8 term: estimate Q from N examples, no examples of its own
+%   Stats is a new leaf's l/9 term: estimate Q from N examples, no examples of its own
 %   yet, K candidates with empty statistics, last updated at Clock, sums in units of
-%   Clock's weight.
+%   Clock's weight, room for its last Keep examples (none kept yet).
 
-tg_new_stats(Q, N, K, Clock, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock)) :-
+tg_new_stats(Q, N, K, Clock, Keep, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock, Ring)) :-
     findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
-    C =.. [c|Xs].
+    C =.. [c|Xs],
+    length(Slots, Keep),
+    maplist(=(none), Slots),
+    Ring =.. [ring, 1|Slots].
 
 % ---- compiling the tree --------------------------------------------------------------------
 

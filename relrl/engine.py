@@ -34,8 +34,8 @@ from relrl.errors import PolicyError, QueryTimeout, RelrlError
 from relrl.kb import Cached, KnowledgeBase
 from relrl.terms import Term, Var
 
-__all__ = ["GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult", "mask_indices",
-           "POLICY_BYTES_PER_POSITION", "POLICY_SECONDS_PER_MB"]
+__all__ = ["ALL_ALLOWED", "GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult",
+           "mask_indices", "POLICY_BYTES_PER_POSITION", "POLICY_SECONDS_PER_MB"]
 
 #: seconds a policy load may take per megabyte of the file, on top of the knowledge base's
 #: time limit (a policy runs no rule of its own: its load is bounded by its size; about
@@ -56,7 +56,7 @@ GOALS: dict[str, str] = {
     "graph": "relrl_engine:engine_graph",
     "knowledge": "relrl_engine:engine_knowledge",
     "size": "relrl_engine:engine_size",
-    "save": "relrl_engine:engine_save",
+    "policy": "relrl_engine:engine_policy",
     "keep": "relrl_engine:engine_keep",
     "resume": "relrl_engine:engine_resume",
     "reseed": "relrl_engine:engine_reseed",
@@ -93,6 +93,10 @@ GOALS: dict[str, str] = {
     "parse": "relrl_gateway:gw_parse",
 }
 
+#: The allowed mask of a step at which every response is allowed (a domain without
+#: constraint rules): the engine does not build a mask of as many bits every step.
+ALL_ALLOWED = -1
+
 #: Step modes: update the learner and explore, explore without learning, or neither.
 MODES = ("learn", "explore", "greedy")
 #: What a step can report besides its result, in the same call.
@@ -109,7 +113,7 @@ class EngineError(RelrlError):
 class StepResult:
     """What one control step (``relrl_engine:engine_step/6``) reports."""
 
-    code: int                     #: the state code, sum of 2^x
+    code: int                     #: the state code, sum of 2^x (0 for a relational learner)
     necessity: str                #: the active necessity, or "none"
     outputs: tuple[float, ...]    #: every necessity unit's output, in declaration order
     reward: float                 #: the reward for the previous response
@@ -195,12 +199,16 @@ class Engine:
             mode: one of :data:`MODES`.
             want: any of :data:`WANTS`, reported in the same call.
         """
-        return StepResult(*self.step_fields(percepts, emitted, mode, want))
+        fields = self.step_fields(percepts, emitted, mode, want)
+        if fields[5] == ALL_ALLOWED:
+            fields = (*fields[:5], (1 << len(self.responses)) - 1, *fields[6:])
+        return StepResult(*fields)
 
     def step_fields(self, percepts: Sequence[Term] | Cached, emitted: int = -1,
                     mode: str = "learn", want: Iterable[str] = ()) -> tuple:
         """:meth:`step`'s fields as a plain tuple, in :class:`StepResult`'s order (for
-        the control loop, which builds its own record of the step)."""
+        the control loop, which builds its own record of the step), as the engine gives
+        them: the allowed mask is :data:`ALL_ALLOWED` when every response is allowed."""
         if type(percepts) is not Cached:
             percepts = Cached(percepts if isinstance(percepts, list) else list(percepts))
         want = list(want) if want else []
@@ -260,17 +268,23 @@ class Engine:
 
     # -- files ------------------------------------------------------------------------------
 
-    def save(self, path: str | Path, header: str) -> Path:
-        """Write the learned knowledge as a readable policy file (atomic).
+    def policy_text(self, header: str) -> str:
+        """The learned knowledge as the text of a policy file (``header`` as its comment).
 
-        Writing is linear in what was learned: it may take the knowledge base's time limit
+        Making it is linear in what was learned: it may take the knowledge base's time limit
         plus :data:`POLICY_SECONDS_PER_MB` per megabyte the policy is expected to take
         (:data:`POLICY_BYTES_PER_POSITION` per position of :meth:`size`).
         """
         megabytes = self.size()[0] * POLICY_BYTES_PER_POSITION / 1e6
-        call(self.kb, "save", self.module, str(path), header,
-             timeout=self.kb.timeout + POLICY_SECONDS_PER_MB * megabytes)
-        return Path(path)
+        return call(self.kb, "policy", self.module, header, Var(),
+                    timeout=self.kb.timeout + POLICY_SECONDS_PER_MB * megabytes)[0]
+
+    def save(self, path: str | Path, header: str) -> Path:
+        """Write the learned knowledge as a readable policy file (:mod:`relrl.outdir`: atomic,
+        never through a link; the text as :meth:`policy_text` makes it)."""
+        from relrl.outdir import write_atomic
+
+        return write_atomic(path, self.policy_text(header))
 
     def load_policy(self, path: str | Path) -> None:
         """Replace the learned knowledge by the policy at ``path``, read as data.

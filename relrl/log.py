@@ -45,9 +45,26 @@ def quiet() -> bool:
     return _state["verbosity"] < 0
 
 
+class _FileLog(logging.StreamHandler):
+    """A log file written through relrl's one writer (:func:`relrl.outdir.open_stream`): a
+    new file, never a link followed; when it cannot be written (a full disk) it falls
+    silent -- the log must never be what stops a session."""
+
+    def handleError(self, record: logging.LogRecord) -> None:  # noqa: N802 (logging's name)
+        self.setLevel(logging.CRITICAL + 1)
+
+    def close(self) -> None:
+        try:
+            self.stream.close()
+        finally:
+            super().close()
+
+
 def add_file(path: str | Path) -> logging.Handler:
     """Also log everything (debug level, with times) to ``path``; returns the handler."""
-    handler = logging.FileHandler(path, encoding="utf-8")
+    from relrl.outdir import open_stream
+
+    handler = _FileLog(open_stream(path))
     handler.setLevel(logging.DEBUG)
     handler.setFormatter(logging.Formatter(FORMAT))
     root = logging.getLogger("relrl")

@@ -14,7 +14,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from relrl.engine import Engine, mask_indices
+from relrl.engine import ALL_ALLOWED, Engine, mask_indices
 from relrl.errors import UserError
 from relrl.interfaces import Actuator, Environment
 from relrl.kb import KnowledgeBase
@@ -127,8 +127,8 @@ class Agent:
 
     def _allow(self, mask: int) -> tuple[tuple[int, ...], tuple[Term, ...]]:
         """The allowed responses' indices and terms for an allowed-mask (remembered: a
-        domain has few masks)."""
-        index = mask_indices(mask)
+        domain has few masks; :data:`~relrl.engine.ALL_ALLOWED`: every response)."""
+        index = range(len(self.responses)) if mask == ALL_ALLOWED else mask_indices(mask)
         pair = (tuple(index), tuple(self.responses[i] for i in index))
         if len(self._allowed) < 4096:
             self._allowed[mask] = pair

@@ -99,9 +99,9 @@ def record(path: str | Path, learner: str = "etg", *, steps: int = 5000, warmup:
         interaction = Interaction(env, agent)
         interaction.reset(seed=seed)
         interaction.run(warmup + steps, keep=False)
-    path = Path(path)
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
+    from relrl.outdir import write_atomic
+
+    return write_atomic(path, "\n".join(lines) + "\n")
 
 
 def replay(path: str | Path, *, passes: int = 3, profile: bool = False, top: int = 25,

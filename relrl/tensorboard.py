@@ -127,12 +127,11 @@ def event_file(points: Iterable[tuple[int, Mapping[str, Any]]],
 
 def write_event_file(folder: str | Path,
                      points: Iterable[tuple[int, Mapping[str, Any]]]) -> Path:
-    """Write :data:`EVENT_FILE` in ``folder`` whole (atomic, through :mod:`relrl.outdir`)."""
+    """Write :data:`EVENT_FILE` in ``folder`` (made when missing) whole, atomically, through
+    :mod:`relrl.outdir` (a table: it does not take the space held back for the results)."""
     from relrl.outdir import write_atomic
 
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    return write_atomic(folder / EVENT_FILE, event_file(points))
+    return write_atomic(Path(folder) / EVENT_FILE, event_file(points), spare=False)
 
 
 class ScalarLog:
@@ -141,12 +140,15 @@ class ScalarLog:
     and at :meth:`close` (safe twice).
 
     Args:
-        path: the file (a new one; an old one is replaced).
+        path: the file (a new one, through :func:`relrl.outdir.open_stream`: whatever was
+            there is replaced, never written through).
     """
 
     def __init__(self, path: str | Path) -> None:
+        from relrl.outdir import open_stream
+
         self.path = Path(path)
-        self._file = open(self.path, "wb")  # noqa: SIM115 - closed by close()
+        self._file = open_stream(self.path, binary=True)
         self._pending = [_record(_event(time.time(), 0, version="brain.Event:2"))]
         self._next = 0.0
 
@@ -163,8 +165,7 @@ class ScalarLog:
     def flush(self) -> None:
         """Write what is buffered."""
         if self._pending and not self._file.closed:
-            self._file.write(b"".join(self._pending))
-            self._file.flush()
+            self._file.write(b"".join(self._pending))  # whole records, or none of them
             self._pending = []
 
     def close(self) -> None:

@@ -6,7 +6,8 @@ from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase, _display_path
 from relrl.terms import Term, Var, format_term
 
-__all__ = ["validate", "describe", "world_warnings", "unread_percepts", "vocabulary_terms"]
+__all__ = ["validate", "describe", "world_warnings", "bias_warnings", "unread_percepts",
+           "vocabulary_terms"]
 
 
 def validate(kb: KnowledgeBase) -> list[str]:
@@ -58,6 +59,16 @@ def world_warnings(kb: KnowledgeBase, world: str) -> list[str]:
     return lines
 
 
+def bias_warnings(kb: KnowledgeBase) -> list[str]:
+    """One line per warning about the tg learner's language bias: a ``#Type`` whose
+    constants grow with the world (one per response's argument, or more than 10), which
+    makes every leaf's candidate tests grow with it (prolog/tg_bias.pl)."""
+    _, _, _, warnings = kb.call("relrl_check:bias_listing", kb.module,
+                                Var())[0]  # type: ignore[index]
+    return [f"{_display_path(path)}:{line}: warning: {message}" if path else
+            f"domain: warning: {message}" for (_, path, line, message) in warnings]
+
+
 def unread_percepts(kb: KnowledgeBase, percepts: list[Term]) -> list[Term]:
     """The ``percepts`` no stimulus, fact or rule of the domain perceives."""
     from relrl.engine import one
@@ -94,8 +105,8 @@ def describe(kb: KnowledgeBase) -> str:
 
 def _bias_lines(kb: KnowledgeBase) -> list[str]:
     """The relational view and what the tg learner's language bias generates at the root."""
-    _, relations, refinements = kb.call("relrl_check:bias_listing", kb.module,
-                                        Var())[0]  # type: ignore[index]
+    _, relations, refinements, _ = kb.call("relrl_check:bias_listing", kb.module,
+                                           Var())[0]  # type: ignore[index]
     if not relations and not refinements:
         return []
     lines = ["relations (the relational view, learner tg):"]

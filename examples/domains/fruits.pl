@@ -90,20 +90,23 @@ pose_place(right_2, right).
 % ---- The language bias (learner tg) ------------------------------------------------------
 
 % Single literals with modes: +T a variable of type T bound earlier on the path (or by the
-% action), -T a new variable, #T each constant of type T. See docs/tg.md.
+% action), -T a new variable, #T each constant of type T. See docs/tg.md. Places, objects
+% and colours enter tests only as variables; the caregiver's face (centre) and the words
+% the caregiver says are the task's own constants.
 rmode(sees(#thing)).
 rmode(gaze(#agent, -place)).
 rmode(gaze(#agent, +place)).
-rmode(gaze(#agent, #place)).
+rmode(gaze(#agent, #face_place)).
 rmode(head_at(+place)).
-rmode(head_at(#place)).
+rmode(head_at(#face_place)).
 rmode(object_at(-object, -place)).
 rmode(object_at(-object, +place)).
-rmode(colour(+object, #colour)).
+rmode(colour(+object, -colour)).
+rmode(colour(+object, +colour)).
 rmode(heard(#word)).
 rmode(action(look(-place))).
 rmode(action(look(+place))).
-rmode(action(look(#place))).
+rmode(action(look(#face_place))).
 rmode(action(name_object)).
 rmode(necessity(#necessity)).
 
@@ -111,16 +114,7 @@ rconst(thing, face).
 rconst(thing, object).
 rconst(thing, environment).
 rconst(agent, face).
-rconst(place, centre).
-rconst(place, left).
-rconst(place, left_down).
-rconst(place, down).
-rconst(place, right_down).
-rconst(place, right).
-rconst(colour, red).
-rconst(colour, orange).
-rconst(colour, yellow).
-rconst(colour, green).
+rconst(face_place, centre).
 rconst(word, attention).
 rconst(word, apple).
 rconst(word, orange).

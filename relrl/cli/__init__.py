@@ -109,7 +109,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         kept = getattr(exc, "kept", None)  # what a run wrote before it stopped
         print(f"relrl {args.command}: interrupted" + (f"; {kept}" if kept else ""),
               file=sys.stderr)
-        return 130
+        return 128 + getattr(exc, "signum", 2)  # SIGINT, or the signal that stopped it
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()
         return 0

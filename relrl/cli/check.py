@@ -35,10 +35,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Check the domain; exit status 0 when valid, 2 when it has problems (load warnings
-    and, with ``--world``, facts the world can never make hold count as problems)."""
+    and, with ``--world``, facts the world can never make hold count as problems). Warnings
+    about the tg learner's language bias are printed and do not count as problems."""
     from relrl.errors import PrologLoadError
     from relrl.kb import KnowledgeBase
-    from relrl.validate import describe, validate, world_warnings
+    from relrl.validate import bias_warnings, describe, validate, world_warnings
 
     kb = KnowledgeBase()
     problems: list[str] = []
@@ -58,6 +59,8 @@ def run(args: argparse.Namespace) -> int:
             problems.extend(world_warnings(kb, args.world))
         if not args.quiet:
             print(describe(kb))
+        for warning in bias_warnings(kb):     # a valid domain, a bias that will not scale
+            print(warning, file=sys.stderr)
         checked = [] if problems else [_check_policy(kb, p, problems) for p in args.policy]
         if problems:
             _print_problems(problems)

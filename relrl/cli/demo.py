@@ -25,7 +25,8 @@ def run(args: argparse.Namespace) -> int:
     """Run the quick Experiment 1 and say where everything is."""
     from relrl.errors import ConfigError
     from relrl.experiments.main import run_sis
-    from relrl.experiments.report import summary_table
+    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.runner import command_signals
     from relrl.experiments.sis import SISConfig
     from relrl.outdir import OutDir
 
@@ -38,10 +39,11 @@ def run(args: argparse.Namespace) -> int:
           f"{config.eval_runs} runs of {config.eval_steps} time units\n"
           f"  setting: {config.setting()}")
     t0 = time.perf_counter()
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/demo") as out:
+    with command_signals(), \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/demo", outputs=OUTPUTS) as out:
         results, files = run_sis(config, out.path, workers=args.workers)
-        out.status = "complete"
+        out.status = "partial" if results.get("partial") else "complete"
     print()
     print(summary_table(results["summary"]))
     print(f"\n(CGI: correct gaze index, Eq. 5; eye contacts in the first "

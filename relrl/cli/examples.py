@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import shutil
 from pathlib import Path
 
 __all__ = ["EXAMPLE", "HELP", "add_arguments", "run"]
@@ -41,13 +40,9 @@ def run(args: argparse.Namespace) -> int:
     target = target_dir / "examples"
     if target.exists():
         raise ConfigError(f"--copy {args.copy}: {target} already exists (choose another folder)")
-    try:
-        for f in files:
-            dest = target / f.relative_to(source)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(f, dest)
-    except OSError as exc:
-        raise ConfigError(f"--copy {args.copy}: cannot write {exc.filename}: "
-                          f"{exc.strerror}") from None
+    from relrl.outdir import write_atomic
+
+    for f in files:
+        write_atomic(target / f.relative_to(source), f.read_bytes())
     print(f"copied {len(files)} example files to {target}")
     return 0

@@ -137,10 +137,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     sc.add_argument("--threshold", type=float, default=0.9, help="the CGI to reach (0.9)")
     sc.add_argument("--patience", type=int, default=2, help="stop after this many "
                     "evaluations at or above the threshold (0: learn the whole budget)")
-    sc.add_argument("--transfer", choices=["places", "kinds", "none"], default="places",
-                    help="hold out places (default), toy kinds, or no transfer jobs")
+    sc.add_argument("--transfer", choices=["places", "kinds", "sizes", "none"],
+                    default="places",
+                    help="hold out places (default) or toy kinds; sizes: learn at "
+                         "--transfer-from places, then act with no learning in the worlds of "
+                         "--transfer-sizes; none: no transfer jobs")
     sc.add_argument("--transfer-sizes", default=None,
-                    help="sizes with transfer jobs (default: all; --quick: 5,9)")
+                    help="sizes with transfer jobs, or with --transfer sizes the worlds the "
+                         "policy is evaluated in (default: all; --quick: 5,9)")
+    sc.add_argument("--transfer-from", type=int, default=5,
+                    help="with --transfer sizes: the world size learned in (default 5)")
     sc.add_argument("--holdout", type=float, default=0.4,
                     help="share of places (or kinds) held out (default 0.4)")
     add_out_options(sc, default="runs/scaling",
@@ -272,6 +278,17 @@ def build_scaling_config(args: argparse.Namespace):
     if math.isnan(args.holdout) or not 0 < args.holdout < 1:
         raise ConfigError(f"--holdout must be between 0 and 1, not {args.holdout}")
     config.holdout = args.holdout
+    if config.transfer == "sizes":
+        from relrl.errors import UserError
+
+        for flag, size in [("--transfer-from", args.transfer_from),
+                           *(("--transfer-sizes", s) for s in config.transfer_sizes)]:
+            try:
+                config.world_of(size).caregiver_params(config.caregiver_params,
+                                                       config.caregiver)
+            except UserError as exc:
+                raise ConfigError(f"{flag} {size}: {exc}") from None
+    config.transfer_from = args.transfer_from
     if config.transfer == "kinds" and world.kinds < 2:
         raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
     return finish_record(config, record)
@@ -281,7 +298,7 @@ def run(args: argparse.Namespace) -> int:
     """Check everything, claim the output folder, run the experiment, print the summary.
 
     ``kill -USR1 PID`` prints the stack of every thread to stderr (for a sweep that seems
-    stuck); Ctrl-C or SIGTERM stops it keeping what finished."""
+    stuck); Ctrl-C, SIGTERM or SIGHUP stops it keeping what finished."""
     import faulthandler
     import io
     import signal
@@ -293,7 +310,8 @@ def run(args: argparse.Namespace) -> int:
         except (ValueError, OSError, io.UnsupportedOperation):
             pass  # no real stderr (embedded): no stack dumps, nothing else changes
     from relrl.experiments import main as sis_main
-    from relrl.experiments.report import summary_table
+    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.runner import command_signals
     from relrl.outdir import OutDir
 
     if args.name == "scaling":
@@ -302,8 +320,9 @@ def run(args: argparse.Namespace) -> int:
 
     config = build_config(args)
     print(f"setting: {config.setting()}")
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/exp1") as out:
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/exp1", outputs=OUTPUTS) as out:
         results, files = sis_main.run_sis(config, out.path, workers=args.workers,
                                           engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
@@ -311,30 +330,42 @@ def run(args: argparse.Namespace) -> int:
     if any(c["held"] is not None for c in results.get("claims", {}).values()):
         print("\nthe paper's claims (docs/experiment1.md):")
         print(claims_table(results["claims"]))
-    return _finish(results, files, out.path)
+    return _finish(results, files, out.path, signals.signum)
 
 
 def _run_scaling(args: argparse.Namespace) -> int:
-    from relrl.experiments.scaling_report import run_scaling, scaling_table
+    from relrl.experiments.runner import command_signals
+    from relrl.experiments.scaling_report import OUTPUTS, run_scaling, scaling_table
     from relrl.outdir import OutDir
 
     config = build_scaling_config(args)
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      default="runs/scaling") as out:
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default="runs/scaling", outputs=OUTPUTS) as out:
         results, files = run_scaling(config, out.path, workers=args.workers,
                                      engine=args.engine, address=args.address)
         out.status = "partial" if results.get("partial") else "complete"
     timing = json.loads((out.path / "timing.json").read_text())
     print(scaling_table(results, timing))
-    return _finish(results, files, out.path)
+    return _finish(results, files, out.path, signals.signum)
 
 
-def _finish(results: dict, files: list, out: Path) -> int:
+def _finish(results: dict, files: list, out: Path, signum: int | None) -> int:
+    """Say what was written; 128 + N when signal N stopped the experiment (or came while
+    its outputs were being written)."""
+    import signal
+
     print(f"\nwrote {len(files)} files to {out}/:")
     for f in files:
         print(f"  {f}")
     if results.get("partial"):
-        print(f"stopped by {results.get('interrupted_by', 'a signal')}: the results are "
-              "partial (every finished evaluation point is kept)")
-        return 130 if results.get("interrupted_by") == "SIGINT" else 143
+        by = results.get("interrupted_by", "a signal")
+        print(f"stopped by {by}: the results are partial (every finished evaluation point "
+              "is kept)")
+        return 128 + (signal.Signals[by].value if by in signal.Signals.__members__
+                      else signum or signal.SIGINT)
+    if signum is not None:
+        print(f"{signal.Signals(signum).name} came as the outputs were written: they are "
+              "complete")
+        return 128 + signum
     return 0

@@ -41,7 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the script, run it, print the summary; 128 + N when stopped by signal N."""
     from relrl.episodes import RunOptions, StopRequest, load_episode
-    from relrl.errors import ConfigError
+    from relrl.errors import ConfigError, OutputError
 
     episode = load_episode(args.episode)
     if args.seed is not None:
@@ -69,25 +69,17 @@ def run(args: argparse.Namespace) -> int:
                       plots=not args.no_plots)
     stop = StopRequest()
     with session_options(args, episode, opts) as session:  # monitor, recording, words
-        if args.out is None:
-            summary = _run(episode, opts, stop)
-        else:
-            from relrl.outdir import OutDir
-
-            with OutDir.claim(args.out, command=args.command_line,
-                              overwrite=args.overwrite) as out:
-                opts.out = out.path
-                session.log_to(out.path / "run.log")
-                summary = _run(episode, opts, stop)
-                if not summary["partial"]:
-                    out.status = "complete"
+        # the stop signals are caught from the claim of --out to its record: a signal at
+        # any moment ends the run with its outputs and the record written
+        with stop.installed():
+            summary = _claim_and_run(args, episode, opts, stop, session)
         print(_report(summary))
         if args.out:
             policy = f", {summary['policy']}" if "policy" in summary else ""
             print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
-            if "policy_error" in summary:
-                print(f"relrl run: the policy was not saved: {summary['policy_error']}",
-                      file=sys.stderr)
+        if "policy_error" in summary:  # the run's product is missing: not a success
+            raise OutputError(f"the policy was not saved: {summary['policy_error']} (the "
+                              f"summary and the trace are in {args.out})")
         if summary["stopped_early"]:
             print(f"stopped after time unit {summary['units']} of {summary['planned_steps']}"
                   f"{' by ' + summary['stopped_by'] if summary['stopped_by'] else ''}; "
@@ -97,14 +89,30 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _claim_and_run(args, episode, opts, stop, session) -> dict:
+    """Claim --out (when given) and run the episode into it."""
+    if args.out is None:
+        return _run(episode, opts, stop)
+    from relrl.episodes.session import run_outputs
+    from relrl.outdir import OutDir
+
+    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                      outputs=run_outputs(episode, args.record)) as out:
+        opts.out = out.path
+        session.log_to(out.path / "run.log")
+        summary = _run(episode, opts, stop)
+        if not summary["partial"] and "policy_error" not in summary:
+            out.status = "complete"
+    return summary
+
+
 def _run(episode, opts, stop) -> dict:
     """Run the episode; a user's error ends with one line that says what was kept."""
     from relrl.episodes import run_episode
     from relrl.errors import USER_ERRORS, UserError
 
     try:
-        with stop.installed():
-            return run_episode(episode, opts, stop)
+        return run_episode(episode, opts, stop)
     except USER_ERRORS as exc:
         kept = getattr(exc, "kept", None)
         if kept is None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import math
 import sys
 import time
 from contextlib import contextmanager
@@ -116,8 +117,9 @@ def _check(args: argparse.Namespace) -> None:
         raise ConfigError(f"--monitor-rate must be positive, not {args.monitor_rate}")
     if args.record and not args.out:
         raise ConfigError("--record needs --out DIR (the recording goes there)")
-    if args.record_rate < 0:
-        raise ConfigError(f"--record-rate must be >= 0, not {args.record_rate}")
+    if not (math.isfinite(args.record_rate) and args.record_rate >= 0):
+        raise ConfigError(f"--record-rate must be a number of frames per second >= 0 (0: "
+                          f"every time unit), not {args.record_rate}")
     if not 1 <= args.record_quality <= 100:
         raise ConfigError(f"--record-quality must be in 1..100, not {args.record_quality}")
     if args.monitor_hold and args.monitor is None:

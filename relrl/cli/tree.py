@@ -32,6 +32,7 @@ def run(args: argparse.Namespace) -> int:
     from relrl.learners import make_learner
     from relrl.loop import Agent
     from relrl.monitor.graph import GraphError, learner_graph, render
+    from relrl.outdir import check_out_file, write_atomic
     from relrl.policy import policy_learner
 
     policy = Path(args.policy)
@@ -46,6 +47,8 @@ def run(args: argparse.Namespace) -> int:
     if fmt not in _FORMATS:
         raise ConfigError(f"--out {out}: unknown picture format {fmt!r}; use "
                           f"{', '.join(_FORMATS)} (or --format)")
+    if out is not None:  # before the work: a folder, a link, no permission, a file above
+        check_out_file(out, "--out")
     with KnowledgeBase(domain) as kb:
         name = policy_learner(policy, kb)
         learner = make_learner(name)
@@ -62,9 +65,6 @@ def run(args: argparse.Namespace) -> int:
     if out is None:
         sys.stdout.write(data.decode())
         return 0
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(out.name + ".tmp")
-    tmp.write_bytes(data)
-    tmp.replace(out)
+    write_atomic(out, data)
     print(f"wrote {out}: {title}")
     return 0

@@ -21,6 +21,8 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         import matplotlib.pyplot as plt
     except ImportError:
         return []
+    from relrl.experiments.report import save_figure
+
     files = []
     # on devices, evaluations and naming ran on the scripted world: the titles say so
     sim = " - SIMULATED" if summary.get("where", {}).get("simulated_evaluation") else ""
@@ -35,9 +37,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         ax.set_ylabel("reward")
         ax.legend(loc="lower right")
         fig.tight_layout()
-        files.append(out / "rewards.png")
-        fig.savefig(files[-1], dpi=100)
-        plt.close(fig)
+        files.append(save_figure(fig, out / "rewards.png", dpi=100))
     if summary.get("evaluation"):
         pts = summary["evaluation"]
         fig, ax = plt.subplots(figsize=(6, 3.5))
@@ -48,9 +48,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         ax.set_ylabel("CGI (mean +- sd of runs)")
         ax.set_title("Learning evolution (cf. the paper's Fig. 6)" + sim)
         fig.tight_layout()
-        files.append(out / "cgi.png")
-        fig.savefig(files[-1], dpi=100)
-        plt.close(fig)
+        files.append(save_figure(fig, out / "cgi.png", dpi=100))
     if summary.get("table1") and summary["table1"]["rates"] is not None:
         rates, paper = summary["table1"]["rates"], summary["table1"]["paper"]
         keys = list(paper)
@@ -65,7 +63,6 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         ax.set_title("Declarative pointing (Table 1)" + sim)
         ax.legend()
         fig.tight_layout()
-        files.append(out / "table1.png")
-        fig.savefig(files[-1], dpi=100)
-        plt.close(fig)
+        files.append(save_figure(fig, out / "table1.png", dpi=100))
     return files
+

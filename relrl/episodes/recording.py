@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import json
 import re
-import shutil
 import time
 from pathlib import Path
 from typing import Any
@@ -43,9 +42,13 @@ from typing import Any
 from relrl.episodes.provenance import provenance
 from relrl.monitor.tap import TreeWatch, leaf_of
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
+from relrl.outdir import open_stream, write_atomic, write_json_atomic
 from relrl.tensorboard import EVENT_FILE, ScalarLog
 
-__all__ = ["RECORDING", "SessionTap", "write_manifest"]
+__all__ = ["RECORDED", "RECORDING", "SessionTap", "write_manifest"]
+
+#: the files a recorded session writes besides the summary's (``--record``).
+RECORDED = ("session.json", "episode.toml", "domain.pl", "session.mcap")
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")
@@ -85,7 +88,7 @@ def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
     files = {}
     domain = Path(episode.domain)
     if domain.is_file():
-        shutil.copyfile(domain, folder / "domain.pl")
+        write_atomic(folder / "domain.pl", domain.read_bytes())
         files["domain"] = "domain.pl"
     script = Path(episode.path) if getattr(episode, "path", None) else None
     if script is not None and script.is_file():
@@ -93,15 +96,13 @@ def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
         if "domain" in files:
             text = re.sub(r'(?m)^(\s*domain\s*=\s*)(["\']).*?\2', r'\g<1>"domain.pl"', text,
                           count=1)
-        (folder / "episode.toml").write_text(text, encoding="utf-8")
+        write_atomic(folder / "episode.toml", text)
         files["script"] = "episode.toml"
     return files
 
 
 def write_manifest(folder: Path, data: dict[str, Any]) -> None:
     """Write ``session.json`` (atomic)."""
-    from relrl.experiments.report import write_json_atomic
-
     write_json_atomic(folder / "session.json", data)
 
 
@@ -128,9 +129,8 @@ class SessionTap:
                  record_quality: int = 85, recorder: Any = None,
                  live_rate: float = 10.0) -> None:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
-        self.trace = open(out / "trace.jsonl", "w", encoding="utf-8") \
-            if out is not None else None  # noqa: SIM115
-        self.scalars = ScalarLog(out / EVENT_FILE) if out is not None else None
+        self.trace = None
+        self.scalars: ScalarLog | None = None
         self.recording = record and out is not None
         self.recorder, self._own = recorder, False
         self.quality = int(record_quality)
@@ -138,17 +138,26 @@ class SessionTap:
         self._frame_rate = _Rate(record_rate if self.recording else live_rate)
         self._live = _Rate(0 if self.recording else live_rate)  # units sent when live only
         self.files: dict[str, str] = {}
-        if self.recording:
-            if self.recorder is None:
-                from relrl.recording.recorder import Recorder
+        try:
+            self.trace = open_stream(out / "trace.jsonl") if out is not None else None
+            self.scalars = ScalarLog(out / EVENT_FILE) if out is not None else None
+            if self.recording:
+                if self.recorder is None:
+                    from relrl.recording.recorder import Recorder
 
-                self.recorder, self._own = Recorder(), True
-            self.recorder.open(out / RECORDING)
-            self.files = _copy_script(run.episode, out)
-            self.files["recording"] = RECORDING
-            for name in ("episode.toml", "domain.pl"):
-                if (out / name).is_file():
-                    self.recorder.attach(name, "text/plain", (out / name).read_bytes())
+                    self.recorder, self._own = Recorder(), True
+                # the file is made (journalled, never through a link) by the one writer;
+                # the recorder's own process then fills it
+                open_stream(out / RECORDING, binary=True).close()
+                self.recorder.open(out / RECORDING)
+                self.files = _copy_script(run.episode, out)
+                self.files["recording"] = RECORDING
+                for name in ("episode.toml", "domain.pl"):
+                    if (out / name).is_file():
+                        self.recorder.attach(name, "text/plain", (out / name).read_bytes())
+        except BaseException:
+            self.close()
+            raise
         self.tree = TreeWatch(run.learner, TREE_PERIOD)
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False

@@ -157,10 +157,6 @@ MAX_RUNS = 10_000
 #: problems listed in full before the rest are counted.
 MAX_LISTED = 20
 #: names in --out that belong to the run itself (a policy may not take them).
-RESERVED = ("trace.jsonl", "summary.json", "timing.json", "rewards.png", "cgi.png",
-            "table1.png", ".relrl-run.json")
-
-
 class _Lines:
     """Where each table header and key is in the text, indexed once (linear in the text)."""
 
@@ -295,9 +291,10 @@ class _Checker:
             self.fail(where, f"policy_save must be a file name inside --out (a relative path "
                              f"without '..'), not {value!r}")
             return None
-        if str(parts) in RESERVED:
-            self.fail(where, f"policy_save {value!r} is a file of the run itself; choose "
-                             "another name (e.g. policy.pl)")
+        from relrl.episodes.session import policy_save_problem  # the session's own files
+
+        if problem := policy_save_problem(str(parts)):
+            self.fail(where, problem)
             return None
         return str(parts)
 
@@ -354,6 +351,8 @@ def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
     domain = c.get(head, "domain", str, None, w)
     if domain is None:
         c.fail(w, "[episode] needs domain = \"path/to/domain.pl\"")
+    elif "\0" in domain:
+        c.fail(w + ("domain",), f"domain {domain!r} holds a NUL character; no file name can")
     else:
         ep.domain = (base / domain).resolve()
         if not ep.domain.is_file():
@@ -369,7 +368,10 @@ def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
     if not c.choice(ep.learner, tuple(sorted(LEARNERS)), "learner", w + ("learner",)):
         ep.learner = ""
     load = c.get(head, "policy_load", str, "", w)
-    if load:
+    if "\0" in load:
+        c.fail(w + ("policy_load",), f"policy_load {load!r} holds a NUL character; no file "
+                                     "name can")
+    elif load:
         ep.policy_load = (base / load).resolve()
         if not ep.policy_load.is_file():
             c.fail(w + ("policy_load",), f"policy file {load!r} not found")

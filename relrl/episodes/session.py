@@ -9,7 +9,11 @@ policy and plots. A stop request (Ctrl-C, SIGTERM, SIGHUP) ends the run after th
 unit with everything up to it written. Nothing learned is lost on an error either: a lost
 serial port or camera, a fault in a domain's rules, a second Ctrl-C -- the summary and the
 policy so far are written, marked ``"partial": true``, before the error goes on
-(:func:`keep_partial`).
+(:func:`keep_partial`). Those writes -- the summary, the policy, the timing -- are made whole
+while further signals wait (:func:`relrl.outdir.deferred_signals`); only the plots after them
+can be cut short by a second Ctrl-C. Every file goes through relrl's one writer
+(:mod:`relrl.outdir`): atomic, never through a link, a full disk ending the run with what
+fits written.
 """
 
 from __future__ import annotations
@@ -22,18 +26,27 @@ import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import Any, TextIO
 
 import numpy as np
 
 from relrl.episodes.provenance import provenance, session_manifest
-from relrl.episodes.recording import SessionTap, write_manifest
+from relrl.episodes.recording import RECORDED, SessionTap, write_manifest
+from relrl.tensorboard import EVENT_FILE
 from relrl.episodes.script import Episode
+from relrl.outdir import check_inside, deferred_signals, write_json_atomic
 from relrl.progress import progress
 from relrl.terms import format_term
 
-__all__ = ["STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial", "run_episode"]
+__all__ = ["RUN_FILES", "STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial",
+           "policy_save_problem", "run_episode", "run_outputs"]
+
+#: the files and folders (``name/``) a session writes into its output folder.
+RUN_FILES = ("trace.jsonl", EVENT_FILE, "summary.json", "timing.json", "run.log",
+             "rewards.png", "cgi.png", "table1.png") + RECORDED
+#: the longest file name most file systems take, in bytes (the folder is asked at the run).
+NAME_MAX = 255
 
 
 #: signals that stop a run after the current time unit (SIGHUP: the terminal was closed).
@@ -125,6 +138,35 @@ class RunOptions:
     timeout: float = 10.0
 
 
+def policy_save_problem(name: str) -> str | None:
+    """Why ``name`` (a path inside the output folder) cannot be an episode's ``policy_save``:
+    a NUL, a part longer than a file name can be, or a file or folder of the run itself
+    (``summary.json``, ``session.json``, ``session.mcap``, relrl's ``.relrl-run.*``); None
+    when it can."""
+    if "\0" in name:
+        return f"policy_save {name!r} holds a NUL character; no file name can"
+    parts = PurePosixPath(name).parts
+    for part in parts:
+        if len(part.encode("utf-8", "surrogateescape")) > NAME_MAX:
+            return (f"policy_save: the name {part[:40]}... is {len(part.encode())} bytes; a "
+                    f"file name has at most {NAME_MAX}")
+    if not parts:
+        return None
+    if {parts[0], f"{parts[0]}/"} & set(RUN_FILES) or parts[0].startswith(".relrl-run"):
+        return (f"policy_save {name!r} is a file of the run itself; choose another name (e.g. "
+                "policy.pl)")
+    return None
+
+
+def run_outputs(episode: Episode, record: bool = False) -> list[str]:
+    """The files and folders a session of ``episode`` writes (checked when ``--out`` is
+    claimed, before the run)."""
+    names = [n for n in RUN_FILES if record or n not in RECORDED]
+    if episode.policy_save:
+        names.append(episode.policy_save)
+    return names
+
+
 def _json_num(x: float) -> float | None:
     return None if isinstance(x, float) and math.isnan(x) else x
 
@@ -161,6 +203,7 @@ class _Run:
         self.units = 0  # learning time units finished
         self.in_view = None
         self.tap: Any = None
+        self.saved: dict[str, Any] | None = None  # the summary, once it is written
 
     def close(self) -> None:
         self.kb.close()
@@ -190,7 +233,6 @@ def _status(opts: RunOptions, activity: str, detail: str = "", **data: Any) -> N
 
 def _on_step(run: _Run, record: Any, phase: str) -> None:
     """Naming, metrics, the trace and the monitor (:class:`SessionTap`), live output."""
-    run.done += 1
     info = record.info
     said = None
     if record.out.action == "name_object":
@@ -205,6 +247,7 @@ def _on_step(run: _Run, record: Any, phase: str) -> None:
     stats["reward"] += float(record.out.reward)
     stats["attention"] += int(info["record"].attention)
     run.tap.step(record, phase, outcome=outcome, said=said)
+    run.done += 1  # traced: a step whose trace line could not be written is not counted
     if run.opts.live:
         print(_live_line(run.t, phase, record, outcome, said), file=run.opts.stream,
               flush=True)
@@ -238,14 +281,15 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     Raises:
         UserError: a bad device, domain or policy.
     """
+    from relrl.errors import ConfigError
     from relrl.experiments import fruits
     from relrl.loop import Interaction
 
     opts = opts or RunOptions()
     stop = stop or StopRequest()
     out = opts.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+    if episode.policy_save and (problem := policy_save_problem(episode.policy_save)):
+        raise ConfigError(f"{episode.path}: {problem}")
     t0 = time.perf_counter()
     _status(opts, "starting", f"loading the domain {Path(episode.domain).name} and building "
                               "the world")
@@ -254,7 +298,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     unit_name = f"{episode.time_unit}s"
     env = actuator = None
     bar = None
-    written = failed = False
+    failed = False
     try:
         if opts.camera is not None:
             _status(opts, "waiting for the camera", f"opening camera {opts.camera}: the "
@@ -371,19 +415,23 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                   "evaluation_steps": sum(p["control_steps"] for p in run.curve),
                   "naming_steps": sum(e["steps"] for e in run.executions)}
         if out is not None:
-            written = True
-            _write_outputs(run, out, summary, timing)
+            manifest = None
             if opts.record:
-                manifest = session_manifest(run, opts, summary, timing, recorded)
-                write_manifest(out, manifest)
-                run.tap.close(manifest, summary)  # both also inside the recording
+                def manifest() -> None:
+                    data = session_manifest(run, opts, summary, timing, recorded)
+                    write_manifest(out, data)
+                    run.tap.close(data, summary)  # both also inside the recording
+            _write_outputs(run, out, summary, timing, manifest)
         return summary
-    except BaseException as exc:  # a lost device, a fault, a second Ctrl-C
+    except BaseException as exc:  # a lost device, a fault, a full disk, a second Ctrl-C
         failed = True
         _status(opts, "stopped", f"stopped by {type(exc).__name__}"
                 + (f": {str(exc).splitlines()[0]}" if str(exc) else ""))
-        if out is not None and not written:
+        if out is not None and not run.saved:
             keep_partial(run, out, t0, exc)
+        elif out is not None:  # stopped while drawing the plots: the rest is written
+            exc.kept = (f"summary.json{_policy_note(run.saved)} written to "  # type: ignore
+                        f"{out}")
         raise
     finally:
         if bar is not None:
@@ -489,44 +537,60 @@ def _memory(run: _Run) -> dict[str, Any]:
 def keep_partial(run: _Run, out: Path, t0: float, exc: BaseException) -> None:
     """Write the summary and the policy learned so far, marked partial, after ``exc`` ended
     the run early; ``exc.kept`` then says what was written (the command line adds it to
-    its one-line message). Never raises: the original error is what the user must see."""
+    its one-line message). Never raises: the original error is what the user must see (a
+    further Ctrl-C waits until the writes are done)."""
     ep = run.episode
     run.t = min(run.t, run.done)  # the time unit in progress did not finish
     try:
         summary = _summary(run, stopped=True, why=type(exc).__name__)
         summary["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         _write_outputs(run, out, summary, {"seconds": time.perf_counter() - t0,
-                                           "learning_steps": run.t})
-    except Exception as inner:  # whatever it is, the first error is the one that goes on
-        exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore[attr-defined]
-        return
-    policy = f" and {summary['policy']}" if "policy" in summary else ""
+                                           "learning_steps": run.t}, plots=False)
+    except BaseException as inner:  # whatever it is, the first error is the one that goes on
+        if run.saved:  # only the plots were cut short
+            summary = run.saved
+        else:
+            exc.kept = f"nothing could be written to {out} ({inner})"  # type: ignore
+            return
     exc.kept = (f"learned up to time unit {run.units} of {ep.steps}: summary.json"  # type: ignore
-                f"{policy} written to {out} (partial)")
+                f"{_policy_note(summary)} written to {out} (partial)")
 
 
-def _write_outputs(run: _Run, out: Path, summary: dict[str, Any],
-                   timing: dict[str, Any]) -> None:
+def _policy_note(summary: Any) -> str:
+    if isinstance(summary, dict) and "policy" in summary:
+        return f" and {summary['policy']}"
+    return ""
+
+
+def _write_outputs(run: _Run, out: Path, summary: dict[str, Any], timing: dict[str, Any],
+                   manifest: Any = None, *, plots: bool = True) -> None:
+    """The summary, the policy, the timing (and ``manifest()``, session.json) -- whole, while
+    signals wait -- then the plots. The summary goes first: on a full disk it is what the
+    space held back is for; a policy that cannot be written is then named in it."""
     from relrl.errors import RelrlError
-    from relrl.experiments.report import write_json_atomic
 
     ep = run.episode
-    if ep.policy_save:
-        path = out / ep.policy_save
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            if not path.resolve().is_relative_to(out.resolve()):
-                raise OSError(f"{ep.policy_save} leads outside {out}")
-            run.learner.save(path, f"relrl policy: {ep.learner} learner, episode {ep.name}, "
-                                   f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "
-                                   f"{run.t} control steps"
-                                   + (" (partial)" if summary.get("partial") else ""))
+    with deferred_signals():
+        if ep.policy_save:
             summary["policy"] = ep.policy_save
-        except (RelrlError, OSError) as exc:  # the summary is written all the same
-            summary["policy_error"] = f"{ep.policy_save}: {exc}"
-    write_json_atomic(out / "summary.json", summary)
-    write_json_atomic(out / "timing.json", timing)
-    if run.opts.plots:
+        write_json_atomic(out / "summary.json", summary)
+        if ep.policy_save:
+            try:
+                check_inside(out, ep.policy_save)  # (a claimed folder checks it again)
+                run.learner.save(out / ep.policy_save,
+                                 f"relrl policy: {ep.learner} learner, episode {ep.name}, "
+                                 f"seed {ep.seed}, {run.units} time units ({ep.time_unit}s), "
+                                 f"{run.t} control steps"
+                                 + (" (partial)" if summary.get("partial") else ""))
+            except RelrlError as exc:  # the summary says why, and the run ends with it
+                del summary["policy"]
+                summary["policy_error"] = f"{ep.policy_save}: {exc}"
+                write_json_atomic(out / "summary.json", summary)
+        write_json_atomic(out / "timing.json", timing)
+        if manifest is not None:
+            manifest()
+        run.saved = summary
+    if plots and run.opts.plots:
         from relrl.episodes.plots import plot_episode
 
         plot_episode(out, summary, run.rewards)

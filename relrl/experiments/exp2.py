@@ -25,7 +25,6 @@ default, so one that lands later is measured too.
 from __future__ import annotations
 
 import argparse
-import csv
 import os
 import platform
 import sys
@@ -43,6 +42,10 @@ __all__ = ["main", "run_job", "summarise"]
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SCRIPT = ROOT / "examples" / "episodes" / "experiment2.toml"
 
+
+#: the files the sweep writes into its folder (checked for links before it runs).
+OUTPUTS = ("fig6.csv", "fig6_summary.csv", "table1.csv", "table1_summary.csv",
+           "confusion.csv", "fig6.png", "table1.png", "results.json", "timing.json")
 
 def run_job(script: str, learner: str, seed: int, time_unit: str,
             overrides: dict[str, Any], *, report: Any = None) -> dict[str, Any]:
@@ -102,32 +105,24 @@ def summarise(jobs: list[dict[str, Any]]) -> dict[str, Any]:
     return out
 
 
-def _write_csv(path: Path, header: list[str], rows: list[list[Any]]) -> None:
-    with open(path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
-
-
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """CSV tables, plots, ``results.json`` and ``timing.json``."""
-    from relrl.experiments.report import write_json_atomic
+    from relrl.experiments.report import write_csv, write_json_atomic
 
-    out.mkdir(parents=True, exist_ok=True)
     jobs, summary = results["jobs"], results["summary"]
     files = [out / n for n in ("fig6.csv", "fig6_summary.csv", "table1.csv",
                                "table1_summary.csv", "confusion.csv")]
-    _write_csv(files[0], ["learner", "time_unit", "seed", "units", "cgi_mean", "cgi_sd_runs",
+    write_csv(files[0], ["learner", "time_unit", "seed", "units", "cgi_mean", "cgi_sd_runs",
                           "no_shift_runs"],
                [[j["learner"], j["time_unit"], j["seed"], p["units"], round(p["cgi_mean"], 4),
                  round(p["cgi_std"], 4), p.get("no_shift_runs", 0)]
                 for j in jobs for p in j["evaluation"]])
-    _write_csv(files[1], ["learner", "time_unit", "units", "cgi_mean_over_seeds",
+    write_csv(files[1], ["learner", "time_unit", "units", "cgi_mean_over_seeds",
                           "cgi_sd_over_seeds", "seeds"],
                [[s["learner"], s["time_unit"], p["units"], round(p["cgi_mean"], 4),
                  round(p["cgi_sd_over_seeds"], 4), p["seeds"]]
                 for s in summary.values() for p in s["fig6"]])
-    _write_csv(files[2], ["learner", "time_unit", "seed", "execution", "presentations",
+    write_csv(files[2], ["learner", "time_unit", "seed", "execution", "presentations",
                           "missed", "control_steps", "categories", *OUTCOMES],
                [[j["learner"], j["time_unit"], j["seed"], k, e["presentations"], e["missed"],
                  e["steps"], e["categories"], *(e["counts"][o] for o in OUTCOMES)]
@@ -141,8 +136,8 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                         + ([f"{r[o][0]:.2f} +- {r[o][1]:.2f}" for o in OUTCOMES] if r else
                            [("no presentation" if t1["executions"] else "not run")]
                            * len(OUTCOMES)))
-    _write_csv(files[3], ["learner", "time_unit", "seed", *OUTCOMES], rows)
-    _write_csv(files[4], ["learner", "time_unit", "shown", "said", "count", "percent_of_shown"],
+    write_csv(files[3], ["learner", "time_unit", "seed", *OUTCOMES], rows)
+    write_csv(files[4], ["learner", "time_unit", "shown", "said", "count", "percent_of_shown"],
                [[s["learner"], s["time_unit"], shown, said, n,
                  round(100.0 * n / sum(row.values()), 2)]
                 for s in summary.values() for shown, row in s["confusion"].items()
@@ -161,6 +156,8 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         import matplotlib.pyplot as plt
     except ImportError:
         return []
+    from relrl.experiments.report import save_figure
+
     units = sorted({s["time_unit"] for s in summary.values()})
     fig, axes = plt.subplots(1, len(units), figsize=(5.5 * len(units), 3.8), squeeze=False)
     for ax, unit in zip(axes[0], units, strict=True):
@@ -179,9 +176,7 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
     fig.text(0.5, 0.005, "paper (text only): a fast rise until the second evaluation, then a "
              "slow rise to a plateau; no values are given", ha="center", fontsize=8)
     fig.tight_layout(rect=(0, 0.04, 1, 1))
-    files = [out / "fig6.png"]
-    fig.savefig(files[0], dpi=100)
-    plt.close(fig)
+    files = [save_figure(fig, out / "fig6.png", dpi=100)]
 
     keys = [k for k, s in summary.items() if s["table1"]["all_executions"]]
     if keys:
@@ -200,10 +195,9 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         ax.set_title("Table 1: declarative pointing")
         ax.legend(fontsize=7)
         fig.tight_layout()
-        files.append(out / "table1.png")
-        fig.savefig(files[-1], dpi=100)
-        plt.close(fig)
+        files.append(save_figure(fig, out / "table1.png", dpi=100))
     return files
+
 
 
 def _seeds(text: str) -> list[int]:
@@ -244,7 +238,10 @@ def _options(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("--timeout", type=float, default=60.0, metavar="SECONDS",
                         help="seconds one control step may run before the job stops, naming "
                              "the rule (default 60: a loaded machine; the robot's own is 10)")
-    parser.add_argument("--out", default="runs/exp2-sweep", help="output folder")
+    from relrl.outdir import add_out_options
+
+    add_out_options(parser, default="runs/exp2-sweep",
+                    what="output folder: results.json, CSVs, figures")
     return parser.parse_args(argv)
 
 
@@ -279,16 +276,33 @@ def _check(args: argparse.Namespace) -> tuple[list[str], list[str], list[int]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the sweep and write the outputs; exit status 2 for a bad option or script."""
+    """Run the sweep and write the outputs; exit status 2 for a bad option, script or output
+    folder (relrl's output policy: refused when it holds files, unless --overwrite; locked
+    while the sweep runs)."""
     from relrl.errors import UserError
-    from relrl.experiments.runner import run_jobs
+    from relrl.experiments.runner import command_signals
+    from relrl.outdir import OutDir
 
     args = _options(argv)
+    command = " ".join(["python -m relrl.experiments.exp2",
+                        *(argv if argv is not None else sys.argv[1:])])
     try:
         learners, units, seeds = _check(args)
+        with command_signals(), \
+                OutDir.claim(args.out, command=command, overwrite=args.overwrite,
+                             default="runs/exp2-sweep", outputs=OUTPUTS) as out:
+            code = _sweep(args, out.path, command, learners, units, seeds)
+            out.status = "complete" if code == 0 else "partial"
     except UserError as exc:
         print(f"exp2: {exc}", file=sys.stderr)
         return 2
+    return code
+
+
+def _sweep(args: argparse.Namespace, out: Path, command: str, learners: list[str],
+           units: list[str], seeds: list[int]) -> int:
+    from relrl.experiments.runner import run_jobs
+
     table1_units = units if args.table1_units == "all" else \
         [u.strip() for u in args.table1_units.split(",") if u.strip()]
     overrides = {"every": args.every, "perception": args.perception,
@@ -303,22 +317,20 @@ def main(argv: list[str] | None = None) -> int:
         why = outcome.error or f"stopped by {outcome.interrupted}"
         if not jobs:
             print(f"exp2: {why}; no job finished, nothing written", file=sys.stderr)
-            return 2 if outcome.error else 130
+            return 2 if outcome.error else _stopped(outcome.interrupted)
     wall = outcome.seconds
     timing = {"wall_seconds": wall, "workers": args.workers,
               "python": platform.python_version(), "machine_info": machine_info(),
               "jobs": [{"learner": j["learner"], "time_unit": j["time_unit"], "seed": j["seed"],
                         "seconds": j.pop("seconds")} for j in jobs]}
     script = Path(args.script).resolve()
-    results = {"experiment": "exp2",
-               "command": " ".join(["python -m relrl.experiments.exp2",
-                                    *(argv if argv is not None else sys.argv[1:])]),
+    results = {"experiment": "exp2", "command": command,
                "script": str(script.relative_to(ROOT)) if script.is_relative_to(ROOT)
                else str(script),
                "learners": learners, "time_units": units, "seeds": seeds,
                "overrides": overrides, "summary": summarise(jobs), "jobs": jobs,
                "partial": not outcome.complete, "paper": PAPER}
-    files = write_outputs(Path(args.out), results, timing)
+    files = write_outputs(out, results, timing)
     for key, s in results["summary"].items():
         line = f"{key:28s}"
         if s["fig6"]:
@@ -330,12 +342,20 @@ def main(argv: list[str] | None = None) -> int:
                  "; Table 1: no presentation" if s["table1"]["executions"] else
                  "; Table 1 not run for this time unit (--table1-units)")
         print(line)
-    print(f"wrote {len(files)} files to {args.out}/ in {wall:.0f} s")
+    print(f"wrote {len(files)} files to {out}/ in {wall:.0f} s")
     if not outcome.complete:
         print(f"exp2: {why}; the {len(jobs)} finished jobs of {len(tasks)} are written "
               "(results.json marked partial)", file=sys.stderr)
-        return 2 if outcome.error else 130
+        return 2 if outcome.error else _stopped(outcome.interrupted)
     return 0
+
+
+def _stopped(name: str | None) -> int:
+    """128 + the number of the signal that stopped the sweep (SIGINT when unknown)."""
+    import signal
+
+    return 128 + (signal.Signals[name].value if name in signal.Signals.__members__
+                  else signal.SIGINT)
 
 
 if __name__ == "__main__":

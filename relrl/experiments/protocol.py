@@ -18,7 +18,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-__all__ = ["Session", "point_summary"]
+__all__ = ["Session", "codes_met", "point_summary"]
 
 
 class Session:
@@ -131,6 +131,12 @@ class Session:
         self.steps += self.eval_steps * len(result.runs)
         return result
 
+    def states_met(self) -> int | None:
+        """Distinct state codes met while learning; None for a learner that reads the
+        relational view only, for which the engine computes no code (every step reports
+        0)."""
+        return codes_met(self.learning_states)
+
     def memory(self) -> dict[str, int]:
         """The learner's memory in positions (and details)."""
         return dict(self.learner.size())
@@ -167,6 +173,12 @@ class Session:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+
+def codes_met(codes: set[int]) -> int | None:
+    """How many distinct state codes ``codes`` holds; None when they are only 0 (a learner
+    that reads the relational view: the engine computes no code for it)."""
+    return len(codes) if codes - {0} else None
 
 
 def _zero(x: float) -> float:

@@ -8,13 +8,20 @@ version; it is byte-identical for the same configuration and seeds. Wall-clock f
 from __future__ import annotations
 
 import csv
+import io
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["aggregate", "cgi_figure", "plot", "pyplot_or_note", "skip_plots", "summary_table",
-           "tensorboard_runs", "write_json_atomic", "write_outputs"]
+__all__ = ["OUTPUTS", "aggregate", "cgi_figure", "plot", "pyplot_or_note", "save_figure",
+           "skip_plots", "summary_table", "tensorboard_runs", "write_csv", "write_json_atomic",
+           "write_outputs"]
+
+#: the files Experiment 1 writes into its folder (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
+           "memory.csv", "cgi_places.csv", "fig5_cgi.png", "fig4_eye_contacts.png",
+           "cgi_places.png", "PLOTS.txt", "tensorboard/")
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -23,6 +30,34 @@ def write_json_atomic(path: Path, data: Any) -> None:
     from relrl.outdir import write_json_atomic as write
 
     write(path, data)
+
+
+def write_csv(path: Path, header: list[str], rows: Any) -> Path:
+    """Write a CSV file whole (:func:`relrl.outdir.write_atomic`; on a full disk it does not
+    take the space held back for the results); returns ``path``."""
+    from relrl.outdir import write_atomic
+
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(header)
+    w.writerows(rows)
+    return write_atomic(path, buf.getvalue(), spare=False)
+
+
+def save_figure(fig: Any, path: Path, **kwargs: Any) -> Path:
+    """Save a matplotlib figure whole (:func:`relrl.outdir.write_atomic`; on a full disk it
+    does not take the space held back for the results), in the format its suffix names, and
+    close it; ``kwargs`` go to ``savefig`` (``dpi``). Returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    from relrl.outdir import write_atomic
+
+    buf = io.BytesIO()
+    try:
+        fig.savefig(buf, format=Path(path).suffix.lstrip(".") or "png", **kwargs)
+    finally:
+        plt.close(fig)
+    return write_atomic(path, buf.getvalue(), spare=False)
 
 
 def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]:
@@ -67,13 +102,19 @@ def aggregate(jobs: list[dict[str, Any]], learners: list[str]) -> dict[str, Any]
                              "cumulative_mean": [float(c) for c in cumulative]},
             "memory": memory,
             "memory_after_first_run": memory_first,
-            "states_met": float(np.mean([j["states_met"]["learning"] for j in mine])),
+            "states_met": _mean_or_none([j["states_met"]["learning"] for j in mine]),
             "states_met_evaluation": float(np.mean(evaluation)) if evaluation else None,
             "partial": any(j.get("partial", False) for j in mine),
         }
         if "cgi_places" in mine[0]["curve"][0]:
             out[name]["cgi_places"] = _places_curve(mine, points)
     return out
+
+
+def _mean_or_none(xs: list[float | None]) -> float | None:
+    """The mean of the values that are not None (None when there are none)."""
+    values = [x for x in xs if x is not None]
+    return float(np.mean(values)) if values else None
 
 
 def _places_curve(jobs: list[dict[str, Any]], points: int) -> dict[str, list[Any]]:
@@ -104,7 +145,8 @@ def summary_table(summary: dict[str, Any]) -> str:
         line = (f"{name:<12} {first if first is not None else nan:>9.3f} "
                 f"{s['cgi_final']:>9.3f} {s['cgi_literal_final']:>8.3f} "
                 f"{ec['mean']:>7.1f}/{ec['opportunities']:<5d} "
-                f"{s['memory']['positions']:>8.0f} {s['states_met']:>7.0f}")
+                f"{s['memory']['positions']:>8.0f} "
+                + (f"{s['states_met']:>7.0f}" if s["states_met"] is not None else f"{'-':>7}"))
         if places:
             for group in ("trained", "held_out"):
                 v = s.get("cgi_places", {}).get(group, [None])[-1]
@@ -118,48 +160,37 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
 
     Returns the files written.
     """
-    out_dir.mkdir(parents=True, exist_ok=True)
     written = [out_dir / "results.json", out_dir / "timing.json"]
     write_json_atomic(written[0], results)
     write_json_atomic(written[1], timing)
     summary = results["summary"]
-    fig5 = out_dir / "fig5_cgi.csv"
-    with open(fig5, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "point", "learning_steps", "cgi_mean", "cgi_std",
-                    "cgi_literal_mean", "cgi_literal_std", "n_runs"])
-        for name, s in summary.items():
-            for c in s["curve"]:
-                w.writerow([name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}",
-                            f"{c['cgi_std']:.6f}", f"{c['cgi_literal_mean']:.6f}",
-                            f"{c['cgi_literal_std']:.6f}", c["n_runs"]])
-    fig4 = out_dir / "fig4_eye_contacts.csv"
-    with open(fig4, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "opportunity", "cumulative_eye_contacts"])
-        for name, s in summary.items():
-            for i, c in enumerate(s["eye_contacts"]["cumulative_mean"], start=1):
-                w.writerow([name, i, f"{c:.4f}"])
-    memory = out_dir / "memory.csv"
-    with open(memory, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["learner", "positions", "detail", "states_met"])
-        for name, s in summary.items():
-            detail = "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions")
-            w.writerow([name, f"{s['memory']['positions']:g}", detail, f"{s['states_met']:g}"])
-    written += [fig5, fig4, memory]
+    written.append(write_csv(
+        out_dir / "fig5_cgi.csv",
+        ["learner", "point", "learning_steps", "cgi_mean", "cgi_std", "cgi_literal_mean",
+         "cgi_literal_std", "n_runs"],
+        [[name, c["point"], c["learning_steps"], f"{c['cgi_mean']:.6f}", f"{c['cgi_std']:.6f}",
+          f"{c['cgi_literal_mean']:.6f}", f"{c['cgi_literal_std']:.6f}", c["n_runs"]]
+         for name, s in summary.items() for c in s["curve"]]))
+    written.append(write_csv(
+        out_dir / "fig4_eye_contacts.csv", ["learner", "opportunity", "cumulative_eye_contacts"],
+        [[name, i, f"{c:.4f}"] for name, s in summary.items()
+         for i, c in enumerate(s["eye_contacts"]["cumulative_mean"], start=1)]))
+    written.append(write_csv(
+        out_dir / "memory.csv", ["learner", "positions", "detail", "states_met"],
+        [[name, f"{s['memory']['positions']:g}",
+          "; ".join(f"{k}={v:g}" for k, v in s["memory"].items() if k != "positions"),
+          "" if s["states_met"] is None else f"{s['states_met']:g}"]
+         for name, s in summary.items()]))
     if any("cgi_places" in s for s in summary.values()):
-        places = out_dir / "cgi_places.csv"
-        with open(places, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(["learner", "point", "cgi_trained", "cgi_held_out"])
-            for name, s in summary.items():
-                groups = s.get("cgi_places", {})
-                for p in range(len(s["curve"])):
-                    w.writerow([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
-                                            else f"{groups[g][p]:.6f}"
-                                            for g in ("trained", "held_out")])
-        written.append(places)
+        rows = []
+        for name, s in summary.items():
+            groups = s.get("cgi_places", {})
+            for p in range(len(s["curve"])):
+                rows.append([name, p] + ["" if groups.get(g, [None] * (p + 1))[p] is None
+                                         else f"{groups[g][p]:.6f}"
+                                         for g in ("trained", "held_out")])
+        written.append(write_csv(out_dir / "cgi_places.csv",
+                                 ["learner", "point", "cgi_trained", "cgi_held_out"], rows))
     written += tensorboard_runs(out_dir, results)
     written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
@@ -197,10 +228,12 @@ def tensorboard_runs(out_dir: Path, results: dict[str, Any]) -> list[Path]:
 def skip_plots(out_dir: Path) -> list[Path]:
     """A note in place of the figures of an interrupted run (drawing them would delay the
     stop by seconds; the numbers are in results.json and the CSVs)."""
-    note = out_dir / "PLOTS.txt"
-    note.write_text("The run was interrupted, so no figures were drawn (to stop at once); "
-                    "every finished point is in results.json and the CSV files.\n")
-    return [note]
+    from relrl.outdir import write_atomic
+
+    return [write_atomic(out_dir / "PLOTS.txt",
+                         "The run was interrupted, so no figures were drawn (to stop at once); "
+                         "every finished point is in results.json and the CSV files.\n",
+                         spare=False)]
 
 
 def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
@@ -212,11 +245,12 @@ def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        note = out_dir / "PLOTS.txt"
-        note.write_text("matplotlib is not installed, so no PNG plots were drawn; the numbers "
-                        "are in the CSV files.\nInstall the extra to get plots:  "
-                        "pip install 'relrl[plots]'\n")
-        return None, [note]
+        from relrl.outdir import write_atomic
+
+        return None, [write_atomic(out_dir / "PLOTS.txt",
+                                   "matplotlib is not installed, so no PNG plots were drawn; "
+                                   "the numbers are in the CSV files.\nInstall the extra to "
+                                   "get plots:  pip install 'relrl[plots]'\n", spare=False)]
     return plt, []
 
 
@@ -270,10 +304,7 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
         return note
 
     def save(fig: Any, name: str) -> Path:
-        path = out_dir / name
-        fig.savefig(path, dpi=120, bbox_inches="tight")
-        plt.close(fig)
-        return path
+        return save_figure(fig, out_dir / name, dpi=120, bbox_inches="tight")
 
     files = [save(cgi_figure(plt, summary)[0], "fig5_cgi.png")]
     fig, ax = plt.subplots(figsize=(7, 4.8))

@@ -9,12 +9,14 @@ Engines are looked up by name (:data:`ENGINES`): ``local`` (the default; spawned
 processes on this machine) and ``ray`` (:mod:`relrl.experiments.ray_engine`; the same jobs on
 a Ray cluster). Both return the same results for the same jobs.
 
-Stopping. :func:`run_jobs` turns SIGINT (Ctrl-C) and SIGTERM into a clean stop: the workers
-are ended (SIGTERM, then SIGKILL after half a second), the jobs finished so far and the
-events of the unfinished ones are returned in a :class:`Outcome` marked ``interrupted``, and
-the caller writes them (marked partial). Workers ignore SIGINT (Ctrl-C in a terminal reaches
-the whole process group; the parent alone decides) and die with the parent (Linux
-``PR_SET_PDEATHSIG``), so no worker outlives the run. Progress (:mod:`relrl.progress`: a bar
+Stopping. :func:`run_jobs` turns SIGINT (Ctrl-C), SIGTERM and SIGHUP (the terminal closed)
+into a clean stop: the workers are ended (SIGTERM, then SIGKILL after half a second), the jobs
+finished so far and the events of the unfinished ones are returned in a :class:`Outcome`
+marked ``interrupted``, and the caller writes them (marked partial). Inside
+:func:`command_signals` (the experiment commands) a signal after the jobs waits until the
+outputs and the record are written. Workers ignore SIGINT and SIGHUP (a terminal's Ctrl-C or
+hang-up reaches the whole process group; the parent alone decides) and die with the parent
+(Linux ``PR_SET_PDEATHSIG``), so no worker outlives the run. Progress (:mod:`relrl.progress`: a bar
 with ETA on a terminal, log lines elsewhere) counts the jobs' ``point`` events.
 
 Failures. A job that raises a relrl error (a bad domain file, a runaway rule) stops the run;
@@ -26,6 +28,7 @@ else is a bug and keeps its traceback (:class:`JobCrashed`).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
@@ -37,8 +40,8 @@ from typing import Any
 
 from relrl.errors import ConfigError, UserError
 
-__all__ = ["ENGINES", "JobCrashed", "Outcome", "ProgressBar", "WorkerLost", "raise_kept",
-           "run_jobs"]
+__all__ = ["ENGINES", "STOP_SIGNALS", "CommandSignals", "JobCrashed", "Outcome", "ProgressBar",
+           "Stopped", "WorkerLost", "command_signals", "raise_kept", "run_jobs"]
 
 #: a job function: ``fn(*args, report=callable) -> dict``.
 JobFn = Callable[..., dict[str, Any]]
@@ -118,33 +121,91 @@ class _Stop(Exception):
         self.name = signal.Signals(signum).name
 
 
+class Stopped(KeyboardInterrupt):
+    """A stop signal before the jobs started: the command ends at once (status 128 + N).
+
+    Attributes:
+        signum: the signal.
+    """
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+#: the signals that stop an experiment (SIGHUP: its terminal was closed).
+STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP")
+                     if hasattr(signal, n))
+
+
+class CommandSignals:
+    """What SIGINT, SIGTERM and SIGHUP do over one experiment command.
+
+    Before the jobs a signal ends the command at once (:class:`Stopped`); while they run
+    (:func:`stop_on_signals`) it stops them, keeping what finished; once they are over it
+    waits: the outputs and the folder's record are written whole, then the command ends
+    with 128 + N.
+
+    Attributes:
+        signum: the first signal received, or ``None``.
+        stopped: set by a signal while the jobs run.
+    """
+
+    def __init__(self) -> None:
+        self.signum: int | None = None
+        self.phase = "start"
+        self.stopped = threading.Event()
+
+    def __call__(self, signum: int, frame: Any) -> None:
+        self.signum = self.signum or signum
+        if self.phase == "start":
+            raise Stopped(signum)
+        if self.phase == "jobs":
+            first = not self.stopped.is_set()
+            if first:
+                self.stopped.signal_name = signal.Signals(signum).name  # type: ignore
+                self.stopped.set()
+                raise _Stop(signum)
+        # after the jobs: wait for the outputs (the command reads signum at its end)
+
+
+_ACTIVE: list[CommandSignals] = []
+
+
+@contextmanager
+def command_signals() -> Iterator[CommandSignals]:
+    """Install :class:`CommandSignals` for the block (main thread only; elsewhere the block
+    runs with the handlers it has); the old handlers come back afterwards."""
+    handler = CommandSignals()
+    if threading.current_thread() is not threading.main_thread():
+        yield handler
+        return
+    old = {s: signal.signal(s, handler) for s in STOP_SIGNALS}
+    _ACTIVE.append(handler)
+    try:
+        yield handler
+    finally:
+        _ACTIVE.remove(handler)
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
 @contextmanager
 def stop_on_signals() -> Iterator[threading.Event]:
-    """Within the block, SIGINT and SIGTERM set the yielded event (and interrupt a blocking
-    wait once) instead of killing the process; the old handlers come back afterwards.
+    """Within the block, SIGINT, SIGTERM and SIGHUP set the yielded event (and interrupt a
+    blocking wait once) instead of ending the process. Inside :func:`command_signals` the
+    command's handler does it (and holds later signals until the outputs are written);
+    otherwise handlers are installed for the block only.
 
     Only the main thread can install handlers; elsewhere the block runs unchanged.
     """
-    stopped = threading.Event()
-    if threading.current_thread() is not threading.main_thread():
-        yield stopped
-        return
-    old = {}
-
-    def handler(signum: int, frame: Any) -> None:
-        first = not stopped.is_set()
-        stopped.set()
-        stopped.signal_name = signal.Signals(signum).name  # type: ignore[attr-defined]
-        if first:
-            raise _Stop(signum)
-
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        old[sig] = signal.signal(sig, handler)
-    try:
-        yield stopped
-    finally:
-        for sig, h in old.items():
-            signal.signal(sig, h)
+    with contextlib.ExitStack() as stack:
+        handler = _ACTIVE[-1] if _ACTIVE else stack.enter_context(command_signals())
+        handler.phase = "jobs"
+        try:
+            yield handler.stopped
+        finally:
+            handler.phase = "after"
 
 
 def run_jobs(fn: JobFn, arglist: list[tuple], *, workers: int = 1, engine: str = "local",
@@ -226,7 +287,11 @@ def _worker_main(conn: Any) -> None:
 
     from relrl.errors import RelrlError
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # a terminal's Ctrl-C or hang-up reaches the whole group: the parent alone decides (its
+    # SIGTERM ends the worker)
+    for sig in STOP_SIGNALS:
+        if sig != signal.SIGTERM:
+            signal.signal(sig, signal.SIG_IGN)
     _die_with_parent()
     while True:
         try:

@@ -13,7 +13,14 @@ reading), memory in positions after learning, distinct states met.
 A *transfer* job learns with some places held out (``holdout`` of them, spread evenly along
 the table; the caregiver's placement weight 0, so no toy is ever put there) or, with
 ``transfer="kinds"``, with only half of the toy kinds; then it is evaluated, without
-learning, on the trained places and on the unseen ones (zero-shot).
+learning, on the trained places and on the unseen ones (zero-shot). With
+``transfer="sizes"`` (cross-size transfer, the classic claim of relational RL) it learns in
+the world of ``transfer_from`` places, saves its policy, and the policy is loaded into a
+fresh agent in each world of ``transfer_sizes`` and evaluated there with no further
+learning. A policy loads only where it is tied to nothing the worlds differ in: tg's names
+its relations and language bias (no place), so it loads in every world of the family; a
+propositional learner's names the features and responses of its world, and its row says so
+(``error``) instead of a CGI.
 
 Wall-clock figures (steps/s) go to timing.json; results.json holds every other number and
 the full configuration, byte-identical for the same configuration and seeds on any engine.
@@ -58,8 +65,9 @@ class ScalingConfig:
     #: seconds one control step may run before the run stops (a rule that never ends); the
     #: robot's own default is 10 s, batch runs on a loaded machine need more room.
     timeout: float = 60.0
-    transfer: str = "places"         #: places | kinds | none
+    transfer: str = "places"         #: places | kinds | sizes | none
     transfer_sizes: list[int] = field(default_factory=lambda: [5, 9, 17, 33])
+    transfer_from: int = 5           #: with transfer "sizes": the world learned in
     holdout: float = 0.4             #: share of places (or kinds) held out for transfer
 
     def world_of(self, size: int) -> Any:
@@ -72,7 +80,10 @@ class ScalingConfig:
         """Every (learner, size, seed, kind) job, kind ``learn`` or ``transfer``."""
         out = [(lr, size, seed, "learn") for size in self.sizes for lr in self.learners
                for seed in self.seeds]
-        if self.transfer != "none":
+        if self.transfer == "sizes":
+            out += [(lr, self.transfer_from, seed, "transfer") for lr in self.learners
+                    for seed in self.seeds]
+        elif self.transfer != "none":
             out += [(lr, size, seed, "transfer") for size in self.transfer_sizes
                     for lr in self.learners for seed in self.seeds]
         return out
@@ -130,7 +141,8 @@ def run_scaling_job(config: ScalingConfig, learner: str, size: int, seed: int,
     from relrl.experiments.protocol import Session, point_summary
 
     world = config.world_of(size)
-    split = _transfer_split(config, world) if kind == "transfer" else None
+    split = (_transfer_split(config, world) if kind == "transfer" and config.transfer != "sizes"
+             else None)
     learn_params = dict(config.caregiver_params)
     eval_params = dict(config.caregiver_params)
     sequence = None
@@ -172,10 +184,13 @@ def run_scaling_job(config: ScalingConfig, learner: str, size: int, seed: int,
             "learning_steps": session.learned,
             "cgi_final": curve[-1]["cgi_mean"],
             "cgi_literal_final": curve[-1]["cgi_literal_mean"],
-            "memory": session.memory(), "states_met": len(session.learning_states),
+            "memory": session.memory(), "states_met": session.states_met(),
             "learning": session.learning_summary(),
         }
-        if split is not None:
+        if kind == "transfer" and config.transfer == "sizes":
+            result["transfer"] = _across_sizes(config, session, learner, seed,
+                                               curve[-1]["cgi_mean"])
+        elif split is not None:
             unseen_params = {**config.caregiver_params, **split["eval_unseen"][0]}
             session.eval_caregiver_params = unseen_params
             ev = session.evaluate(config.eval_runs, sequence=split["eval_unseen"][1])
@@ -189,6 +204,44 @@ def run_scaling_job(config: ScalingConfig, learner: str, size: int, seed: int,
                                                if learn_seconds else 0.0)
         result["timing"] = timing
         return result
+
+
+def _across_sizes(config: ScalingConfig, session: Any, learner: str, seed: int,
+                  cgi_trained: float) -> dict[str, Any]:
+    """The learned policy of ``session`` loaded into a fresh agent in each world of
+    ``transfer_sizes`` and evaluated there, no learning (cross-size transfer)."""
+    from relrl.errors import PolicyError
+    from relrl.experiments.protocol import Session
+
+    by_size: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory(prefix="relrl-transfer-") as tmp:
+        policy = session.learner.save(Path(tmp) / f"{learner}-policy",
+                                      f"relrl policy: {learner}, P={config.transfer_from}, "
+                                      f"seed {seed}")
+        for size in config.transfer_sizes:
+            world = config.world_of(size)
+            with Session(_domain(world), learner, config.learner_params.get(learner, {}),
+                         seed, world=world, caregiver=config.caregiver,
+                         caregiver_params=config.caregiver_params,
+                         eval_steps=config.eval_steps, eval_policy=config.eval_policy,
+                         timeout=config.timeout) as target:
+                try:
+                    target.learner.load(policy)
+                except PolicyError as exc:
+                    by_size[str(size)] = {"cgi": None, "cgi_literal": None,
+                                          "error": str(exc).replace(str(policy), "the policy")}
+                    continue
+                ev = target.evaluate(config.eval_runs)
+                by_size[str(size)] = {"cgi": ev.cgi_mean, "cgi_literal": ev.cgi_literal_mean,
+                                      "cgi_runs": ev.cgi,
+                                      "memory_positions": target.memory()["positions"]}
+    unseen = [r["cgi"] for s, r in by_size.items()
+              if int(s) != config.transfer_from and r["cgi"] is not None]
+    return {"mode": "sizes", "trained": [config.transfer_from],
+            "unseen": [s for s in config.transfer_sizes if s != config.transfer_from],
+            "cgi_trained": cgi_trained,
+            "cgi_unseen": sum(unseen) / len(unseen) if unseen else None,
+            "by_size": by_size}
 
 
 def summarize(jobs: list[dict[str, Any]], config: ScalingConfig) -> dict[str, Any]:
@@ -217,6 +270,14 @@ def summarize(jobs: list[dict[str, Any]], config: ScalingConfig) -> dict[str, An
                        "cgi_final": mean([j["cgi_final"] for j in mine]),
                        "cgi_literal_final": mean([j["cgi_literal_final"] for j in mine]),
                        "memory_positions": mean([j["memory"]["positions"] for j in mine]),
+                       # a relational learner's candidate tests per leaf (None for others)
+                       "candidates_per_leaf": mean([j["memory"]["candidates"]
+                                                    / j["memory"]["leaves"] for j in mine
+                                                    if "candidates" in j["memory"]
+                                                    and j["memory"].get("leaves")]),
+                       "candidates_max": max((j["memory"]["candidates_max"] for j in mine
+                                              if "candidates_max" in j["memory"]),
+                                             default=None),
                        "states_met": mean([j["states_met"] for j in mine]),
                        "learning_steps": mean([j["learning_steps"] for j in mine]),
                        "partial": any(j.get("partial", False) for j in mine)}
@@ -228,6 +289,35 @@ def summarize(jobs: list[dict[str, Any]], config: ScalingConfig) -> dict[str, An
                 rows[str(size)] = row
             if rows:
                 out[kind][learner] = rows
+    if config.transfer == "sizes":
+        out["transfer"] = _sizes_summary(jobs, config, mean)
+    return out
+
+
+def _sizes_summary(jobs: list[dict[str, Any]], config: ScalingConfig,
+                   mean: Callable[[list[float | None]], float | None]) -> dict[str, Any]:
+    """Cross-size transfer, per learner and target size: the CGI where the policies were
+    learned (``cgi_trained``) and in the target world, no learning (``cgi_unseen``)."""
+    out: dict[str, Any] = {}
+    for learner in config.learners:
+        mine = [j["transfer"] for j in jobs if (j["learner"], j["kind"]) ==
+                (learner, "transfer") and "transfer" in j]
+        if not mine:
+            continue
+        rows = {}
+        for size in config.transfer_sizes:
+            got = [t["by_size"][str(size)] for t in mine if str(size) in t["by_size"]]
+            cgis = [g["cgi"] for g in got]
+            row = {"seeds": len(got), "from": config.transfer_from,
+                   "cgi_trained": mean([t["cgi_trained"] for t in mine]),
+                   "cgi_unseen": mean(cgis),
+                   "cgi_unseen_min": min((c for c in cgis if c is not None), default=None),
+                   "unseen": [str(size)], "partial": False}
+            errors = sorted({g["error"] for g in got if g.get("error")})
+            if errors:
+                row["errors"] = errors
+            rows[str(size)] = row
+        out[learner] = rows
     return out
 
 

@@ -9,18 +9,28 @@ Files (in the output folder): ``results.json`` (every number and the full config
 
 from __future__ import annotations
 
-import csv
 import platform
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import pyplot_or_note, skip_plots, write_json_atomic
+from relrl.experiments.report import (
+    pyplot_or_note,
+    save_figure,
+    skip_plots,
+    write_csv,
+    write_json_atomic,
+)
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.experiments.scaling import ScalingConfig, growth, run_scaling_job, summarize
 from relrl.machine import machine_info
 
-__all__ = ["run_scaling", "scaling_table"]
+__all__ = ["OUTPUTS", "run_scaling", "scaling_table"]
 
+
+#: the files and folders the scaling benchmark writes (checked for links before it runs).
+OUTPUTS = ("results.json", "timing.json", "scaling.csv", "transfer.csv", "curves.csv",
+           "speed.csv", "memory_vs_size.png", "time_to_threshold.png", "transfer.png",
+           "PLOTS.txt", "domains/", "tensorboard/")
 
 def _label(args: tuple) -> str:
     _, learner, size, seed, kind = args
@@ -37,9 +47,10 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
     from relrl import __version__
 
     out = Path(out_dir)
-    (out / "domains").mkdir(parents=True, exist_ok=True)
-    for size in sorted(set(config.sizes) | set(config.transfer_sizes
-                                              if config.transfer != "none" else [])):
+    transfer_sizes = (set(config.transfer_sizes) | {config.transfer_from}
+                      if config.transfer == "sizes" else set(config.transfer_sizes)
+                      if config.transfer != "none" else set())
+    for size in sorted(set(config.sizes) | transfer_sizes):
         config.world_of(size).write_domain(out / "domains")
     tasks = [(config, *job) for job in config.jobs()]
     points = config.budget // config.block + 1
@@ -85,7 +96,6 @@ def run_scaling(config: ScalingConfig, out_dir: str | Path, *, workers: int = 1,
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """results.json, timing.json, the CSVs and the plots; returns the files written."""
-    out.mkdir(parents=True, exist_ok=True)
     files = [out / "results.json", out / "timing.json"]
     write_json_atomic(files[0], results)
     write_json_atomic(files[1], timing)
@@ -93,16 +103,13 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
     learners = results["config"]["learners"]
 
     def table(name: str, header: list[str], rows: list[list[Any]]) -> None:
-        path = out / name
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows([["" if v is None else (f"{v:.6g}" if isinstance(v, float) else v)
-                          for v in row] for row in rows])
-        files.append(path)
+        files.append(write_csv(out / name, header, [
+            ["" if v is None else (f"{v:.6g}" if isinstance(v, float) else v) for v in row]
+            for row in rows]))
 
     keys = ["seeds", "reached", "steps_to_threshold", "steps_to_threshold_max", "cgi_final",
-            "cgi_literal_final", "memory_positions", "states_met", "learning_steps"]
+            "cgi_literal_final", "memory_positions", "candidates_per_leaf", "candidates_max",
+            "states_met", "learning_steps"]
     table("scaling.csv", ["learner", "size", *keys],
           [[lr, int(size), *(row[k] for k in keys)]
            for lr, rows in _ordered(summary["learn"], learners) for size, row in rows])
@@ -149,9 +156,7 @@ def plot(out: Path, results: dict[str, Any]) -> list[Path]:
 
     def save(fig: Any, name: str) -> None:
         fig.tight_layout()
-        fig.savefig(out / name, dpi=120)
-        plt.close(fig)
-        files.append(out / name)
+        files.append(save_figure(fig, out / name, dpi=120))
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     sizes_seen: set[int] = set()
@@ -199,15 +204,19 @@ def plot(out: Path, results: dict[str, Any]) -> list[Path]:
               _ordered(summary["transfer"], config["learners"]) for size, row in rows]
     if groups:
         xs = range(len(groups))
+        trained = {"places": "trained places", "kinds": "trained kinds",
+                   "sizes": f"P={config.get('transfer_from')}, where it learned"}
         ax.bar([x - 0.2 for x in xs], [g[2]["cgi_trained"] or 0 for g in groups], 0.4,
-               label="trained places" if config["transfer"] == "places" else "trained kinds")
+               label=trained.get(config["transfer"], "trained"))
         ax.bar([x + 0.2 for x in xs], [g[2]["cgi_unseen"] or 0 for g in groups], 0.4,
                label="unseen (zero-shot)")
         ax.set_xticks(list(xs))
         ax.set_xticklabels([f"{lr}\nP={s}" for lr, s, _ in groups], fontsize=8)
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("CGI (no learning)")
-    ax.set_title(f"Zero-shot transfer ({config['transfer']} held out)")
+    ax.set_title("Zero-shot transfer to other world sizes (no learning)"
+                 if config["transfer"] == "sizes" else
+                 f"Zero-shot transfer ({config['transfer']} held out)")
     ax.legend()
     ax.grid(alpha=0.3, axis="y")
     save(fig, "transfer.png")
@@ -243,7 +252,7 @@ def scaling_table(results: dict[str, Any], timing: dict[str, Any] | None = None)
             speed.setdefault((t["learner"], t["size"]), []).append(
                 t["learning_steps_per_second"])
     lines = [f"{'learner':<12} {'P':>3} {'reached':>7} {'to 0.9':>8} {'CGI':>6} "
-             f"{'literal':>7} {'memory':>8} {'steps/s':>8}"]
+             f"{'literal':>7} {'memory':>8} {'cand/leaf':>9} {'steps/s':>8}"]
     learners = results["config"]["learners"]
     for learner, rows in _ordered(results["summary"]["learn"], learners):
         for size, r in rows:
@@ -253,10 +262,18 @@ def scaling_table(results: dict[str, Any], timing: dict[str, Any] | None = None)
                 f"{learner:<12} {size:>3} {r['reached']:>3}/{r['seeds']:<3} "
                 f"{'never' if to is None else f'{to:,.0f}':>8} {r['cgi_final']:>6.2f} "
                 f"{r['cgi_literal_final']:>7.2f} {r['memory_positions']:>8,.0f} "
-                f"{sum(sp) / len(sp) if sp else float('nan'):>8,.0f}"
+                + (f"{r['candidates_per_leaf']:>9.1f} " if r.get("candidates_per_leaf")
+                   is not None else f"{'-':>9} ")
+                + f"{sum(sp) / len(sp) if sp else float('nan'):>8,.0f}"
                 + ("  (partial)" if r["partial"] else ""))
     for learner, rows in _ordered(results["summary"]["transfer"], learners):
         for size, r in rows:
+            if "from" in r:         # cross-size transfer
+                unseen = ("not loaded" if r["cgi_unseen"] is None else
+                          f"{r['cgi_unseen']:.2f} (lowest seed {r['cgi_unseen_min']:.2f})")
+                lines.append(f"transfer {learner:<12} P={r['from']} -> P={size:<3} learned at "
+                             f"{r['cgi_trained'] or 0:.2f}  here {unseen}")
+                continue
             lines.append(f"transfer {learner:<12} P={size:<3} trained {r['cgi_trained'] or 0:.2f}"
                          f"  unseen {r['cgi_unseen'] or 0:.2f}")
     return "\n".join(lines)

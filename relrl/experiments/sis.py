@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from relrl.experiments.protocol import codes_met
 from relrl.resources import example
 
 __all__ = ["CLAIMS", "DEFAULT_DOMAIN", "PAPER", "PRESETS", "SISConfig", "claims_table",
@@ -287,7 +288,7 @@ def run_job(config: SISConfig, learner_name: str, seed: int,
                      "memory": session.memory(),
                      "eye_contacts": session.eye_contacts(config.opportunities),
                      "learning": session.learning_summary(),
-                     "states_met": len(session.learning_states)}
+                     "states_met": session.states_met()}
             if groups:
                 entry["place_runs"] = {
                     g: [[sum(r["by_place"].get(p, [0, 0])[i] for p in ps) for i in (0, 1)]
@@ -352,7 +353,8 @@ def job_from_curve(learner: str, seed: int, parts: list[list[dict[str, Any]]],
            "mutual_gaze_events": last["learning"]["mutual_gaze_events"],
            "learning": last["learning"], "memory": last["memory"],
            "states_met": {"learning": last["states_met"],
-                          "evaluation": len(eval_states) if eval_states is not None else None}}
+                          "evaluation": (codes_met(eval_states) if eval_states is not None
+                                         else None)}}
     if params is not None:
         job["params"] = params
     return job

@@ -2,8 +2,10 @@
 
 In the line of RRL-TG (Driessens, Ramon & Blockeel, ECML 2001): one regression tree over
 (relational state, action, necessity) examples whose tests are conjunctions of literals
-from the domain's language bias (``rmode/1``), split by an F-test on incremental statistics
-of the Q-targets. See docs/tg.md.
+from the domain's language bias (``rmode/1``: typed variables, constants only where the
+task needs them), split by an F-test on incremental statistics of the TD errors; choices
+and Q-targets over classes of responses the bias cannot tell apart, so its work and memory
+do not grow with the world. See docs/tg.md.
 """
 
 from __future__ import annotations
@@ -37,8 +39,11 @@ class TGLearner(Learner):
     novelty_confidence standard errors, of the regions (s, a) falls in — its leaf and the
     yes-side of each candidate test of the leaf that succeeds on it — capped at
     novelty_bonus, which is also the bound of a region fewer than two examples reached;
-    novelty_bonus 0 turns it off). Explore and greedy choices and the Q-targets never
-    include the bonuses.
+    novelty_bonus 0 turns it off), keep_examples (each leaf keeps its last examples so
+    that a split's children start with statistics; 0: they start empty). Explore and greedy
+    choices and the Q-targets never include the bonuses. Choices are over classes of
+    responses no test of the bias tells apart in the state (scored by one representative,
+    uniform within a class).
     """
 
     name = "tg"
@@ -46,7 +51,7 @@ class TGLearner(Learner):
     defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "temperature": 1.0,
                 "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
                 "stale_bonus": 1.0, "half_life": 1000.0, "novelty_bonus": 20.0,
-                "novelty_confidence": 2.0}
+                "novelty_confidence": 2.0, "keep_examples": 0.0}
 
     def _check_params(self) -> None:
         super()._check_params()
@@ -56,6 +61,9 @@ class TGLearner(Learner):
         if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
             raise ConfigError(f"min_examples must be a whole number >= 3, not "
                               f"{p['min_examples']}")
+        if p["keep_examples"] < 0 or p["keep_examples"] != int(p["keep_examples"]):
+            raise ConfigError(f"keep_examples must be a whole number >= 0, not "
+                              f"{p['keep_examples']}")
         for key in ("temperature", "stale_bonus", "half_life", "novelty_bonus"):
             if p[key] < 0:
                 raise ConfigError(f"{key} must be >= 0, not {p[key]}")

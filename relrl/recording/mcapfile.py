@@ -9,14 +9,19 @@ kept) leaves a file that is readable up to its last closed chunk -- at most a se
 session is lost. ``relrl replay`` reads such a file and says where it was cut.
 
 The file is the one output of a run that is appended to while the run goes on, so it cannot
-be written through a temporary file and a rename. It is opened with ``O_CREAT | O_EXCL |
-O_NOFOLLOW``: it is never a link and never an earlier file written over (``--overwrite``
-removes the earlier run's file first), mode 0644 less the umask, and ``fsync``-ed when closed.
+be written through a temporary file and a rename. A session makes it empty through relrl's
+one writer first (:func:`relrl.outdir.open_stream`: the name journalled in the claimed
+folder, whatever was there replaced, never written through); this process then opens it
+with ``O_NOFOLLOW`` and writes only into an empty regular file -- or, given no such file,
+creates it with ``O_CREAT | O_EXCL | O_NOFOLLOW``. Either way it is never a link and never
+an earlier file written over, mode 0644 less the umask, and ``fsync``-ed when closed.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 import time
 from pathlib import Path
 from typing import Any
@@ -33,15 +38,26 @@ CHUNK_SECONDS = 1.0
 
 
 def _open_new(path: Path) -> Any:
-    """Open ``path`` for writing: created here, never a link, never an existing file."""
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    """Open ``path`` for writing: an empty regular file made for it, or created here; never
+    a link, never a file with something in it."""
+    nofollow = getattr(os, "O_NOFOLLOW", 0)
     mask = os.umask(0o022)
     os.umask(mask)
     try:
-        fd = os.open(path, flags, 0o666 & ~mask)
-    except FileExistsError:
-        raise OutputError(f"cannot write {path}: a file or link is already there") from None
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | nofollow, 0o666 & ~mask)
+        except FileExistsError:
+            fd = os.open(path, os.O_WRONLY | nofollow)
+            st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode) or st.st_size:
+                os.close(fd)
+                raise OutputError(f"cannot write {path}: a file is already there") from None
+    except OutputError:
+        raise
     except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise OutputError(f"cannot write {path}: a link is there (relrl never writes "
+                              "through a link)") from None
         raise OutputError(f"cannot write {path}: {exc.strerror or exc}") from None
     return os.fdopen(fd, "wb", buffering=1 << 16)
 

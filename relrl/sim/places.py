@@ -63,7 +63,7 @@ CENTRE = 0
 #: distance between the robot's and the caregiver's eyes, in centimetres.
 DISTANCE_CM = 50.0
 #: the most toy places a world may have.
-MAX_PLACES = 99
+MAX_PLACES = 257
 
 #: the paper's five toy places come from the project's shared vocabulary.
 _PAPER_NAMES: tuple[str, ...] = OBJECT_PLACES

@@ -57,7 +57,7 @@ class World:
     """The size of a Social Interactive Simulator world.
 
     Attributes:
-        places: ``P``, the toy places (gaze directions besides the caregiver's face), 2 to 99.
+        places: ``P``, the toy places (gaze directions besides the caregiver's face), 2 to 257.
         colours: ``C``, toy colours (0: toys have no colour and no colour percept).
         kinds: ``K``, toy kinds (0: toys have no kind, as in the paper).
         toys: toys per trial: the target and ``toys - 1`` distractors the caregiver does not
@@ -148,21 +148,13 @@ class World:
     def write_domain(self, folder: str | Path) -> Path:
         """Write this world's domain to ``folder/NAME.pl`` (unchanged files are left alone;
         a new one appears whole, through a rename). Returns the path."""
-        import os
-        import tempfile
+        from relrl.outdir import write_atomic
 
-        folder = Path(folder)
-        folder.mkdir(parents=True, exist_ok=True)
-        path = folder / f"{self.name}.pl"
+        path = Path(folder) / f"{self.name}.pl"
         text = self.domain_text()
-        if path.exists() and path.read_text() == text:
+        if path.is_file() and not path.is_symlink() and path.read_text() == text:
             return path
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-        return path
+        return write_atomic(path, text)
 
     def vocabulary(self) -> Any:
         """The percepts this world produces, as a

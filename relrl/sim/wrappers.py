@@ -140,7 +140,6 @@ class EpisodeScalars(gym.Wrapper, gym.utils.RecordConstructorArgs):
 
         gym.utils.RecordConstructorArgs.__init__(self, folder=str(folder))
         gym.Wrapper.__init__(self, env)
-        Path(folder).mkdir(parents=True, exist_ok=True)
         self.log = ScalarLog(Path(folder) / EVENT_FILE)
         self.episodes: list[dict[str, float]] = []
         self.steps = 0

@@ -82,11 +82,27 @@ def corpus(tmp_path_factory) -> Path:
         "absolute.toml": episode_text(head=f'policy_save = "{d}/abs-policy.pl"'),
         "reserved.toml": episode_text(head='policy_save = "summary.json"'),
         "dir_policy.toml": episode_text(head='policy_save = "policies/"'),
+        "long_policy.toml": episode_text(head=f'policy_save = "{"p" * 300}.pl"'),
+        "nul_policy.toml": episode_text(head='policy_save = "p\\u0000.pl"'),
+        "nul_load.toml": episode_text(head='policy_load = "p\\u0000.pl"'),
+        "nul_domain.toml": episode_text().replace('.pl"\n', '.pl\\u0000"\n', 1),
     }
+    for own in ("session.json", "session.mcap", "summary.json", "trace.jsonl", "domain.pl",
+                "episode.toml", "run.log", "timing.json", ".relrl-run.files"):
+        eps[f"own_{own.replace('/', '_')}.toml"] = episode_text(head=f'policy_save = "{own}"')
     for name, text in eps.items():
         (d / name).write_text(text)
     hostile_policies(d)
     hostile_tomls(d)
+    head = (ROOT / "examples" / "heads" / "wha8030.toml").read_text()
+    (d / "nul_scripts.toml").write_text(
+        head.replace("[head]\n", '[head]\nscripts = "more\\u0000.toml"\n', 1))
+    (d / "adir.svg").mkdir()
+    from relrl.episodes import RunOptions, parse_episode, run_episode
+
+    # a policy with a tree to draw (30 time units of etg)
+    run_episode(parse_episode(episode_text(steps=30), d / "tree.toml"),
+                RunOptions(out=d / "tree-run", plots=False))
     return d
 
 

@@ -1,16 +1,22 @@
 """The bad-input corpus, every subcommand: one line naming the value, exit 2.
 
-It holds 118 cases in :data:`CASES` (a test checks this count), and the tests below it for
-inputs whose answer is more than one line. Each case is ``relrl ARGV`` run in this process
-(an escaping exception fails the test with its traceback) and the words the one line must
-contain. ``{d}`` is the corpus folder (``conftest.corpus``: hostile files, policies and TOML
-included), ``{fruits}`` the fruits domain. Outputs that must *not* be written are checked in
-``test_outputs.py``; lost devices, faults and signals in ``test_nothing_lost.py``.
+Each case is ``relrl ARGV`` run in this process (an escaping exception fails the test with its
+traceback) and the words the one line must contain. ``{d}`` is the corpus folder
+(``conftest.corpus``: hostile files, policies and TOML included), ``{fruits}`` the fruits
+domain. Outputs that must *not* be written are
+checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
+``test_nothing_lost.py``.
+
+The corpus holds 215 cases: 149 bad inputs in ``CASES`` and 23 more tests here, 26 in
+``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
+:func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
 
 from __future__ import annotations
 
+import importlib
 import io
+import re
 import sys
 
 import pytest
@@ -71,6 +77,20 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["reserved.toml:4", "summary.json"]),
     ("run-policy-folder", ["run", "{d}/dir_policy.toml", "--out", "{d}/out-dirp"],
      ["dir_policy.toml:4", "policies/"]),
+    ("run-policy-300-characters", ["run", "{d}/long_policy.toml", "--check"],
+     ["long_policy.toml:4", "policy_save", "255"]),
+    ("run-policy-nul", ["run", "{d}/nul_policy.toml", "--out", "{d}/out-nul"],
+     ["nul_policy.toml:4", "policy_save", "NUL"]),
+    ("run-policy-nul-check", ["run", "{d}/nul_policy.toml", "--check"],
+     ["nul_policy.toml:4", "NUL"]),
+    ("run-domain-nul", ["run", "{d}/nul_domain.toml", "--check"],
+     ["nul_domain.toml:2", "domain", "NUL"]),
+    ("run-policy-load-nul", ["run", "{d}/nul_load.toml", "--check"],
+     ["nul_load.toml:4", "policy_load", "NUL"]),
+    *[(f"run-policy-own-{own}", ["run", f"{{d}}/own_{own}.toml", "--check"],
+       [f"own_{own}.toml:4", "file of the run itself"])
+      for own in ("session.json", "session.mcap", "summary.json", "trace.jsonl", "domain.pl",
+                  "episode.toml", "run.log", "timing.json", ".relrl-run.files")],
     ("run-protocol-without-head", ["run", "{d}/ok.toml", "--protocol", "ssc32"],
      ["--protocol"]),
     ("run-missing-head", ["run", "{d}/ok.toml", "--head", "/dev/ttyNOPE0", "--protocol",
@@ -115,6 +135,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("head-latin1-calibration", ["head", "--calibration", "{d}/latin1.toml", "status"],
      ["latin1.toml"]),
     ("head-calibration-dir", ["head", "--calibration", "{d}/adir", "status"], ["adir"]),
+    ("head-calibration-scripts-nul", ["head", "--calibration", "{d}/nul_scripts.toml",
+                                      "status"], ["nul_scripts.toml", "head.scripts", "NUL"]),
     ("head-timeout-nan", ["head", "--port", "/dev/ttyNOPE0", "--protocol", "ssc32",
                           "--timeout", "nan", "status"], ["--timeout", "nan"]),
     ("head-timeout-negative", ["head", "--port", "/dev/ttyNOPE0", "--protocol", "ssc32",
@@ -130,6 +152,13 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("run-record-without-out", ["run", "{d}/ok.toml", "--record"], ["--record", "--out"]),
     ("run-record-quality", ["run", "{d}/ok.toml", "--out", "{d}/rq", "--record",
                             "--record-quality", "101"], ["--record-quality", "101"]),
+    ("run-record-rate-nan", ["run", "{d}/ok.toml", "--out", "{d}/rr", "--record",
+                             "--record-rate", "nan"], ["--record-rate", "nan"]),
+    ("run-record-rate-inf", ["run", "{d}/ok.toml", "--out", "{d}/rr", "--record",
+                             "--record-rate", "inf"], ["--record-rate", "inf"]),
+    ("run-calibration-scripts-nul", ["run", "{d}/ok.toml", "--head", "sim", "--calibration",
+                                     "{d}/nul_scripts.toml"],
+     ["nul_scripts.toml", "head.scripts", "NUL"]),
     ("run-audio-missing", ["run", "{d}/ok.toml", "--audio", "{d}/nope.wav"], ["nope.wav"]),
     ("run-audio-not-wav", ["run", "{d}/ok.toml", "--audio", "{d}/afile"], ["afile"]),
     ("run-mic-missing", ["run", "{d}/ok.toml", "--mic", "no-such-microphone"],
@@ -154,6 +183,12 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["random.toml"]),
     ("tree-format", ["tree", "{d}/afile", "--domain", "{fruits}", "--out", "{d}/t.gif"],
      ["t.gif", "format"]),
+    ("tree-out-a-folder-named-svg", ["tree", "{d}/tree-run/policy.pl", "--domain", "{fruits}",
+                                     "--out", "{d}/adir.svg"], ["adir.svg", "folder"]),
+    ("tree-out-under-a-file", ["tree", "{d}/tree-run/policy.pl", "--domain", "{fruits}",
+                               "--out", "{d}/afile/t.svg"], ["afile"]),
+    ("tree-out-unwritable", ["tree", "{d}/tree-run/policy.pl", "--domain", "{fruits}",
+                             "--out", "/proc/relrl-tree.svg"], ["/proc"]),
     ("examples-copy-file", ["examples", "--copy", "{d}/afile"], ["afile", "not a folder"]),
     # ---- policies: refused whole, naming the file and line (conftest.hostile_policies) ----
     ("tree-policy-id-1e9", ["tree", "{d}/p_id1e9.pl", "--domain", "{fruits}"],
@@ -212,6 +247,7 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("head-calibration-scripts-dev-zero", ["head", "--calibration",
                                            "{d}/cal_scripts_dev_zero.toml", "status"],
      ["cal_scripts_dev_zero.toml", "head.scripts", "/dev/zero", "not a regular file"]),
+    ("report-out-unwritable", ["report", "{d}/adir", "--out", "/proc/relrl.md"], ["/proc"]),
     # ---- demo ------------------------------------------------------------------------------
     ("demo-out-file", ["demo", "--out", "{d}/afile"], ["afile", "not a folder"]),
     ("demo-out-dev-null", ["demo", "--out", "/dev/null"], ["/dev/null"]),
@@ -233,10 +269,6 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
     needles = [n.format(d=corpus) for n in needles]
     one_line_exit_2(capsys, argv, *needles)
-
-
-def test_the_corpus_says_how_many_cases_it_holds():
-    assert f"It holds {len(CASES)} cases" in " ".join(__doc__.split())
 
 
 def test_every_subcommand_is_in_the_corpus():
@@ -331,3 +363,29 @@ def test_user_clauses_piped_into_the_shell(capfd, monkeypatch):
     captured = capfd.readouterr()
     assert captured.out.startswith("error: user:2: Syntax error")
     assert "iri_scheme" not in captured.err and "Traceback" not in captured.err
+
+
+def _cases(module: str) -> int:
+    """The test cases of a module: its test functions, each parametrization counted."""
+    n = 0
+    for name, fn in vars(importlib.import_module(module)).items():
+        if name.startswith("test_") and callable(fn):
+            k = 1
+            for mark in getattr(fn, "pytestmark", []):
+                if mark.name == "parametrize":
+                    k *= len(mark.args[1])
+            n += k
+    return n
+
+
+def test_the_corpus_says_how_many_cases_it_holds():
+    said = re.search(r"holds (\d+) cases: (\d+) bad inputs in ``CASES`` and (\d+) more tests "
+                     r"here, (\d+) in\s+``test_outputs.py``, (\d+) in ``test_nothing_lost.py``",
+                     __doc__)
+    assert said, "the docstring no longer says how many cases the corpus holds"
+    total, cases, here, outputs, lost = map(int, said.groups())
+    counted = {"cases": len(CASES), "here": _cases(__name__) - len(CASES),
+               "outputs": _cases("tests.cli.test_outputs"),
+               "lost": _cases("tests.cli.test_nothing_lost")}
+    assert counted == {"cases": cases, "here": here, "outputs": outputs, "lost": lost}
+    assert total == sum(counted.values())

@@ -1,6 +1,8 @@
 """Nothing learned is lost: a lost serial port or camera, a fault in a domain's rules, a bug,
-a signal -- ``relrl run`` writes the summary and the policy so far, marked partial, and then
-ends with one line (or the stop message) -- and interrupted evaluations are flagged."""
+a signal (two Ctrl-C in a row, SIGHUP to an experiment), a full disk, the output folder
+deleted -- ``relrl run`` writes the summary and the policy so far, marked partial, and then
+ends with one line (or the stop message) -- and interrupted evaluations are flagged. Signals
+are real signals to a real process; the full disk is a real small tmpfs."""
 
 from __future__ import annotations
 
@@ -12,10 +14,12 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from head.fake import FakeController, PtyController
+from relrl.cli import main
 from relrl.episodes import RunOptions, StopRequest, parse_episode, run_episode
 from tests.cli.conftest import FRUITS, ROOT, episode_text, one_line_exit_2
 from tests.head.conftest import FAST_TOML
@@ -217,3 +221,171 @@ def test_an_interrupted_evaluation_point_is_flagged(tmp_path):
     assert cut["partial"]
     saved = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert saved["evaluation"][1]["interrupted"]
+
+
+# ---- real signals, a full disk, a folder deleted: what a session keeps ----------------------
+
+def _start(*argv: str, stderr: Any = subprocess.PIPE) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-m", "relrl", *argv], cwd=ROOT, text=True,
+                            stdout=subprocess.PIPE, stderr=stderr, stdin=subprocess.DEVNULL)
+
+
+def _wait_traced(out: Path, steps: int, proc: subprocess.Popen) -> None:
+    deadline = time.monotonic() + 240  # generous: a loaded machine starts Python slowly
+    while time.monotonic() < deadline and proc.poll() is None and \
+            _lines(out / "trace.jsonl") < steps:
+        time.sleep(0.02)
+    assert _lines(out / "trace.jsonl") >= steps, f"the run did not start (exit {proc.poll()})"
+
+
+def _no_leftovers(out: Path) -> None:
+    """No temporary file, nor relrl's journal or held-back space, is left in ``out``."""
+    left = [p.name for p in out.rglob("*") if p.name.endswith(".tmp")
+            or p.name in (".relrl-run.files", ".relrl-run.spare")]
+    assert left == [], left
+
+
+@pytest.mark.parametrize("gap", [0.0, 0.05])
+def test_two_ctrl_c_in_a_row_keep_the_summary_timing_and_policy(tmp_path, gap):
+    """Real SIGINTs to a real ``relrl run``: the second comes while the first one's outputs
+    are being written, and waits for them."""
+    (tmp_path / "long.toml").write_text(LONG)
+    out = tmp_path / "out"
+    proc = _start("run", str(tmp_path / "long.toml"), "--out", str(out), "--no-plots")
+    _wait_traced(out, 20, proc)
+    os.kill(proc.pid, signal.SIGINT)
+    time.sleep(gap)
+    os.kill(proc.pid, signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    # 130 (exit 128 + 2), or -2: the second came as Python was ending, everything written
+    # (a shell shows both as 130)
+    assert proc.returncode in (130, -signal.SIGINT), stderr
+    assert "Traceback" not in stderr and len(stderr.strip().splitlines()) == 1, stderr
+    summary = _assert_kept(out)
+    assert json.loads((out / "timing.json").read_text())["learning_steps"] == summary["steps"]
+    _no_leftovers(out)
+
+
+def _read_all(fd: int, into: list[bytes]) -> None:
+    while True:
+        try:
+            chunk = os.read(fd, 4096)
+        except OSError:  # the other side closed
+            return
+        if not chunk:
+            return
+        into.append(chunk)
+
+
+def test_sighup_stops_an_experiment_keeping_every_finished_point(tmp_path):
+    """The terminal closed (a real SIGHUP): the experiment stops like on Ctrl-C, writing
+    the points that finished, marked partial; exit 128 + 1."""
+    import pty
+
+    out = tmp_path / "out"
+    master, slave = pty.openpty()  # a terminal: the progress bar shows each point
+    proc = _start("experiment", "sis", "--learners", "etg", "--points", "2000",
+                  "--eval-runs", "1", "--eval-steps", "20", "--block", "20", "--workers", "1",
+                  "--out", str(out), stderr=slave)
+    os.close(slave)
+    shown: list[bytes] = []
+    reader = threading.Thread(target=_read_all, args=(master, shown), daemon=True)
+    reader.start()
+    deadline = time.monotonic() + 240
+    while time.monotonic() < deadline and proc.poll() is None \
+            and b"point 3" not in b"".join(shown):
+        time.sleep(0.05)
+    assert proc.poll() is None, b"".join(shown).decode(errors="replace")
+    os.kill(proc.pid, signal.SIGHUP)
+    stdout, _ = proc.communicate(timeout=120)
+    reader.join(timeout=10)
+    os.close(master)
+    assert proc.returncode == 128 + signal.SIGHUP, b"".join(shown)[-2000:]
+    assert "stopped by SIGHUP" in stdout
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] and results["interrupted_by"] == "SIGHUP"
+    assert len(results["summary"]["etg"]["curve"]) >= 3
+    record = json.loads((out / ".relrl-run.json").read_text())
+    assert record["status"] == "partial" and "results.json" in record["files"]
+    _no_leftovers(out)
+
+
+def _on_a_small_disk(tmp_path: Path, argv: list[str], size: str = "200k"
+                     ) -> tuple[subprocess.CompletedProcess, Path]:
+    """Run ``relrl ARGV`` with ``{disk}`` a fresh tmpfs of ``size`` (its own mount namespace:
+    nothing is left mounted); returns the process and a copy of what the disk held."""
+    disk, copy = tmp_path / "disk", tmp_path / "copy"
+    disk.mkdir()
+    copy.mkdir()
+    unshare = ["unshare", "--mount"] if os.geteuid() == 0 else \
+        ["unshare", "--user", "--map-root-user", "--mount"]
+    shell = ('mount -t tmpfs -o size="$SIZE" relrl-test "$DISK" || exit 97; "$@"; rc=$?; '
+             'cp -a "$DISK/." "$COPY/"; exit $rc')
+    proc = subprocess.run([*unshare, "sh", "-c", shell, "sh", sys.executable, "-m", "relrl",
+                           *[a.format(disk=disk) for a in argv]],
+                          env={**os.environ, "DISK": str(disk), "COPY": str(copy),
+                               "SIZE": size},
+                          cwd=ROOT, capture_output=True, text=True, timeout=600)
+    if proc.returncode == 97 or "unshare:" in proc.stderr:
+        pytest.fail(f"a small tmpfs could not be mounted here: {proc.stderr.strip()}")
+    return proc, copy
+
+
+@pytest.mark.parametrize("flags", [[], ["--record", "--camera", "synthetic://?size=160x120",
+                                        "--record-rate", "0"]], ids=["trace", "frames"])
+def test_a_full_disk_ends_in_one_line_with_what_fits_written(tmp_path, flags):
+    """A real 200 KB tmpfs fills up: one line, exit 2, the summary and the policy written in
+    the space held back, the record says partial, no temporary file anywhere."""
+    (tmp_path / "long.toml").write_text(LONG)
+    proc, copy = _on_a_small_disk(tmp_path, ["run", str(tmp_path / "long.toml"), "--out",
+                                             "{disk}/out", "--no-plots", *flags])
+    out = copy / "out"
+    lines = [x for x in proc.stderr.splitlines() if x.strip()]
+    assert proc.returncode == 2 and len(lines) == 1, proc.stderr
+    assert "No space left on device" in lines[0] and "(partial)" in lines[0], lines[0]
+    assert "Traceback" not in proc.stderr
+    summary = _assert_kept(out)
+    assert "No space left on device" in summary["error"]
+    for line in (out / "trace.jsonl").read_text().splitlines():  # whole lines only
+        json.loads(line)
+    _no_leftovers(out)
+
+
+def test_an_experiment_on_a_full_disk_keeps_its_results(tmp_path):
+    """The figures do not fit: results.json does (one line, exit 2, the record partial)."""
+    proc, copy = _on_a_small_disk(tmp_path, [
+        "experiment", "sis", "--learners", "etg", "--points", "2", "--eval-runs", "1",
+        "--eval-steps", "20", "--block", "20", "--workers", "1", "--out", "{disk}/out"],
+        size="120k")
+    out = copy / "out"
+    lines = [x for x in proc.stderr.splitlines() if x.strip()]
+    assert proc.returncode == 2 and "No space left on device" in lines[-1], proc.stderr
+    assert "Traceback" not in proc.stderr
+    assert json.loads((out / "results.json").read_text())["summary"]["etg"]["curve"]
+    record = json.loads((out / ".relrl-run.json").read_text())
+    assert record["status"] == "partial" and "results.json" in record["files"]
+    _no_leftovers(out)
+
+
+def test_deleting_out_mid_run_ends_in_one_line_not_a_success(capsys, tmp_path):
+    """The folder removed under a running session: exit 2 saying so, not "wrote
+    trace.jsonl" -- and the folder is not made again behind the user's back."""
+    import shutil
+
+    (tmp_path / "long.toml").write_text(LONG)
+    out, gone = tmp_path / "out", tmp_path / "gone"
+
+    def delete() -> None:  # `rm -rf out`, done at once: the session may write as it goes
+        out.rename(gone)
+        while gone.exists():
+            shutil.rmtree(gone, ignore_errors=True)
+
+    watcher = _when_traced(out / "trace.jsonl", 5, delete)
+    code = main(["run", str(tmp_path / "long.toml"), "--out", str(out), "--no-plots"])
+    watcher.join()
+    captured = capsys.readouterr()
+    lines = [x for x in captured.err.splitlines() if x.strip()]
+    assert code == 2 and len(lines) == 1 and "Traceback" not in captured.err, captured.err
+    assert "deleted" in lines[0] and str(out) in lines[0], lines[0]
+    assert "wrote" not in captured.out
+    assert not out.exists()

@@ -90,6 +90,49 @@ def test_kinds_transfer_holds_out_toy_kinds(tmp_path: Path) -> None:
     assert job["transfer"]["trained"] == ["ball", "car"]
 
 
+def test_sizes_transfer_acts_in_larger_worlds_with_no_learning(tmp_path: Path,
+                                                              capsys) -> None:
+    """tg learns at P = 5 and its policy, which names no place, acts at P = 9 and 33; ETG's
+    policy names its world's features and does not load there (the row says why)."""
+    out = tmp_path / "sizes"
+    assert main(["experiment", "scaling", "--learners", "tg,etg", "--sizes", "5", "--seeds",
+                 "0", "--budget", "2000", "--block", "1000", "--eval-runs", "2",
+                 "--eval-steps", "150", "--transfer", "sizes", "--transfer-from", "5",
+                 "--transfer-sizes", "9,33", "--workers", "1", "--out", str(out)]) == 0
+    assert "P=5 -> P=33" in capsys.readouterr().out
+    results = json.loads((out / "results.json").read_text())
+    transfer = [j for j in results["jobs"] if j["kind"] == "transfer"]
+    assert sorted((j["learner"], j["size"]) for j in transfer) == [("etg", 5), ("tg", 5)]
+    tg = results["summary"]["transfer"]["tg"]
+    assert set(tg) == {"9", "33"} and all(r["from"] == 5 for r in tg.values())
+    assert all(r["cgi_unseen"] is not None and "errors" not in r for r in tg.values())
+    by_size = next(j for j in transfer if j["learner"] == "tg")["transfer"]["by_size"]
+    assert by_size["33"]["memory_positions"] == by_size["9"]["memory_positions"] > 0
+    etg = results["summary"]["transfer"]["etg"]["33"]
+    assert etg["cgi_unseen"] is None and "features differ" in etg["errors"][0]
+    rows = list(csv.DictReader(open(out / "transfer.csv")))
+    assert [(r["learner"], r["size"]) for r in rows] == [("tg", "9"), ("tg", "33"),
+                                                         ("etg", "9"), ("etg", "33")]
+    assert (out / "domains" / "sis-p33-c2-k0-t2.pl").exists()
+
+
+@pytest.mark.parametrize("size", [5, 33, 129])
+def test_tg_candidates_do_not_depend_on_the_world_size(size: int, tmp_path: Path) -> None:
+    """The generated worlds' bias names no place: an empty tree's candidate tests are the
+    same at every size, and relrl check has no warning about the bias."""
+    from relrl.kb import KnowledgeBase
+    from relrl.sim.world import World
+    from relrl.terms import Var
+    from relrl.validate import bias_warnings
+
+    with KnowledgeBase(World(places=size).write_domain(tmp_path)) as kb:
+        _, _, refinements, _ = kb.call("relrl_check:bias_listing", kb.module, Var())[0]
+        assert bias_warnings(kb) == []
+    with KnowledgeBase(World(places=5).write_domain(tmp_path)) as kb:
+        _, _, at_five, _ = kb.call("relrl_check:bias_listing", kb.module, Var())[0]
+    assert refinements == at_five and len(refinements) == 19
+
+
 def test_growth_is_the_log_log_slope() -> None:
     summary = {"learn": {"a": {"5": {"memory_positions": 100.0},
                                "10": {"memory_positions": 400.0}},
@@ -113,6 +156,8 @@ def test_growth_is_the_log_log_slope() -> None:
     (["--learners", "sarsa"], "unknown learner 'sarsa'"),
     (["--patience", "-1"], "--patience must be 0 or more"),
     (["--transfer-sizes", "x"], "--transfer-sizes must be comma-separated integers"),
+    (["--transfer", "sizes", "--transfer-from", "1"], "--transfer-from 1: "),
+    (["--transfer", "sizes", "--transfer-sizes", "5,300"], "--transfer-sizes 300: "),
     (["--seeds", "1,1"], "--seeds must be distinct"),
     (["--caregiver-param", "reliability=7"], "reliability=7"),
     (["--caregiver-param", "placement={\"left\": 1}"],

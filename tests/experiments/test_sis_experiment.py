@@ -35,7 +35,8 @@ def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
         s = results["summary"][name]
         assert len(s["curve"]) == 3
         assert s["memory"]["positions"] > 0
-        assert s["states_met"] > 0
+        # tg reads the relational view: the engine computes no state code for it
+        assert s["states_met"] is None if name == "tg" else s["states_met"] > 0
     lines = (a / "fig5_cgi.csv").read_text().splitlines()
     assert lines[0] == ("learner,point,learning_steps,cgi_mean,cgi_std,cgi_literal_mean,"
                         "cgi_literal_std,n_runs")

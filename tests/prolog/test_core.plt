@@ -274,9 +274,10 @@ tree_nodes(KB, Nodes) :-
 % ---------------------------------------------------------------------------------------
 :- begin_tests(engine_step).
 
-%   tiny.pl: light 1, dark 2, food 4; hunger always active; food is the reinforcer.
+%   tiny.pl: light 1, dark 2, food 4; hunger always active; food is the reinforcer; no
+%   constraint rules, so every response is allowed (mask -1).
 test(step_reports_code_reward_and_mask,
-     [true((Code == 5, N == hunger, Reward =:= 10, R == true, Mask == 7,
+     [true((Code == 5, N == hunger, Reward =:= 10, R == true, Mask == -1,
             between(0, 2, A)))]) :-
     kb_with('tests/data/tiny.pl', KB),
     etg_params(P),
@@ -419,6 +420,20 @@ test(snapshot_restores_memory_and_stream, [X1 == X2]) :-
 test(unknown_learner, [error(domain_error(learner(_), sarsa))]) :-
     kb_with('tests/data/tiny.pl', KB),
     relrl_engine:engine_configure(KB, sarsa, [], 0).
+
+%   A policy is text (relrl's writer puts it on disk): the header as comments, then terms
+%   that read back, the first naming the learner.
+test(policy_text_reads_back_as_terms, [true((Name/Arity == relrl_policy/2, L == etg))]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    etg_params(P),
+    relrl_engine:engine_configure(KB, etg, P, 0),
+    relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
+    relrl_engine:engine_policy(KB, "a policy\nof two lines", Text),
+    assertion(string(Text)),
+    assertion(sub_string(Text, 0, _, _, "% a policy\n% of two lines\n")),
+    setup_call_cleanup(open_string(Text, S), read_term(S, T, []), close(S)),
+    functor(T, Name, Arity),
+    arg(1, T, L).
 
 :- end_tests(engine_step).
 

@@ -25,7 +25,7 @@ gaze_kb(KB) :-
 params(Level, MinEx,
        [alpha=0, gamma=0.9, epsilon=0, temperature=0, q_init=0, significance=Level,
         min_examples=MinEx, stale_bonus=0, half_life=0, novelty_bonus=0,
-        novelty_confidence=2]).
+        novelty_confidence=2, keep_examples=0]).
 
 fresh_learner(KB, Level, MinEx) :-
     gaze_kb(KB),
@@ -189,7 +189,7 @@ test(children_start_from_partitions, [true(abs(Q - Expected) + abs(N - 12) < 1.0
                      ( G == P -> T = 10 ; T = 0 ) ), Stream),
     forall(member(G-P-T, Stream), tg_insert(KB, [gaze(face, G)], look(P), curiosity, T)),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
-    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _, _, _)),
     length(First, 28), append(First, _, Stream),
     foldl(replay, First, 0-0-[], QLeaf-_-Errors),
     sum_list(Errors, Sum), length(Errors, 10),
@@ -293,8 +293,8 @@ test(forgetting_rescales, [true(abs(Today - Expected) < 1.0e-9)]) :-
     aggregate_all(sum(X), ( between(0, 99, J), X is 2 ** (-J) ), Expected).
 
 today_weight(KB, Today) :-
-    relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base)),
-    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _), _, _, _, Clock)),
+    relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base, _)),
+    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _, _), _, _, _, Clock, _)),
     Today is M / 2 ** ((Clock - Base) / H).
 
 test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-

@@ -29,6 +29,13 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
     assert side["inferences_per_step"] > 100
     assert "etg_calls_per_step<=1.5" in figures["targets"]
     assert "tg_steps_per_second>=3000" in figures["targets"]
+    assert figures["tg_step_in_etg_steps"] == (figures["learners"]["tg"]["cpu_us_per_step"]
+                                               / figures["learners"]["etg"]["cpu_us_per_step"])
+    assert "tg_step<=2x_etg_step" in figures["targets"]
+    by_size = figures["tg_step_by_size"]
+    assert set(by_size["sizes"]) == {"5", "129"} and by_size["ratio"]["5"] == 1.0
+    assert by_size["ratio"]["129"] > 0 and by_size["sizes"]["129"]["positions"] > 0
+    assert "tg_step_P129<=1.5x_P5" in figures["targets"]
     rec = figures["recording"]
     assert rec["units_per_second_out"] > 0 and rec["units_per_second_record"] > 0
     assert rec["mcap_bytes_per_unit"] > 0

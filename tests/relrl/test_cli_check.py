@@ -24,6 +24,24 @@ def test_check_fruits_lists_codes(capsys) -> None:
 
 def test_check_sis_is_valid(capsys) -> None:
     assert main(["check", str(SIS)]) == 0
+    assert "warning" not in capsys.readouterr().err     # its bias names no place
+
+
+def test_a_bias_that_grows_with_the_world_warns(tmp_path, capsys) -> None:
+    """A #place constant per place (as the SIS's bias once had) is valid but warned about,
+    with file and line, also with -q."""
+    text = SIS.read_text().replace("rmode(head_at(#face_place)).",
+                                   "rmode(head_at(#place)).")
+    text += "".join(f"rconst(place, {p}).\n" for p in
+                    ("centre", "left", "left_down", "down", "right_down", "right"))
+    path = tmp_path / "old_bias.pl"
+    path.write_text(text)
+    line = text.splitlines().index("rmode(head_at(#place)).") + 1
+    assert main(["check", "-q", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert f"old_bias.pl:{line}: warning: rconst type place has a constant for each of 6 " \
+        "responses' arguments" in err
+    assert len(err.strip().splitlines()) == 1
 
 
 BAD = {

@@ -382,6 +382,7 @@ def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path, crossing: str
     not fit its one-call read: a state code or a response mask beyond 64 bits."""
     n = 70
     text = "".join(f"stimulus(s{i}).\nresponse(r{i}).\n" for i in range(n))
+    text += "forbidden(r0) :- fail.\n"     # a constraint rule: the engine builds the mask
     with KnowledgeBase(domain(tmp_path, text)) as kb:
         engine = Engine(kb)
         engine.configure("etg", {**make_learner("etg").params}, seed=0)
@@ -391,6 +392,26 @@ def test_step_reads_codes_and_masks_beyond_64_bits(tmp_path: Path, crossing: str
         assert r.allowed_mask == 2 ** n - 1 and r.allowed_index == list(range(n))
         assert engine.responses[r.action_index] in {f"r{i}" for i in range(n)}
         assert r.necessity == "none" and r.outputs == () and not r.reinforced
+
+
+def test_every_response_allowed_is_minus_one_and_read_as_all(tmp_path: Path,
+                                                             crossing: str) -> None:
+    """Without constraint rules the engine reports -1 (every response allowed) instead of a
+    mask of as many bits; Engine.step gives the full mask and the loop every response."""
+    from relrl.engine import ALL_ALLOWED
+    from relrl.loop import Agent
+
+    n = 70
+    text = "".join(f"stimulus(s{i}).\nresponse(r{i}).\n" for i in range(n))
+    with KnowledgeBase(domain(tmp_path, text)) as kb:
+        engine = Engine(kb)
+        engine.configure("etg", {**make_learner("etg").params}, seed=0)
+        assert engine.step_fields([("see", "s1")])[5] == ALL_ALLOWED
+        r = engine.step([("see", "s1")])
+        assert r.allowed_mask == 2 ** n - 1 and r.allowed_index == list(range(n))
+        out = Agent(kb, make_learner("qlearning"), seed=0).step([("see", "s1")])
+        assert out.allowed_index == list(range(n)) and len(out.allowed) == n
+        assert out.action in out.allowed
 
 
 def test_step_failure_and_errors_through_the_fast_read(tmp_path: Path, crossing: str) -> None:
