@@ -33,10 +33,10 @@ import numpy as np
 
 from relrl.episodes.provenance import provenance, session_manifest
 from relrl.episodes.recording import RECORDED, SessionTap, write_manifest
-from relrl.tensorboard import EVENT_FILE
 from relrl.episodes.script import Episode
 from relrl.outdir import check_inside, deferred_signals, write_json_atomic
 from relrl.progress import progress
+from relrl.tensorboard import EVENT_FILE
 from relrl.terms import format_term
 
 __all__ = ["RUN_FILES", "STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial",
