@@ -31,7 +31,7 @@ from typing import Any
 
 from relrl.errors import ConfigError
 
-__all__ = ["RECORDABLE", "add_config_option", "apply_record", "finish_record"]
+__all__ = ["Record", "add_config_option", "apply_record", "finish_record", "read_record"]
 
 log = logging.getLogger(__name__)
 
@@ -48,37 +48,50 @@ def _world(values: dict[str, Any]) -> str:
                     for k, v in values.items())
 
 
-#: per experiment: a config field -> (the option's dest, its recorded value as the option's
-#: parsed value); fields put back as recorded unless their option (the dest named, if any)
-#: is typed -- the domain's path as written, not resolved again; fields derived from others.
-_PARAMS = ("param", lambda v: [(lr, k, x) for lr, ps in v.items() for k, x in ps.items()])
-#: the settings both experiments have (``relrl.cli.experiment._common``'s options).
-_COMMON: dict[str, tuple[str, Any]] = {
-    "learners": ("learners", _joined), "seeds": ("seeds", _joined),
-    "block": ("block", None), "eval_runs": ("eval_runs", None),
-    "eval_steps": ("eval_steps", None), "caregiver": ("caregiver", None),
+#: settings whose option takes another form than the recorded value: the option's dest and
+#: the recorded value as that option's parsed value. Every other setting whose name is an
+#: option's dest goes through that option (a list as ``a,b,c``); one that no option sets is
+#: put back as recorded after the configuration is built.
+FORMS: dict[str, tuple[str, Any]] = {
     "caregiver_params": ("caregiver_param", lambda v: list(v.items())),
-    "learner_params": _PARAMS, "eval_policy": ("eval_policy", None),
-    "timeout": ("timeout", None),
+    "learner_params": ("param", lambda v: [(lr, k, x) for lr, ps in v.items()
+                                           for k, x in ps.items()]),
+    "world": ("world", _world),
 }
-RECORDABLE: dict[str, dict[str, Any]] = {
-    "sis": {
-        "options": {**_COMMON, "points": ("points", None),
-                    "train_places": ("train_places", _joined),
-                    "eval_places": ("eval_places", _joined), "preset": ("preset", None)},
-        "kept": {"opportunities": None, "eval_caregiver_params": None, "domain": "domain"},
-        "derived": ("caregiver_resolved", "eval_caregiver_resolved", "setting"),
-    },
-    "scaling": {
-        "options": {**_COMMON, "sizes": ("sizes", _joined), "world": ("world", _world),
-                    "budget": ("budget", None), "threshold": ("threshold", None),
-                    "patience": ("patience", None), "transfer": ("transfer", None),
-                    "transfer_sizes": ("transfer_sizes", _joined),
-                    "holdout": ("holdout", None)},
-        "kept": {},
-        "derived": ("worlds", "caregiver_resolved"),
-    },
-}
+#: settings put back as written unless their option is typed (the domain's path: not
+#: resolved again through a link).
+AS_WRITTEN = ("domain",)
+#: what a configuration records besides its settings (derived from them; not read back).
+DERIVED = {"sis": ("caregiver_resolved", "eval_caregiver_resolved", "setting"),
+           "scaling": ("worlds", "caregiver_resolved")}
+
+
+def _settings(experiment: str) -> list[str]:
+    """The settings of ``experiment``'s configuration (its dataclass's fields)."""
+    from dataclasses import fields
+
+    from relrl.experiments.scaling import ScalingConfig
+    from relrl.experiments.sis import SISConfig
+
+    return [f.name for f in fields(SISConfig if experiment == "sis" else ScalingConfig)]
+
+
+def _plan(experiment: str, parser: argparse.ArgumentParser
+          ) -> tuple[dict[str, tuple[str, Any]], list[str]]:
+    """How each setting comes back: through an option (``{name: (dest, form)}``), or put
+    back after the configuration is built (the rest)."""
+    dests = {a.dest for a in parser._actions}
+    through, after = {}, []
+    for name in _settings(experiment):
+        if name in FORMS:
+            through[name] = FORMS[name]
+        elif name in dests and name not in AS_WRITTEN:
+            through[name] = (name, None)
+        else:
+            after.append(name)
+    return through, after
+
+
 #: options whose values add to the recorded ones (repeatable NAME=VALUE options).
 _ADDING = ("caregiver_param", "param")
 
@@ -139,8 +152,7 @@ def read_record(path: str | Path, experiment: str) -> dict[str, Any]:
     config = data.get("config", data if other is None else None)
     if not isinstance(config, dict):
         raise ConfigError(f"{where}: no \"config\" object (give the results.json of a run)")
-    known = RECORDABLE[experiment]
-    names = set(known["options"]) | set(known["kept"]) | set(known["derived"])
+    names = set(_settings(experiment)) | set(DERIVED[experiment])
     for name in config:
         if name not in names:
             raise ConfigError(f"{where}: config.{name} is not a setting of relrl "
@@ -177,10 +189,12 @@ def _in_preset(config: dict[str, Any], name: str) -> dict[str, Any]:
 
 @dataclass
 class Record:
-    """A recorded configuration and the options typed beside it."""
+    """A recorded configuration, the options typed beside it, and the settings to put
+    back after the configuration is built."""
 
     config: dict[str, Any]
     typed: set[str]
+    after: list[str]
 
 
 def apply_record(args: argparse.Namespace, experiment: str) -> Record | None:
@@ -201,10 +215,14 @@ def apply_record(args: argparse.Namespace, experiment: str) -> Record | None:
                           "the run is (give --points, --eval-runs, ... to change it)")
     if experiment == "sis" and "preset" in typed and args.preset != config.get("preset"):
         config = _in_preset(config, args.preset)
-    for name, (dest, form) in RECORDABLE[experiment]["options"].items():
+    through, after = _plan(experiment, args.experiment_parser)
+    for name, (dest, form) in through.items():
         if name not in config:
             continue
-        value = config[name] if form is None or config[name] is None else form(config[name])
+        value = config[name]
+        if value is not None:
+            value = form(value) if form is not None else \
+                _joined(value) if isinstance(value, list) else value
         if dest in _ADDING:  # the recorded ones first: the typed ones override them
             if dest == "param" and "learners" in typed:  # of the learners still run
                 chosen = {x.strip() for x in args.learners.split(",")}
@@ -212,7 +230,7 @@ def apply_record(args: argparse.Namespace, experiment: str) -> Record | None:
             setattr(args, dest, value + list(getattr(args, dest) or []))
         elif dest not in typed:
             setattr(args, dest, value)
-    return Record(config, typed)
+    return Record(config, typed, after)
 
 
 def finish_record(config: Any, recorded: Record | None) -> Any:
@@ -225,8 +243,8 @@ def finish_record(config: Any, recorded: Record | None) -> Any:
     if recorded is None:
         return config
     record = recorded.config
-    for name, dest in RECORDABLE[_experiment(config)]["kept"].items():
-        if name in record and (dest is None or dest not in recorded.typed):
+    for name in recorded.after:
+        if name in record and name not in recorded.typed:
             setattr(config, name, record[name])
     domain = getattr(config, "domain", None)
     if domain is not None and not Path(domain).is_file():
@@ -238,9 +256,3 @@ def finish_record(config: Any, recorded: Record | None) -> Any:
         log.warning("the recorded caregiver resolves to other parameters in this relrl "
                     "(its defaults changed): the numbers may differ from the record")
     return config
-
-
-def _experiment(config: Any) -> str:
-    from relrl.experiments.sis import SISConfig
-
-    return "sis" if isinstance(config, SISConfig) else "scaling"

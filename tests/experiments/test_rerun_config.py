@@ -80,7 +80,7 @@ def test_a_recorded_scaling_configuration_comes_back_field_for_field(tmp_path) -
     config = ScalingConfig(learners=["etg", "tg"], sizes=[5, 9], seeds=[2], budget=3000,
                            block=500, world={"colours": 3, "kinds": 2, "scene": True},
                            caregiver_params={"latency": 1}, threshold=0.8, patience=0,
-                           transfer="kinds", transfer_sizes=[9], holdout=0.5)
+                           transfer="kinds", transfer_sizes=[9], holdout=0.5, transfer_from=9)
     config.world = _config("scaling", "--world", "colours=3,kinds=2,scene=true").world
     path = _record(tmp_path, config, "scaling")
     assert _config("scaling", "--config", str(path)).to_dict() == config.to_dict()
