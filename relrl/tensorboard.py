@@ -18,6 +18,7 @@ unit costs one record, not one per scalar, and the checksum is compiled
 
 from __future__ import annotations
 
+import logging
 import math
 import struct
 import time
@@ -26,6 +27,8 @@ from pathlib import Path
 from typing import Any
 
 __all__ = ["EVENT_FILE", "ScalarLog", "crc32c", "event_file", "write_event_file"]
+
+log = logging.getLogger(__name__)
 
 #: the event file's name in its folder (TensorBoard reads files whose name holds "tfevents").
 EVENT_FILE = "events.out.tfevents.relrl"
@@ -137,7 +140,9 @@ def write_event_file(folder: str | Path,
 class ScalarLog:
     """An event file that grows as a run goes: :meth:`add` a step's scalars; they reach
     the file at most :data:`FLUSH_SECONDS` apart (TensorBoard shows them while the run goes)
-    and at :meth:`close` (safe twice).
+    and at :meth:`close` (safe twice). The file is a view of numbers the run keeps elsewhere
+    (the trace): when it cannot be written (a full disk) the run goes on without it (run.log
+    says so), the file ending at its last whole record.
 
     Args:
         path: the file (a new one, through :func:`relrl.outdir.open_stream`: whatever was
@@ -154,6 +159,8 @@ class ScalarLog:
 
     def add(self, step: int, scalars: Mapping[str, Any]) -> None:
         """The scalars of one step (values that are not finite numbers are left out)."""
+        if self._file.closed:
+            return
         values = _finite(scalars)
         if values:
             self._pending.append(_record(_event(time.time(), step, values)))
@@ -164,8 +171,16 @@ class ScalarLog:
 
     def flush(self) -> None:
         """Write what is buffered."""
+        from relrl.errors import OutputError
+
         if self._pending and not self._file.closed:
-            self._file.write(b"".join(self._pending))  # whole records, or none of them
+            try:
+                self._file.write(b"".join(self._pending))  # whole records, or none of them
+            except OutputError as exc:
+                # said in run.log; the trace's own write meets the same cause and says it
+                log.info("TensorBoard's event file is not written any more (the trace keeps "
+                         "every number): %s", exc)
+                self._file.close()
             self._pending = []
 
     def close(self) -> None:

@@ -268,11 +268,15 @@ class SessionTap:
             self.recorder.event(kind, self.run.t, **data)
 
     def finish(self) -> dict[str, Any]:
-        """The session ended: the last tree, the last frame (when every unit is recorded).
+        """The session ended: the last tree, the last frame (when every unit is recorded);
+        TensorBoard's event file written out and closed (here, while the session's own
+        errors and signals are still handled, not in the clean-up after them).
 
         Returns:
             what was recorded (frames, bytes), for ``session.json``.
         """
+        if self.scalars is not None:
+            self.scalars.close()
         self._tree(self.run.t, force=True)
         frame, percept, looked = self._seen
         if self.recording and self._frame_rate.rate <= 0 and frame is not None:
