@@ -277,7 +277,7 @@ def _outside(tmp_path: Path) -> Path:
 
 @pytest.mark.parametrize("name, flags", [
     ("trace.jsonl", []), ("run.log", []), ("summary.json", []),
-    ("episode.toml", ["--record"]), ("trees.jsonl", ["--record"])])
+    ("episode.toml", ["--record"]), ("session.mcap", ["--record"])])
 def test_a_link_kept_under_overwrite_is_refused_not_written_through(capsys, tmp_path, name,
                                                                      flags):
     outside = _outside(tmp_path)
@@ -303,18 +303,28 @@ def test_a_hard_link_in_out_is_replaced_never_written_in_place(tmp_path):
     assert (out / "trace.jsonl").read_text().count("\n") == 6
 
 
-def test_a_linked_frames_folder_is_refused(capsys, tmp_path):
-    elsewhere = tmp_path / "elsewhere"
-    elsewhere.mkdir()
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "frames").symlink_to(elsewhere)
-    script = tmp_path / "e.toml"
-    script.write_text(episode_text())
-    one_line_exit_2(capsys, ["run", str(script), "--camera", "synthetic://?size=64x48",
-                             "--out", str(out), "--overwrite", "--record", "--record-rate",
-                             "0", "--no-plots"], "frames is a symbolic link")
-    assert list(elsewhere.iterdir()) == []
+def test_the_recording_process_writes_only_into_the_empty_file_it_was_given(tmp_path):
+    """The session makes session.mcap empty through the writer; the recording's own process
+    then writes only into an empty regular file: a link put at the name in between, or a
+    file with something in it, is refused and left as it was."""
+    from relrl.errors import OutputError
+    from relrl.recording.mcapfile import _open_new
+
+    outside = _outside(tmp_path)
+    link = tmp_path / "linked.mcap"
+    link.symlink_to(outside)
+    with pytest.raises(OutputError, match="link"):
+        _open_new(link)
+    full = tmp_path / "full.mcap"
+    full.write_text("an earlier session")
+    with pytest.raises(OutputError, match="already there"):
+        _open_new(full)
+    assert outside.read_text() == OUTSIDE and full.read_text() == "an earlier session"
+    empty = tmp_path / "empty.mcap"
+    empty.touch()
+    with _open_new(empty) as fh:
+        fh.write(b"x")
+    assert empty.read_bytes() == b"x"
 
 
 def test_an_experiment_output_that_is_a_link_is_refused_before_the_work(capsys, tmp_path):
@@ -364,6 +374,12 @@ _WRITES = re.compile(r"open\([^)]*['\"][wax]b?\+?['\"]|\.write_text\(|\.write_by
 _ELSEWHERE = {
     "relrl/speech.py": "the recogniser's grammar, in a private temporary folder",
     "relrl/monitor/live.py": "the monitor process's OOM score (/proc/self/oom_score_adj)",
+    "relrl/shell.py": "clauses typed after [user]., in a private temporary folder",
+    "relrl/recording/bench.py": "the benchmark's own episode script, in a private temporary "
+                                "folder",
+    "relrl/recording/mcapfile.py": "the recording's process fills the empty session.mcap the "
+                                   "writer made (or a new file; never a link, never a file "
+                                   "with something in it)",
 }
 
 
