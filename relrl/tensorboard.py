@@ -178,8 +178,8 @@ class ScalarLog:
                 self._file.write(b"".join(self._pending))  # whole records, or none of them
             except OutputError as exc:
                 # said in run.log; the trace's own write meets the same cause and says it
-                log.info("TensorBoard's event file is not written any more (the trace keeps "
-                         "every number): %s", exc)
+                log.debug("TensorBoard's event file is not written any more (the trace keeps "
+                          "every number): %s", exc)
                 self._file.close()
             self._pending = []
 
