@@ -438,10 +438,23 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             bar.close()
         try:
             if getattr(run, "tap", None) is not None:
-                run.tap.close()
+                _close_tap(run.tap, quiet=failed)
             _release(actuator, env, quiet=failed)
         finally:
             run.close()
+
+
+def _close_tap(tap: SessionTap, *, quiet: bool) -> None:
+    """Close the trace and the recording. After an error (``quiet``) an error of closing them
+    -- the recording's process stopped by the same full disk, say -- is logged, not raised:
+    the first error is the one to report, with what was kept."""
+    if not quiet:
+        tap.close()
+        return
+    try:
+        tap.close()
+    except Exception as exc:  # noqa: BLE001 - the session already failed; report that one
+        log.warning("closing the session's outputs after the error: %s", exc)
 
 
 def _release(*things: Any, quiet: bool) -> None:

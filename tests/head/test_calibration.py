@@ -181,9 +181,9 @@ def test_a_scripts_file_that_is_no_file_is_refused_before_reading(tmp_path: Path
     text = fast_toml.replace('name = "fast test head"',
                              f'name = "fast test head"\nscripts = "{name}"')
     (tmp_path / "cal.toml").write_text(text)
-    with pytest.raises(CalibrationError, match=r"cal\.toml: head\.scripts: .*cannot read: "
-                                               r"(not a regular file|is a folder|a file "
-                                               r"name cannot hold a NUL)"):
+    with pytest.raises(CalibrationError, match=r"cal\.toml: head\.scripts: .*(cannot read: "
+                                               r"(not a regular file|is a folder)|holds a NUL "
+                                               r"character)"):
         load_calibration(tmp_path / "cal.toml")
 
 
