@@ -297,7 +297,7 @@ class SessionTap:
     def close(self, manifest: dict[str, Any] | None = None,
               summary: dict[str, Any] | None = None) -> None:
         """Close the recording -- with what was run and its summary in it, when given --
-        and the trace (safe twice)."""
+        the trace and TensorBoard's event file (safe twice)."""
         try:
             if self.recording and self.recorder is not None:
                 self.recorder.close_file({name: value for name, value in (
