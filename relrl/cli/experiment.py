@@ -8,12 +8,14 @@ import math
 import os
 from pathlib import Path
 
+from relrl.cli.recorded import add_config_option, apply_record, finish_record
 from relrl.outdir import add_out_options
 
 HELP = ("run the experiments (sis: the paper's Experiment 1, with relrl's relational learner tg "
         "beside the paper's three; scaling: every learner in worlds that grow, with zero-shot "
         "transfer; worlds: tasks of worlds written in Prolog, blocks world first)")
 EXAMPLE = ("relrl experiment sis --quick --out runs/exp1-quick\n"
+           "  relrl experiment sis --config runs/exp1-quick/results.json --out runs/exp1-again\n"
            "  relrl experiment scaling --quick --out runs/scaling-quick\n"
            "  relrl experiment worlds --quick --out runs/worlds-quick")
 
@@ -93,6 +95,7 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
                    help="seconds one control step may run before the run stops, naming the "
                         "rule (default 60)")
     p.add_argument("--quick", action="store_true", help="a short run")
+    add_config_option(p)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -245,6 +248,7 @@ def build_config(args: argparse.Namespace):
     from relrl.learners import LEARNERS
     from relrl.sim.caregiver import make_caregiver
 
+    record = apply_record(args, "sis")
     config = SISConfig.from_preset(args.preset, seeds=_ints(args.seeds or "0", "--seeds"))
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
@@ -264,7 +268,7 @@ def build_config(args: argparse.Namespace):
         if not Path(args.domain).is_file():
             raise ConfigError(f"--domain {args.domain}: no such file")
         config.domain = str(Path(args.domain).resolve())
-    return config
+    return finish_record(config, record)
 
 
 def build_scaling_config(args: argparse.Namespace):
@@ -274,6 +278,7 @@ def build_scaling_config(args: argparse.Namespace):
     from relrl.learners import LEARNERS
     from relrl.sim.world import World
 
+    record = apply_record(args, "scaling")
     quick = QUICK_SCALING if args.quick else {}
     config = ScalingConfig(seeds=_ints(args.seeds or quick.get("seeds", "0,1,2"), "--seeds"))
     config.sizes = _ints(args.sizes, "--sizes")
@@ -324,7 +329,7 @@ def build_scaling_config(args: argparse.Namespace):
     config.transfer_from = args.transfer_from
     if config.transfer == "kinds" and world.kinds < 2:
         raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
-    return config
+    return finish_record(config, record)
 
 
 def run(args: argparse.Namespace) -> int:
