@@ -106,7 +106,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                 parser_class=type(parser))
     sis = sub.add_parser("sis", help="the paper's Experiment 1 (the learners in the SIS)",
                          description="The paper's Experiment 1: learning curves (CGI), eye "
-                                     "contacts and memory of each learner in the simulator.")
+                                     "contacts and memory of each learner in the simulator.",
+                         epilog="examples:\n"
+                                "  relrl experiment sis --out runs/exp1\n"
+                                "  relrl experiment sis --preset paper-2012 --learners "
+                                "contingency,qlearning,etg --seeds 0,1,2,3,4 --out "
+                                "runs/paper-2012\n"
+                                "  relrl experiment sis --config runs/exp1/results.json --out "
+                                "runs/exp1-again",
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
     _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
     from relrl.experiments.sis import PRESETS
 
@@ -127,7 +135,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     sc = sub.add_parser("scaling", help="every learner in worlds that grow; transfer",
                         description="Time to CGI >= 0.9, final CGI, memory and steps/s of "
                                     "every learner as the world grows (P toy places), and "
-                                    "zero-shot transfer to places never trained on.")
+                                    "zero-shot transfer to places never trained on.",
+                        epilog="examples:\n"
+                               "  relrl experiment scaling --quick --out runs/scaling-quick\n"
+                               "  relrl experiment scaling --learners tg --sizes "
+                               "5,9,17,33,65,129 --out runs/scaling-tg\n"
+                               "  relrl experiment scaling --learners tg --sizes 5 --transfer "
+                               "sizes --transfer-sizes 9,33,129 --out runs/transfer",
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _common(sc, default_learners=",".join(LEARNERS), default_seeds="0,1,2")
     sc.add_argument("--sizes", default="5,9,17,33", help="world sizes P (default 5,9,17,33)")
     sc.add_argument("--world", default="", metavar="NAME=VALUE,...",
@@ -162,7 +177,12 @@ def _add_worlds(sub) -> None:
                        description="Learning curves, evaluation on other sizes with no "
                                    "further learning, memory and step cost of the learners "
                                    "of worlds (tg, qtable) on tasks of worlds written in "
-                                   "Prolog; the worlds' stated optimum checked by search.")
+                                   "Prolog; the worlds' stated optimum checked by search.",
+                       epilog="examples:\n"
+                              "  relrl experiment worlds --quick --out runs/worlds-quick\n"
+                              "  relrl experiment worlds --tasks stack,unstack,on --seeds "
+                              "0,1,2 --out runs/worlds",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     w.add_argument("--worlds", default=None, metavar="FILE,FILE",
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
     w.add_argument("--tasks", default="stack,unstack,on",
