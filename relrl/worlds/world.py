@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from relrl.bridge.calls import display_path as _display_path
 from relrl.engine import Engine, call, one
 from relrl.errors import ConfigError, PrologError
-from relrl.bridge.calls import display_path as _display_path
 from relrl.kb import KnowledgeBase
 from relrl.terms import Term, Var, format_term
 

@@ -92,3 +92,23 @@ def test_shipped_docs_match_the_runs_they_cite() -> None:
     docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
     stale = [line for md in docs for line in stale_blocks(md)]
     assert stale == [], "re-render with `relrl report --update FILE.md`:\n" + "\n".join(stale)
+
+
+def test_the_claims_of_two_runs_side_by_side(sis_run: Path, tmp_path: Path) -> None:
+    """A block may name two runs (``a,b``): the paper's claims judged on each, one column per
+    setting, and both runs' provenance."""
+    for name, preset in (("fixed", None), ("paper", "paper-2012")):
+        shutil.copytree(sis_run, tmp_path / name)
+        results = json.loads((tmp_path / name / "results.json").read_text())
+        results["config"]["preset"] = preset
+        results["claims"] = {"after_first_run": {"held": preset is None, "values": {
+            "cgi_after_first_run": {"contingency": 0.5, "etg": 0.75, "qlearning": 0.8}}}}
+        (tmp_path / name / "results.json").write_text(json.dumps(results))
+    md = tmp_path / "doc.md"
+    md.write_text("<!-- relrl-report fixed,paper claims -->\n<!-- /relrl-report -->\n")
+    assert update_file(md) == 1
+    text = md.read_text()
+    assert "| the paper's claim | `fixed task` | `paper-2012` |" in text
+    assert "**held**: run 1 C 0.50, ETG 0.75, Q 0.80 | not held: run 1 C 0.50" in text
+    assert "`fixed/results.json`" in text and "`paper/results.json`" in text
+    assert stale_blocks(md) == []
