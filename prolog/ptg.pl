@@ -81,7 +81,7 @@ ptg_init(KB, Params) :-
     Pairs is max(1, round(Pairs0)),
     exclude(p_param, Params, QParams),
     tg_init(KB, QParams),
-    select(alpha=_, QParams, alpha=PAlpha, PParams),
+    selectchk(alpha=_, QParams, alpha=PAlpha, PParams),
     ptg_key(KB, PK),
     tg_init(PK, KB, PParams),
     params_key(KB, K),

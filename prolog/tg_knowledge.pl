@@ -342,28 +342,26 @@ tg_save(KB, Face, S) :-
     saved_tree(KB, Root, [], Saved, Vars),
     name_variables(Vars, Names),
     maplist([Name=V]>>(V = '$VAR'(Name)), Names),
-    save_comment(Face, tree, Lines),
+    save_comments(TreeName, Lines, RuleLines),
     forall(member(L, Lines), format(S, "% ~w~n", [L])),
     Tree =.. [TreeName, Saved],
     portray_clause(S, Tree),
     nl(S),
-    save_comment(Face, rules, RuleLines),
     forall(member(L, RuleLines), format(S, "% ~w~n", [L])),
     tg_leaf_clauses(KB, Face, Clauses),
     forall(member(C, Clauses), portray_clause(S, C)).
 
-save_comment(face(tg_tree, _, _), tree,
-             ["The tree: tests (conjunctions; a variable is used only in the yes-branch of",
-              "the test that introduces it) and leaves (Q estimate, examples counted)."]).
-save_comment(face(tg_tree, _, _), rules,
-             ["The same knowledge as rules: Q of an action in the state working memory",
-              "holds now, under the active necessity (one clause per leaf)."]).
-save_comment(face(ptg_tree, _, _), tree,
-             ["The P-tree: the same kind of tests, and leaves (P: the share of the examples",
-              "there that the Q-tree found optimal, examples counted)."]).
-save_comment(face(ptg_tree, _, _), rules,
-             ["The policy as rules: P of an action in the state working memory holds now",
-              "(near 1: optimal, near 0: not; one clause per leaf)."]).
+%   The comment lines a policy file writes above a tree and above its rules.
+save_comments(tg_tree,
+              ["The tree: tests (conjunctions; a variable is used only in the yes-branch of",
+               "the test that introduces it) and leaves (Q estimate, examples counted)."],
+              ["The same knowledge as rules: Q of an action in the state working memory",
+               "holds now, under the active necessity (one clause per leaf)."]).
+save_comments(ptg_tree,
+              ["The P-tree: the same kind of tests, and leaves (P: the share of the examples",
+               "there that the Q-tree found optimal, examples counted)."],
+              ["The policy as rules: P of an action in the state working memory holds now",
+               "(near 1: optimal, near 0: not; one clause per leaf)."]).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
     tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)).
