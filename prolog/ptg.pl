@@ -114,14 +114,13 @@ ptg_p(KB, Facts, A, N, P) :-
 
 %!  ptg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
-%   With Mode greedy, Action is a member of the class of Allowed responses with the largest
-%   P, ties broken by the largest Q, then at random. With Mode learn or explore, tg's choice
+%   With Mode greedy, Action is a member of the class of Allowed responses (every response
+%   when Allowed is []) with the largest P, ties broken by the largest Q, then at random. With Mode learn or explore, tg's choice
 %   (tg_choose/6: Boltzmann over the Q-tree's values, with its bonuses while learning).
 
 ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     (   Mode == greedy
-    ->  Allowed = [_|_],
-        tg_class_values(KB, Facts, N, Allowed, Classes, Qs),
+    ->  tg_class_values(KB, Facts, N, Allowed, Classes, Qs),
         ptg_key(KB, PK),
         maplist(class_p(PK, Facts, N), Classes, Qs, Scored),
         max_member(s(BestP, _, _), Scored),
