@@ -200,8 +200,9 @@ class World:
 
     def attach(self, learner: Any, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a :class:`relrl.learners.Learner` whose Prolog learner reads the
-        relational view: ``tg``, ``qtable``) afresh in this world, seeded; for ``task``, its
-        language bias holds the task's own modes too (task_rmode/2)."""
+        relational view: ``tg``, ``ptg``, ``qtable``) afresh in this world, seeded; for
+        ``task``, its language bias holds the task's own modes too (task_rmode/2), or them
+        alone (task_own_bias/1)."""
         if task is not None:
             call(self.kb, "world_for_task", self.kb.module, self._task(task))
         learner.attach(self.engine, seed)
