@@ -152,8 +152,8 @@ def render_many(runs: list[Run], name: str, labels: list[str]) -> str:
     if fn is None:
         raise UserError(f"no view {name!r} of several {'/'.join(sorted(kinds))} runs side by "
                         f"side (known: {', '.join(sorted(v for _, v in MULTI_VIEWS)) or 'none'})")
-    return fn(runs) + "\n" + "\n".join(provenance(r, lb) for r, lb in zip(runs, labels,
-                                                                            strict=True))
+    return _ended(fn(runs)) + "\n" + "\n".join(provenance(r, lb) for r, lb in zip(runs, labels,
+                                                                                    strict=True))
 
 
 def render(run: Run, name: str, label: str | None = None) -> str:
@@ -163,7 +163,13 @@ def render(run: Run, name: str, label: str | None = None) -> str:
         known = sorted(v for e, v in VIEWS if e == run.experiment)
         raise UserError(f"{run.path}: no view {name!r} of a {run.experiment!r} run "
                         f"(known: {', '.join(known) or 'none'})")
-    return fn(run) + "\n" + provenance(run, label or str(run.path))
+    return _ended(fn(run)) + "\n" + provenance(run, label or str(run.path))
+
+
+def _ended(body: str) -> str:
+    """A view's Markdown ending in a newline, so the provenance line after it is a paragraph
+    of its own (not a row of the table above it)."""
+    return body if body.endswith("\n") else body + "\n"
 
 
 def render_report(paths: list[str | Path], out: Path) -> str:
@@ -287,6 +293,9 @@ def _exp2_table1(run: Run) -> str:
     r = run.results
     paper = r.get("paper", {}).get("table1", {})
     keys = sorted(r["summary"])
+    if not all((r["summary"][k].get("table1") or {}).get("all_executions") for k in keys):
+        raise UserError(f"{run.path / 'results.json'}: no Table 1 in this run (symbolic "
+                        "perception, or no naming executions)")
     outcomes = list(paper) or sorted({o for k in keys
                                       for o in r["summary"][k]["table1"]["all_executions"]})
     header = ["measure (%)", "paper"] + keys
@@ -323,7 +332,7 @@ def _exp2_short(run: Run) -> str:
     for k in sorted(r["summary"]):
         s = r["summary"][k]
         fig6 = s["fig6"]
-        t1 = s["table1"]["all_executions"]
+        t1 = (s.get("table1") or {}).get("all_executions") or {}
         rows.append([k, _f(fig6[-1]["cgi_mean"]) if fig6 else "—",
                      f"{t1['success'][0]:.1f}" if "success" in t1 else "—"])
     if "success" in paper:
