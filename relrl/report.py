@@ -113,8 +113,8 @@ def provenance(run: Run, label: str) -> str:
     from relrl.machine import describe
 
     command = run.manifest.get("command") or run.results.get("command")
-    machine = run.timing.get("machine_info") or {"machine": run.timing.get("machine"),
-                                                  "python": run.timing.get("python")}
+    machine = (run.timing.get("machine_info") or run.results.get("machine_info")
+               or {"machine": run.timing.get("machine"), "python": run.timing.get("python")})
     when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
     line = f"*From `{label}/results.json`"
     if command:
@@ -339,6 +339,59 @@ def _exp2_short(run: Run) -> str:
         rows.append(["*paper (2012)*", "rises, then flat", f"{paper['success'][0]}"])
     return table(["learner / time unit", "final CGI (Fig. 6)", "success rate % (Table 1)"],
                  rows)
+
+
+# ---- relrl bench ------------------------------------------------------------------------
+
+
+@view("bench", "summary")
+def _bench_summary(run: Run) -> str:
+    """What ``relrl bench --json FILE`` measured: rates and ratios, each beside its target."""
+    r = run.results
+    learners = r["learners"]
+    rows: list[list[Any]] = [["one gateway call, one binding (median)",
+                              f"{r['gateway_call_us']:.1f} µs", "—"]]
+    for name in ("etg", "tg", "qlearning", "contingency"):
+        if name in learners:
+            f = learners[name]
+            rows.append([f"{name}: learning steps/s on the simulator (calls per step)",
+                         f"{f['steps_per_second']:,.0f} ({f['gateway_calls_per_step']:.2f})",
+                         "tg ≥ 3,000; ≤ 1.5 calls" if name == "tg" else "≤ 1.5 calls"])
+    etg = learners.get("etg", {})
+    if etg:
+        rows.append(["ETG agent step, in gateway calls' worth of time",
+                     f"{etg['step_in_gateway_calls']:.2f}", "≤ 3"])
+    rows.append(["tg's step against ETG's (CPU time)", _f(r.get("tg_step_in_etg_steps")),
+                 "≤ 2"])
+    by_size = r.get("tg_step_by_size", {}).get("ratio", {})
+    if by_size:
+        big = max(by_size, key=int)
+        rows.append([f"tg's learning step at P = {big} against P = 5",
+                     f"{by_size[big]:.2f}", "≤ 1.5"])
+    side = r.get("etg_prolog_side", {})
+    if "cpu_us_per_step" in side:
+        rows.append(["the Prolog side of an ETG step, plain swipl (inferences)",
+                     f"{side['cpu_us_per_step']:.1f} µs ({side['inferences_per_step']:.0f})",
+                     "—"])
+    rows.append(["simulator step() alone, steps/s",
+                 f"{r['sis_env_steps_per_second']['steps_per_second']:,.0f}", "—"])
+    for key, label in (("monitor", "ETG steps/s with the live monitor, against without"),
+                       ("recording", "a session's time units/s recording MCAP, against the "
+                                     "trace alone")):
+        part = r.get(key, {})
+        if "ratio" in part:
+            low, high = part.get("ratio_range", [None, None])
+            spread = f" (pairs {low:.2f}–{high:.2f})" if low is not None else ""
+            rows.append([label, f"{part['ratio']:.2f}{spread}", "≥ 0.9"])
+    photos = r.get("perception", {})
+    for key, label in (("fps_photos_320x240_cold", "perception, real photos 320x240, one "
+                                                   "thread, frames/s"),
+                       ("fps_photos_320x240_cold_2threads", "the same, two threads")):
+        if key in photos:
+            rows.append([label, f"{photos[key]:.1f}", "≥ 60"])
+    met = sum(bool(v) for v in r.get("targets", {}).values())
+    return (f"{r.get('cpus')} CPUs; {met} of {len(r.get('targets', {}))} targets met.\n\n"
+            + table(["what", "measured", "target"], rows))
 
 
 # ---- Worlds written in Prolog --------------------------------------------------------------
