@@ -411,6 +411,20 @@ def _worlds_summary(run: Run) -> str:
     return head + worlds_table(r)
 
 
+@view("worlds", "short")
+def _worlds_short(run: Run) -> str:
+    """Each task and learner: optimality on the training sizes and on the largest test size."""
+    r = run.results
+    train, test = r["config"]["train_sizes"], r["config"]["test_sizes"]
+    rows = [[f"{Path(x['world']).stem}: {x['task']}", x["learner"],
+             f"{x['train_optimality']:.3f} ({x['train_optimality_min']:.3f})",
+             _f(x["test"][str(max(test))]["optimality"], 3), _f(x["memory_positions"], 0)]
+            for x in r["summary"]]
+    return table(["world: task", "learner",
+                  f"of optimal, {min(train)}–{max(train)} blocks (worst seed)",
+                  f"{max(test)} blocks, no learning", "memory (positions)"], rows)
+
+
 @view("worlds", "cost")
 def _worlds_cost(run: Run) -> str:
     rows = []
@@ -524,6 +538,26 @@ def _scaling_transfer(run: Run) -> str:
             "kinds": "toy kinds held out while learning"}.get(kind, kind)
     return (f"Zero-shot transfer ({what}).\n\n"
             + table(["learner", "places P", "CGI trained", "CGI unseen", "seeds"], rows))
+
+
+@view("scaling", "transfer-short")
+def _scaling_transfer_short(run: Run) -> str:
+    """Transfer in one row per learner: the CGI trained → unseen at each size."""
+    r = run.results
+    transfer = r["summary"].get("transfer", {})
+    if not transfer:
+        raise UserError(f"{run.path / 'results.json'}: no transfer jobs in this run")
+    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, acting at P",
+            "places": "places held out while learning", "kinds": "toy kinds held out"
+            }.get(r["config"].get("transfer"), str(r["config"].get("transfer")))
+    rows = []
+    for learner, by_size in transfer.items():
+        sizes = _sizes(by_size)
+        rows.append([learner, what, ", ".join(sizes), " · ".join(
+            f"{_f(by_size[p].get('cgi_trained'))} → {_f(by_size[p].get('cgi_unseen'))}"
+            for p in sizes)])
+    return table(["learner", "zero-shot transfer", "places P",
+                  "CGI trained → unseen (no learning), per P"], rows)
 
 
 @view("scaling", "short")
