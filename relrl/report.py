@@ -285,6 +285,14 @@ def _sis_short(run: Run) -> str:
     return table(["learner", "CGI after run 1", "CGI final", "eye contacts", "positions"], rows)
 
 
+@view("sis", "curves")
+def _sis_curves(run: Run) -> str:
+    """Each learner's CGI curve, point by point (mean over the seeds), before learning first."""
+    rows = [[name, " ".join(f"{p['cgi_mean']:.2f}" for p in s["curve"])]
+            for name, s in run.results["summary"].items()]
+    return table(["learner", "CGI at each evaluation point (mean over the seeds)"], rows)
+
+
 # ---- Experiment 2 --------------------------------------------------------------------------
 
 
@@ -520,22 +528,28 @@ def _scaling_summary(run: Run) -> str:
                          "final CGI", "memory (positions)", "candidate tests per leaf"], rows)
 
 
-@view("scaling", "transfer")
-def _scaling_transfer(run: Run) -> str:
+def _transfer_of(run: Run) -> tuple[dict[str, Any], str]:
+    """A scaling run's transfer summary, and what was transferred, in words."""
     r = run.results
     transfer = r["summary"].get("transfer", {})
     if not transfer:
         raise UserError(f"{run.path / 'results.json'}: no transfer jobs in this run")
     kind = r["config"].get("transfer")
+    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, then acting with no "
+                     "learning in each world", "places": "places held out while learning",
+            "kinds": "toy kinds held out while learning"}.get(kind, str(kind))
+    return transfer, what
+
+
+@view("scaling", "transfer")
+def _scaling_transfer(run: Run) -> str:
+    transfer, what = _transfer_of(run)
     rows = []
     for learner, by_size in transfer.items():
         for size in _sizes(by_size):
             s = by_size[size]
             rows.append([learner, int(size), _f(s.get("cgi_trained")), _f(s.get("cgi_unseen")),
                          f"{s['seeds']}"])
-    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, then acting with no "
-                     "learning in each world", "places": "places held out while learning",
-            "kinds": "toy kinds held out while learning"}.get(kind, kind)
     return (f"Zero-shot transfer ({what}).\n\n"
             + table(["learner", "places P", "CGI trained", "CGI unseen", "seeds"], rows))
 
@@ -543,13 +557,7 @@ def _scaling_transfer(run: Run) -> str:
 @view("scaling", "transfer-short")
 def _scaling_transfer_short(run: Run) -> str:
     """Transfer in one row per learner: the CGI trained → unseen at each size."""
-    r = run.results
-    transfer = r["summary"].get("transfer", {})
-    if not transfer:
-        raise UserError(f"{run.path / 'results.json'}: no transfer jobs in this run")
-    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, acting at P",
-            "places": "places held out while learning", "kinds": "toy kinds held out"
-            }.get(r["config"].get("transfer"), str(r["config"].get("transfer")))
+    transfer, what = _transfer_of(run)
     rows = []
     for learner, by_size in transfer.items():
         sizes = _sizes(by_size)
