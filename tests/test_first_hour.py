@@ -16,6 +16,7 @@ import os
 import re
 import signal
 import subprocess
+import sys
 import tomllib
 import urllib.request
 from pathlib import Path
@@ -27,13 +28,27 @@ from tests.conftest import ROOT
 URL = re.compile(r"(http://127\.0\.0\.1:\d+/\S*)")
 
 
+def _first_hour_block(language: str) -> str:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("## Your first hour", 1)[1].split("\n## ", 1)[0]
+    block = re.search(rf"```{language}\n(.*?)```", section, re.S)
+    assert block, f"README.md: no ```{language} block under 'Your first hour'"
+    return block[1]
+
+
 def first_hour_commands() -> list[str]:
     """The command lines of the README's first hour, as written."""
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = text.split("## Your first hour", 1)[1]
-    block = re.search(r"```sh\n(.*?)```", section, re.S)
-    assert block, "README.md: no ```sh block under 'Your first hour'"
-    return [line for line in block[1].splitlines() if line.strip()]
+    return [line for line in _first_hour_block("sh").splitlines() if line.strip()]
+
+
+def test_the_first_hour_python_runs_as_written(tmp_path: Path) -> None:
+    """The README's own-code example learns gaze following (tg's first test) in 2,000 units."""
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    (tmp_path / "example.py").write_text(_first_hour_block("python"))
+    proc = subprocess.run([sys.executable, "example.py"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "gaze(face, P), action(look(P))" in proc.stdout, proc.stdout
 
 
 def _get(url: str) -> str:
