@@ -10,4 +10,5 @@ here is all it takes to make a learner available by name.
 :- use_module(contingency).
 :- use_module(external).
 :- use_module(tg).
+:- use_module(ptg).
 :- use_module(world_qtable).

@@ -1,8 +1,10 @@
 :- module(relrl_tg,
           [ tg_init/2,            % +KB, +Params
+            tg_init/3,            % +Key, +KB, +Params
             tg_state/2,           % +KB, -Facts
             tg_q/5,               % +KB, +Facts, +Action, +Necessity, -Q
             tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
+            tg_class_values/6,    % +KB, +Facts, +Necessity, +Allowed, -Classes, -Qs
             tg_bonus/5,           % +KB, +Facts, +Action, +Necessity, -Bonus
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
@@ -79,6 +81,17 @@ engine's reward_positive and reward_negative.
 %   Start KB's TG learner afresh: one leaf, Q = q_init, candidates from the domain's bias.
 
 tg_init(KB, Params) :-
+    tg_init(KB, KB, Params).
+
+%!  tg_init(+Key, +KB, +Params:list) is det.
+%
+%   Start a TG tree afresh under Key, with KB's language bias and responses: tg_init/2 is
+%   tg_init(KB, KB, Params). Every predicate of this module that takes a KB then works on
+%   the tree of Key; a learner that keeps a second tree beside KB's (ptg.pl's P-tree) gives
+%   it a key of its own.
+
+tg_init(Key, KB, Params) :-
+    must_be(atom, Key),
     must_be(atom, KB),
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
@@ -97,14 +110,14 @@ tg_init(KB, Params) :-
     tg_new_stats(Qinit, 0, K, 0, Keep, L),
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
-    atom_concat('$tg:', KB, DK),
+    atom_concat('$tg:', Key, DK),
     Half is max(0, round(Half0)),
     nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
                        novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
-    tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
-    tg_forget_leaves(KB),
-    tg_compile_leaf(KB, Root),
-    tg_compile_tree(KB, Root).
+    tg_put_tree(Key, tree(Root, 2, Bias, Responses)),
+    tg_forget_leaves(Key),
+    tg_compile_leaf(Key, Root),
+    tg_compile_tree(Key, Root).
 
 param(Params, Name, Value) :-
     (   memberchk(Name=V, Params)
@@ -198,6 +211,28 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     ->  true
     ;   note_choice(Cache, Facts, N, Version, Noted)
     ).
+
+%!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, -Classes, -Qs) is det.
+%
+%   Classes are the classes of the Allowed responses in the state Facts (every response
+%   when Allowed is []), as tg_choose/6 chooses among them (cls(Representative, Pick)
+%   terms, tg_classes.pl), and Qs their representatives' Q. The last update's look-up of
+%   the same state is reused while the tree is unchanged.
+
+tg_class_values(KB, Facts, N, Allowed0, Classes, Qs) :-
+    tg_data(KB, D),
+    D = tg(_, Leaves, Cache, Version, _, Index),
+    (   Allowed0 == []
+    ->  tg_get_tree(KB, tree(_, _, _, Allowed))
+    ;   Allowed = Allowed0
+    ),
+    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
+        A1 == Allowed
+    ->  Classes = Classes0, Ids = Ids0
+    ;   classes(KB, Index, Facts, Allowed, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ),
+    maplist(leaf_q(Leaves), Ids, Qs).
 
 %   The chosen action with the leaf and candidate hits of its class, found for its bonus,
 %   noted in the cache the update of this step made (Cache, for the same state and tree):

@@ -67,8 +67,17 @@ the names of their variables are given once.
 %   extra_rmode(?KB, ?Mode): a mode a driver adds to KB's bias for its run (world.pl: the
 %   task_rmode/2 modes of the task the world's learner is configured for).
 
+:- multifile own_rmodes/1.
+
+%   own_rmodes(+KB): for KB's run the driver's extra_rmode/2 modes are the whole bias, KB's
+%   rmode/1 left out (world.pl: a task the world declares task_own_bias/1 for). No clause
+%   holds for a domain: its bias is its rmode/1.
+
 tg_bias(KB, bias(Modes, Consts)) :-
-    findall(M, ( declared(KB, rmode(M)) ; extra_rmode(KB, M) ), Modes0),
+    (   own_rmodes(KB)
+    ->  findall(M, extra_rmode(KB, M), Modes0)
+    ;   findall(M, ( declared(KB, rmode(M)) ; extra_rmode(KB, M) ), Modes0)
+    ),
     list_to_set(Modes0, Modes),
     findall(T-C, declared(KB, rconst(T, C)), Pairs0),
     findall(necessity-N, ( kb_necessity(KB, N) ; N = none ), Nec),

@@ -1,11 +1,17 @@
 :- module(relrl_tg_knowledge,
           [ tg_explain/4,         % +KB, +Facts, +Necessity, -Explanation
             tg_text/2,            % +KB, -Text
+            tg_text/3,            % +KB, +Face, -Text
             tg_graph/2,           % +KB, -Graph
+            tg_graph/3,           % +KB, +Face, -Graph
             tg_leaf_clauses/2,    % +KB, -Clauses
+            tg_leaf_clauses/3,    % +KB, +Face, -Clauses
             tg_save/2,            % +KB, +Stream
+            tg_save/3,            % +KB, +Face, +Stream
             tg_policy_term/1,     % ?Term
-            tg_restore/2          % +KB, +Terms
+            tg_restore/2,         % +KB, +Terms
+            tg_restore/3,         % +KB, +Face, +Terms
+            tg_face/2             % ?Name, ?Face
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -22,7 +28,23 @@
 Explanations (the first-order tests on an example's path with the bindings that made them
 true), the tree as indented text and as a graph, the leaves as q/3 rules, and policy files:
 written as Prolog that plain swipl consults, read back by relrl as terms (never run).
+
+The same tree code holds other functions than Q (ptg.pl's P-tree, whose leaves estimate
+whether an action is optimal): a *face* names what a tree's leaves hold, as the policy file
+and the drawings write it — face(TreeName, RuleName, ValueName), tg's face(tg_tree, q, 'Q')
+(tg_face/2). The predicates of arity one less use tg's.
 */
+
+%!  tg_face(?Name, ?Face) is nondet.
+%
+%   Face is face(TreeName, RuleName, ValueName) of a kind of tree: `q` (tg's Q-tree:
+%   tg_tree/1 and q/3 rules) or `p` (ptg.pl's P-tree: ptg_tree/1 and p/3 rules).
+
+tg_face(q, face(tg_tree, q, 'Q')).
+tg_face(p, face(ptg_tree, p, 'P')).
+
+q_face(Face) :-
+    tg_face(q, Face).
 
 % ---- explaining ----------------------------------------------------------------------------
 
@@ -80,41 +102,57 @@ binding_pair(Name=Value, Name-Value).
 %   Text draws the tree, one line per node, indented by depth.
 
 tg_text(KB, Text) :-
-    tg_get_tree(KB, tree(Root, _, _, _)),
-    with_output_to(string(Text), text_node(KB, Root, [], "", "")).
+    q_face(Face),
+    tg_text(KB, Face, Text).
 
-text_node(KB, leaf(Id, _, _, _), _, Indent, Label) :-
+%!  tg_text(+KB, +Face, -Text:string) is det.
+%
+%   As tg_text/2, the leaves' values named as Face says (tg_face/2).
+
+tg_text(KB, face(_, _, V), Text) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    with_output_to(string(Text), text_node(KB, V, Root, [], "", "")).
+
+text_node(KB, V, leaf(Id, _, _, _), _, Indent, Label) :-
     tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
-    format("~w~wleaf [~d] Q=~4f  (n=~d)~n", [Indent, Label, Id, Q, N]).
-text_node(KB, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
+    format("~w~wleaf [~d] ~w=~4f  (n=~d)~n", [Indent, Label, Id, V, Q, N]).
+text_node(KB, V, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
     append(Vars, New, Vars1),
     name_variables(Vars1, Names),
     conj_text(Lits, Names, Text),
     format("~w~w[~d] ~w ?~n", [Indent, Label, Id, Text]),
     string_concat(Indent, "    ", Deeper),
-    text_node(KB, Yes, Vars1, Deeper, "yes: "),
-    text_node(KB, No, Vars, Deeper, "no:  ").
+    text_node(KB, V, Yes, Vars1, Deeper, "yes: "),
+    text_node(KB, V, No, Vars, Deeper, "no:  ").
 
 %!  tg_graph(+KB, -Graph) is det.
 %
 %   Graph is graph(Nodes, Edges): node(Id, test, Label) and node(Id, leaf, Label) (Label a
 %   string), edge(From, To, yes) and edge(From, To, no).
 
-tg_graph(KB, graph(Nodes, Edges)) :-
-    tg_get_tree(KB, tree(Root, _, _, _)),
-    graph_node(KB, Root, [], Nodes, [], Edges, []).
+tg_graph(KB, Graph) :-
+    q_face(Face),
+    tg_graph(KB, Face, Graph).
 
-graph_node(KB, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
+%!  tg_graph(+KB, +Face, -Graph) is det.
+%
+%   As tg_graph/2, the leaves' values named as Face says (tg_face/2).
+
+tg_graph(KB, face(_, _, V), graph(Nodes, Edges)) :-
+    tg_get_tree(KB, tree(Root, _, _, _)),
+    graph_node(KB, V, Root, [], Nodes, [], Edges, []).
+
+graph_node(KB, V, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
     tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
-    format(string(Label), "Q=~2f (n=~d)", [Q, N]).
-graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
+    format(string(Label), "~w=~2f (n=~d)", [V, Q, N]).
+graph_node(KB, V, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
            [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
     append(Vars, New, Vars1),
     name_variables(Vars1, Names),
     conj_text(Lits, Names, Text),
     arg(1, Yes, YId), arg(1, No, NId),
-    graph_node(KB, Yes, Vars1, Ns0, Ns1, Es0, Es1),
-    graph_node(KB, No, Vars, Ns1, Ns, Es1, Es).
+    graph_node(KB, V, Yes, Vars1, Ns0, Ns1, Es0, Es1),
+    graph_node(KB, V, No, Vars, Ns1, Ns, Es1, Es).
 
 %!  tg_leaf_clauses(+KB, -Clauses:list) is det.
 %
@@ -131,7 +169,16 @@ graph_node(KB, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], N
 %   once is written _.
 
 tg_leaf_clauses(KB, Clauses) :-
-    leaf_rules(KB, short, Rules),
+    q_face(Face),
+    tg_leaf_clauses(KB, Face, Clauses).
+
+%!  tg_leaf_clauses(+KB, +Face, -Clauses:list) is det.
+%
+%   As tg_leaf_clauses/2, the rules' head named as Face says (tg_face/2): p(Action,
+%   Necessity, P) for a P-tree.
+
+tg_leaf_clauses(KB, Face, Clauses) :-
+    leaf_rules(KB, Face, short, Rules),
     maplist(named_rule, Rules, Clauses).
 
 named_rule(Rule-Names, Rule) :-
@@ -155,14 +202,14 @@ name_var(Counts, Name=V) :-
 %   `short` leaves out of each negation the path literals the body proves (as written in
 %   policy files since relrl 0.1); `full` negates the whole renamed path query, as policy
 %   files written before did: both read back.
-leaf_rules(KB, Form, Rules) :-
+leaf_rules(KB, Face, Form, Rules) :-
     tg_get_tree(KB, tree(Root, _, _, _)),
-    findall(R, leaf_clause(KB, Form, Root, [], [], [], R), Rules).
+    findall(R, leaf_clause(KB, Face-Form, Root, [], [], [], R), Rules).
 
-leaf_clause(KB, Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
+leaf_clause(KB, face(_, Name, _)-Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
     tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000.0,
-    Head = q(Action, Necessity, Q),
+    Head =.. [Name, Action, Necessity, Q],
     foldl(positive(Action, Necessity), Pos, Goals0, []),
     pairs_keys_values(Neg, NegTests, NegVars),
     maplist(negative(Form, Action, Necessity, Goals0), NegTests, NegGoals),
@@ -175,13 +222,13 @@ leaf_clause(KB, Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
     ;   list_conj_(Goals, Body),
         Clause = (Head :- Body)
     ).
-leaf_clause(KB, Form, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
+leaf_clause(KB, FF, node(_, Lits, New, Yes, No), Pos, Neg, Vars, Clause) :-
     append(Pos, Lits, Pos1),
     append(Vars, New, Vars1),
-    (   leaf_clause(KB, Form, Yes, Pos1, Neg, Vars1, Clause)
+    (   leaf_clause(KB, FF, Yes, Pos1, Neg, Vars1, Clause)
     ;   copy_term(Pos-Lits-Vars1, PathCopy-TestCopy-TestVars),
         append(Neg, [(PathCopy-TestCopy)-TestVars], Neg1),
-        leaf_clause(KB, Form, No, Pos, Neg1, Vars, Clause)
+        leaf_clause(KB, FF, No, Pos, Neg1, Vars, Clause)
     ).
 
 positive(A, _, action(T), Gs, Gs) :- !, A = T.
@@ -281,18 +328,40 @@ list_conj_([G|Gs], (G, C)) :- list_conj_(Gs, C).
 %   the leaves as q/3 rules (for a person, and for plain swipl).
 
 tg_save(KB, S) :-
+    q_face(Face),
+    tg_save(KB, Face, S).
+
+%!  tg_save(+KB, +Face, +Stream) is det.
+%
+%   As tg_save/2, the tree and its rules named as Face says (tg_face/2): a P-tree as
+%   ptg_tree/1 and p/3 rules.
+
+tg_save(KB, Face, S) :-
+    Face = face(TreeName, _, _),
     tg_get_tree(KB, tree(Root, _, _, _)),
     saved_tree(KB, Root, [], Saved, Vars),
     name_variables(Vars, Names),
     maplist([Name=V]>>(V = '$VAR'(Name)), Names),
-    format(S, "% The tree: tests (conjunctions; a variable is used only in the yes-branch of~n", []),
-    format(S, "% the test that introduces it) and leaves (Q estimate, examples counted).~n", []),
-    portray_clause(S, tg_tree(Saved)),
+    save_comments(TreeName, Lines, RuleLines),
+    forall(member(L, Lines), format(S, "% ~w~n", [L])),
+    Tree =.. [TreeName, Saved],
+    portray_clause(S, Tree),
     nl(S),
-    format(S, "% The same knowledge as rules: Q of an action in the state working memory~n", []),
-    format(S, "% holds now, under the active necessity (one clause per leaf).~n", []),
-    tg_leaf_clauses(KB, Clauses),
+    forall(member(L, RuleLines), format(S, "% ~w~n", [L])),
+    tg_leaf_clauses(KB, Face, Clauses),
     forall(member(C, Clauses), portray_clause(S, C)).
+
+%   The comment lines a policy file writes above a tree and above its rules.
+save_comments(tg_tree,
+              ["The tree: tests (conjunctions; a variable is used only in the yes-branch of",
+               "the test that introduces it) and leaves (Q estimate, examples counted)."],
+              ["The same knowledge as rules: Q of an action in the state working memory",
+               "holds now, under the active necessity (one clause per leaf)."]).
+save_comments(ptg_tree,
+              ["The P-tree: the same kind of tests, and leaves (P: the share of the examples",
+               "there that the Q-tree found optimal, examples counted)."],
+              ["The policy as rules: P of an action in the state working memory holds now",
+               "(near 1: optimal, near 0: not; one clause per leaf)."]).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
     tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)).
@@ -325,9 +394,20 @@ tg_policy_term(Term) :-
 %   @error domain_error(tg_rules_match_tree, Clause) for a q/3 rule the tree does not give.
 
 tg_restore(KB, Terms) :-
-    (   memberchk(tg_tree(Saved), Terms)
+    q_face(Face),
+    tg_restore(KB, Face, Terms).
+
+%!  tg_restore(+KB, +Face, +Terms:list) is det.
+%
+%   As tg_restore/2, for the tree and rules named as Face says (tg_face/2): a P-tree from
+%   ptg_tree/1 and p/3 rules.
+
+tg_restore(KB, Face, Terms) :-
+    Face = face(TreeName, _, _),
+    Wanted =.. [TreeName, Saved],
+    (   memberchk(Wanted, Terms)
     ->  true
-    ;   existence_error(tg_tree, Terms)
+    ;   existence_error(TreeName, Terms)
     ),
     tg_get_tree(KB, tree(_, _, Bias, Responses)),
     tg_data(KB, D),
@@ -342,8 +422,8 @@ tg_restore(KB, Terms) :-
     max_list(Ids, MaxId),
     (   MaxId =< U                                   % ids 1 .. U, as the learner numbers
     ->  true
-    ;   policy_refuse(tg_tree(Saved), "node id ~d is out of range: the tree has ~d nodes, \c
-                                       ids 1 to ~d", [MaxId, U, U])
+    ;   policy_refuse(Wanted, "node id ~d is out of range: the tree has ~d nodes, ids 1 \c
+                              to ~d", [MaxId, U, U])
     ),
     Cap is max(16, MaxId),
     tg_empty_leaves(Cap, Leaves),
@@ -357,7 +437,7 @@ tg_restore(KB, Terms) :-
     tg_forget_leaves(KB),
     forall(tg_tree_leaf(Root, Leaf), tg_compile_leaf(KB, Leaf)),
     tg_compile_tree(KB, Root),
-    check_rules(KB, Terms).
+    check_rules(KB, Face, Terms).
 
 restored(leaf(Id, Q, N), b(Bias, Keep), Path, Vars, leaf(Id, Path, Vars, Cands), [Id-L]) :-
     !,
@@ -427,23 +507,31 @@ typed_var(V-T) :-
 
 %   The q/3 rules of a policy are the tree written as rules: refuse a file whose rules
 %   say something else (an edited rule would otherwise be silently ignored).
-check_rules(KB, Terms) :-
-    leaf_rules(KB, short, Short),
-    leaf_rules(KB, full, Full),
+check_rules(KB, Face, Terms) :-
+    Face = face(_, Name, _),
+    leaf_rules(KB, Face, short, Short),
+    leaf_rules(KB, Face, full, Full),
     append(Short, Full, Mine),
-    include(is_rule, Terms, Rules),
+    include(is_rule(Name), Terms, Rules),
     forall(member(R, Rules),
            (   member(M-_, Mine), same_rule(R, M)
            ->  true
            ;   domain_error(tg_rules_match_tree, R)
            )).
 
-is_rule((q(_, _, _) :- _)).
-is_rule(q(_, _, _)).
+is_rule(Name, Term) :-
+    (   Term = (Head :- _)
+    ->  true
+    ;   Head = Term
+    ),
+    compound(Head),
+    compound_name_arity(Head, Name, 3).
 
 same_rule(R, M) :-
-    rule_parts(R, q(A, N, Q), B),
-    rule_parts(M, q(A1, N1, Q1), B1),
+    rule_parts(R, H, B),
+    rule_parts(M, H1, B1),
+    H =.. [Name, A, N, Q],
+    H1 =.. [Name, A1, N1, Q1],
     number(Q),
     abs(Q - Q1) =< 0.0011,
     q(A, N)-B =@= q(A1, N1)-B1.

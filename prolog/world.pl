@@ -45,6 +45,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | optimal_steps(+Goal, +State, -Steps)  | optional: the optimal number of steps, when known (relrl check verifies it against a search) |
   | sizes(train|test, Sizes)              | optional: the sizes learning and transfer use by default |
   | task_rmode(Task, Mode)                | optional: a mode of the language bias for episodes of Task only (world_for_task/2) |
+  | task_own_bias(Task)                   | optional: Task's bias is its task_rmode/2 modes alone, without rmode/1 |
   | discount(Gamma)                       | optional: the task's discount, the learners' gamma (default theirs) |
   | relation/1, rmode/1, rconst/2         | the learner's view and language bias, as in a domain (docs/tg.md) |
 
@@ -89,6 +90,7 @@ world_predicate(optimal_steps/3, optional).
 world_predicate(sizes/2, optional).
 world_predicate(discount/1, optional).
 world_predicate(task_rmode/2, optional).
+world_predicate(task_own_bias/1, optional).
 
 %!  world_defines(+KB, +PI) is semidet.
 %
@@ -426,7 +428,9 @@ expand([A|As], KB, Goal, S, Seen0, Seen, N0, N, Next0, Next, Found) :-
 %   run, through tg_bias's extra_rmode/2. Background knowledge that serves one task can
 %   mislead another: highest/1, the top of a tallest tower, is what stacking needs, and a
 %   tree that splits on it while unstacking values moves by tower heights seen in small
-%   worlds. Call it before engine_configure/4; a later call changes only the next run.
+%   worlds. When the world declares task_own_bias(T) for such a T, Task's task_rmode/2 modes
+%   are the whole bias (tg_bias's own_rmodes/1): the rmode/1 shared by the other tasks are
+%   left out. Call it before engine_configure/4; a later call changes only the next run.
 
 world_for_task(KB, Task) :-
     must_be(atom, KB),
@@ -434,7 +438,7 @@ world_for_task(KB, Task) :-
     atom_concat('$relrl_world_task:', KB, Key),
     nb_setval(Key, Task).
 
-:- multifile relrl_tg_bias:extra_rmode/2.
+:- multifile relrl_tg_bias:extra_rmode/2, relrl_tg_bias:own_rmodes/1.
 
 relrl_tg_bias:extra_rmode(KB, Mode) :-
     atom(KB),
@@ -442,6 +446,14 @@ relrl_tg_bias:extra_rmode(KB, Mode) :-
     nb_current(Key, Task),
     declared(KB, task_rmode(T, Mode)),
     subsumes_term(T, Task).
+
+relrl_tg_bias:own_rmodes(KB) :-
+    atom(KB),
+    atom_concat('$relrl_world_task:', KB, Key),
+    nb_current(Key, Task),
+    declared(KB, task_own_bias(T)),
+    subsumes_term(T, Task),
+    !.
 
 % ---- what the world offers -----------------------------------------------------------------
 

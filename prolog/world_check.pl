@@ -101,6 +101,15 @@ static_problem(KB, problem(File, Line, Msg)) :-
                              relation/1)", [T, M, Name/Arity])
     ),
     clause_location(Ref, File, Line).
+static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, task_own_bias(T), true, Ref),
+    (   \+ ( declared(KB, task(T0)), \+ T0 \= T )
+    ->  format(string(Msg), "task_own_bias(~q): no declared task is ~q", [T, T])
+    ;   \+ ( declared(KB, task_rmode(T1, M)), \+ T1 \= T, M = action(_) )
+    ->  format(string(Msg), "task_own_bias(~q): its bias would have no action test (give \c
+                             task_rmode(~q, action(...)) modes)", [T, T])
+    ),
+    clause_location(Ref, File, Line).
 static_problem(KB, P) :-
     bias_problem(KB, P).
 

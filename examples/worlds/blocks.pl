@@ -151,6 +151,16 @@ rmode(covers(+block, +block)).
 % holds it.
 task_rmode(stack, highest(+block)).
 
+% Unstacking needs to know only what a move does to the block it moves: off a block onto the
+% floor is right in every state, any other move wrong. Tests of the towers tell states near
+% the goal from states far from it, and a Q-tree that splits on them ranks the moves of one
+% state by the values of different states (a move that is only legal near the goal looks
+% better than the right move far from it); so unstack has a bias of its own.
+task_rmode(unstack, action(move(-block, -block))).
+task_rmode(unstack, action(move(-block, floor))).
+task_rmode(unstack, on(+block, floor)).
+task_own_bias(unstack).
+
 % ---- the optimal number of moves (verified against a breadth-first search by relrl check) --
 
 % stack: every block outside a tallest tower moves once; unstack: every block not on the

@@ -176,7 +176,7 @@ def _add_worlds(sub) -> None:
     w = sub.add_parser("worlds", help="tasks of worlds written in Prolog (blocks world)",
                        description="Learning curves, evaluation on other sizes with no "
                                    "further learning, memory and step cost of the learners "
-                                   "of worlds (tg, qtable) on tasks of worlds written in "
+                                   "of worlds (tg, ptg, qtable) on tasks of worlds written in "
                                    "Prolog; the worlds' stated optimum checked by search.",
                        epilog="examples:\n"
                               "  relrl experiment worlds --quick --out runs/worlds-quick\n"

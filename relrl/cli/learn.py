@@ -5,7 +5,10 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 from relrl.outdir import add_out_options
 
@@ -46,8 +49,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("world", metavar="WORLD.pl", help="the world file (docs/worlds.md)")
     parser.add_argument("--learner", default="tg",
-                        help=f"{' or '.join(WORLD_LEARNERS)}: tg (relational, the default) or "
-                             "qtable (Q-learning over ground states, the baseline)")
+                        help=f"{', '.join(WORLD_LEARNERS)}: tg (relational, the default), ptg "
+                             "(tg's Q-tree and a P-tree that acts: P-learning) or qtable "
+                             "(Q-learning over ground states, the baseline)")
     parser.add_argument("--task", default=None,
                         help="a task of the world: its name (stack, on) or an instance "
                              "(on(b1, b2)); default: the first the world declares")
@@ -79,6 +83,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "DIR/replay shows the world's states) (3)")
     parser.add_argument("--no-speed", action="store_true",
                         help="skip the step-cost and crossing measurements")
+    parser.add_argument("--monitor", nargs="?", const="", default=None, metavar="HOST:PORT",
+                        help="serve a live web page of the learning: progress, the curve, "
+                             "the learned tree and a greedy episode's last state after each "
+                             "evaluation (default 127.0.0.1 and a free port, printed at "
+                             "start; off localhost a token is required)")
     add_out_options(parser, default=None,
                     what="output folder: results.json, curve.csv, policy.pl, traces.jsonl")
 
@@ -136,23 +145,48 @@ def run(args: argparse.Namespace) -> int:
     print(f"{args.learner} learns {task_text} on sizes {','.join(map(str, train))} "
           f"({args.episodes} episodes, seed {args.seed}); greedy evaluation of "
           f"{args.eval_episodes} episodes:")
-    if args.out is None:
-        result = learn_task(config, report=show, policy_in=args.policy)
-        _summary(result, result["timing"])
-        return 0
-    with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                      outputs=OUTPUTS) as out:
-        result = learn_task(config, report=show, policy_in=args.policy,
-                            policy_out=out.path / "policy.pl", traces=args.traces)
-        timing = result["timing"]
-        files = _write(out.path, config, result)
-        out.status = "complete"
+    with _live_monitor(args.monitor, config) as hub:
+        if args.out is None:
+            result = learn_task(config, report=show, policy_in=args.policy, monitor=hub)
+            _summary(result, result["timing"])
+            return 0
+        with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                          outputs=OUTPUTS) as out:
+            result = learn_task(config, report=show, policy_in=args.policy,
+                                policy_out=out.path / "policy.pl", traces=args.traces,
+                                monitor=hub)
+            timing = result["timing"]
+            files = _write(out.path, config, result)
+            out.status = "complete"
     _summary(result, timing)
     print(f"\nwrote {len(files)} files to {out.path}/: "
           f"{', '.join(str(f.relative_to(out.path)) for f in files)}")
     if (out.path / "replay").is_dir():
         print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
     return 0
+
+
+@contextmanager
+def _live_monitor(address: str | None, config: Any) -> Iterator[Any]:
+    """The live monitor's hub (its page served from a process of its own) when ``address``
+    is not None (``""``: localhost and a free port), else None; closed on the way out."""
+    if address is None:
+        yield None
+        return
+    from relrl.monitor import Hub, start_live
+
+    hub = Hub(info={"episode": f"{Path(config.world).name}: {config.task}",
+                    "learner": {"name": config.learner}, "seed": config.seed,
+                    "necessities": ["of optimal"], "responses": None})
+    server = start_live(hub, address or None)
+    note = " (token required: not bound to localhost)" if server.token else ""
+    print(f"monitor: {server.url}{note}", flush=True)
+    try:
+        yield hub
+        hub.status("finished", "learned and evaluated")
+    finally:
+        hub.finish()
+        server.close()
 
 
 def _summary(result: dict, t: dict) -> None:

@@ -42,7 +42,7 @@ class WorldsConfig:
 
     worlds: list[str] = field(default_factory=list)           #: world files
     tasks: list[str] = field(default_factory=lambda: ["stack", "unstack", "on"])
-    learners: list[str] = field(default_factory=lambda: ["tg", "qtable"])
+    learners: list[str] = field(default_factory=lambda: ["tg", "ptg", "qtable"])
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])

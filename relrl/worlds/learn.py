@@ -55,7 +55,7 @@ class LearnConfig:
 
 def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] | None = None,
                policy_out: str | Path | None = None, policy_in: str | Path | None = None,
-               traces: int = 0) -> dict[str, Any]:
+               traces: int = 0, monitor: Any = None) -> dict[str, Any]:
     """Learn ``config.task`` and evaluate it; returns a JSON-ready dict.
 
     Args:
@@ -65,6 +65,10 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
         policy_in: start from this saved policy instead of from nothing.
         traces: keep this many greedy episodes of each test size with every step's state
             (for replay).
+        monitor: a live monitor's :class:`~relrl.monitor.hub.Hub`: after each evaluation it
+            is given the progress (status), the curve (one point of the plot per
+            evaluation: the fraction of optimal), the learned tree and the first greedy
+            episode's last state; the evaluation's episodes are the same with or without it.
 
     The result holds ``curve`` (one entry per evaluation), ``test`` (per test size),
     ``memory``, ``timing`` (wall-clock figures; the caller keeps them out of results.json)
@@ -80,8 +84,9 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
         learn_seconds, learn_steps, done = 0.0, 0, 0
 
         def evaluate() -> None:
-            ev = score(world.episodes(task, config.train_sizes, config.eval_episodes,
-                                      "greedy", optimal=True))
+            eps = world.episodes(task, config.train_sizes, config.eval_episodes, "greedy",
+                                 optimal=True, trace=monitor is not None)
+            ev = score(eps)
             positions, details = world.size()
             entry = {"point": len(curve), **ev, "eval_episodes": ev["episodes"],
                      "episodes": done, "learning_steps": learn_steps,
@@ -89,9 +94,18 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
             curve.append(entry)
             if report is not None:
                 report({"kind": "point", "entry": entry})
+            if monitor is not None:
+                _monitor_point(monitor, world, config, entry, eps)
 
+        if monitor is not None:
+            monitor.status("initial evaluation", f"{config.learner} on {config.task}: "
+                           f"{config.eval_episodes} greedy episodes")
         evaluate()
         while done < config.episodes:
+            if monitor is not None:
+                monitor.status("learning", f"{config.learner} learns {config.task}: episodes "
+                               f"{done + 1}-{min(done + config.block, config.episodes)} of "
+                               f"{config.episodes}", done=done, total=config.episodes)
             n = min(config.block, config.episodes - done)
             t0 = time.perf_counter()
             eps = world.episodes(task, config.train_sizes, n, "learn", updates=config.updates)
@@ -102,6 +116,9 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
         positions, details = world.size()
         test: dict[str, Any] = {}
         kept: dict[str, list[dict[str, Any]]] = {}
+        if monitor is not None:
+            monitor.status("evaluating", "no further learning: sizes "
+                           + ", ".join(map(str, config.test_sizes)))
         for size in config.test_sizes:
             eps = world.episodes(task, [size], config.eval_episodes, "greedy", optimal=True,
                                  trace=traces > 0)
@@ -134,6 +151,26 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
             out["traces"] = kept
             out["graph"] = world.engine.graph()
         return out
+
+
+def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str, Any],
+                   eps: Sequence[Any]) -> None:
+    """Give the live monitor one evaluation: a point of its plot (the fraction of optimal at
+    the number of learning episodes), the learned tree, and the last state of the first
+    greedy episode (as the replay shows it)."""
+    from relrl.worlds.replay import step_rows
+
+    hub.tick(entry["episodes"], [entry["optimality"]], entry["success"])
+    hub.set_tree(world.engine.graph())
+    if eps:
+        ep = eps[0]
+        rows = step_rows({"goal": ep.goal, "steps": ep.steps, "optimal": ep.optimal,
+                          "trace": ep.trace}, world=Path(config.world).name, size=ep.size,
+                         label=f"greedy after {entry['episodes']} episodes "
+                               f"(of optimal {entry['optimality']:.3f})",
+                         t0=entry["episodes"])
+        if rows:
+            hub.publish(rows[-1])
 
 
 def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int], *,

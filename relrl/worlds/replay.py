@@ -15,7 +15,25 @@ from typing import Any
 from relrl.monitor.view import StepView
 from relrl.outdir import write_atomic, write_json_atomic
 
-__all__ = ["write_replay"]
+__all__ = ["step_rows", "write_replay"]
+
+
+def step_rows(ep: dict[str, Any], *, world: str, size: int, label: str,
+              t0: int = 0) -> list[dict[str, Any]]:
+    """One traced episode (as :func:`relrl.worlds.learn.learn_task` keeps it: ``goal``,
+    ``steps``, ``optimal``, ``trace``) as the monitor's rows (:meth:`StepView.row`), numbered
+    from ``t0 + 1``: the world's state as the percepts, the action as the response, the
+    episode (size, ``label``, goal, step, optimum) as the phase."""
+    rows = []
+    for i, step in enumerate(ep["trace"]):
+        phase = (f"size {size} · {label} · goal {ep['goal']} · step {i} of {ep['steps']} "
+                 f"(optimal {ep['optimal']})")
+        rows.append(StepView(
+            t=t0 + i + 1, phase=phase, percepts=list(step["state"]), memory=None,
+            memory_size=None, state=0, necessity=None, activation={},
+            reward=float(step["reward"] or 0), response=step["action"], allowed=[],
+            metrics={}, extra={"world": world, "size": size}).row())
+    return rows
 
 
 def write_replay(folder: Path, traces: dict[str, list[dict[str, Any]]], *, learner: str,
@@ -30,18 +48,11 @@ def write_replay(folder: Path, traces: dict[str, list[dict[str, Any]]], *, learn
         learner, world, task, seed: for the page's heading.
         graph: the learned tree (:meth:`relrl.engine.Engine.graph`), shown from the start.
     """
-    rows, t = [], 0
+    rows: list[dict[str, Any]] = []
     for size, episodes in traces.items():
         for n, ep in enumerate(episodes, 1):
-            for i, step in enumerate(ep["trace"]):
-                t += 1
-                phase = (f"size {size} · episode {n} · goal {ep['goal']} · step {i} of "
-                         f"{ep['steps']} (optimal {ep['optimal']})")
-                rows.append(StepView(
-                    t=t, phase=phase, percepts=list(step["state"]), memory=None,
-                    memory_size=None, state=0, necessity=None, activation={},
-                    reward=float(step["reward"] or 0), response=step["action"], allowed=[],
-                    metrics={}, extra={"world": world, "size": int(size)}).row())
+            rows += step_rows(ep, world=world, size=int(size), label=f"episode {n}",
+                              t0=len(rows))
     files = [write_atomic(folder / "trace.jsonl",
                           "".join(json.dumps(r) + "\n" for r in rows)),
              write_json_atomic(folder / "session.json",

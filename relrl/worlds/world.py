@@ -29,7 +29,7 @@ __all__ = ["Episode", "World", "WORLD_DEFAULTS", "WORLD_LEARNERS", "make_world_l
            "score"]
 
 #: The learners of worlds: those whose Prolog learner reads the relational view.
-WORLD_LEARNERS = ("tg", "qtable")
+WORLD_LEARNERS = ("tg", "ptg", "qtable")
 
 #: Learner parameters for worlds, where they differ from the learners' own defaults (those
 #: were chosen on the simulator's rewards, 10 and -1, and its one-step reward delays): a
@@ -38,6 +38,7 @@ WORLD_LEARNERS = ("tg", "qtable")
 #: states, and the goal tasks were learned as well without it) and so is the staleness bonus.
 WORLD_DEFAULTS: dict[str, dict[str, float]] = {
     "tg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
+    "ptg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
     "qtable": {},
 }
 
@@ -51,6 +52,7 @@ def make_world_learner(name: str, **params: float) -> Any:
         ConfigError: an unknown learner or parameter.
     """
     from relrl.learners import make_learner
+    from relrl.learners.ptg import PTGLearner
     from relrl.learners.qtable import QTableLearner
 
     if name not in WORLD_LEARNERS:
@@ -59,6 +61,8 @@ def make_world_learner(name: str, **params: float) -> Any:
     merged = {**WORLD_DEFAULTS.get(name, {}), **params}
     if name == "qtable":
         return QTableLearner(**merged)
+    if name == "ptg":
+        return PTGLearner(**merged)
     return make_learner(name, **merged)
 
 
@@ -196,8 +200,9 @@ class World:
 
     def attach(self, learner: Any, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a :class:`relrl.learners.Learner` whose Prolog learner reads the
-        relational view: ``tg``, ``qtable``) afresh in this world, seeded; for ``task``, its
-        language bias holds the task's own modes too (task_rmode/2)."""
+        relational view: ``tg``, ``ptg``, ``qtable``) afresh in this world, seeded; for
+        ``task``, its language bias holds the task's own modes too (task_rmode/2), or them
+        alone (task_own_bias/1)."""
         if task is not None:
             call(self.kb, "world_for_task", self.kb.module, self._task(task))
         learner.attach(self.engine, seed)

@@ -162,6 +162,21 @@ test(task_rmode_of_no_task, [Msg == "task_rmode(fly, p(+x)): no declared task is
             KB, _),
     world_problems(KB, [problem(_, 8, Msg)]).
 
+test(own_bias_of_no_task, [Msg == "task_own_bias(fly): no declared task is fly"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, _) :- fail.", "relation(p(_)).", "task_own_bias(fly)."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
+
+test(own_bias_without_an_action_test, [Msg == "task_own_bias(t): its bias would have no action test (give task_rmode(t, action(...)) modes)"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, _) :- fail.", "relation(p(_)).", "task_rmode(t, p(+x)).",
+             "task_own_bias(t)."],
+            KB, _),
+    world_problems(KB, [problem(_, 9, Msg)]).
+
 :- end_tests(world_check).
 
 :- begin_tests(world_task_bias).
@@ -179,7 +194,24 @@ test(only_stack_sees_highest) :-
     assertion(\+ memberchk(highest(+block), Unstack)),
     assertion(\+ memberchk(highest(+block), On)),
     subtract(Stack, [highest(+block)], Rest),
-    assertion(Rest == Unstack).
+    assertion(Rest == On).
+
+test(unstack_has_a_bias_of_its_own, [Unstack == [action(move(-block, -block)),
+                                                 action(move(-block, floor)),
+                                                 on(+block, floor)]]) :-
+    % task_own_bias(unstack): its task_rmode/2 modes alone, none of the shared rmode/1
+    blocks(KB),
+    bias_modes(KB, unstack, Unstack),
+    bias_modes(KB, on(b1, b2), On),
+    assertion(memberchk(on(+block, -block), On)),     % the shared modes: other tasks keep them
+    assertion(memberchk(goal_on(+block, -block), On)).
+
+test(a_domain_keeps_its_rmodes) :-
+    % no task configured (a domain's knowledge base): the bias is rmode/1
+    blocks(KB),
+    relrl_tg_bias:tg_bias(KB, bias(Modes, _)),
+    findall(M, relrl_declarations:declared(KB, rmode(M)), Declared),
+    assertion(Modes == Declared).
 
 :- end_tests(world_task_bias).
 

@@ -28,6 +28,42 @@ def test_tg_learns_3_block_stack_to_optimal() -> None:
     assert after["exactly_optimal"] == 1.0
 
 
+def test_ptg_learns_3_block_unstack_to_optimal_and_acts_on_6() -> None:
+    """P-learning: learned on 3 blocks only, the P-tree's greedy choices are optimal on 3
+    blocks and, with no further learning, on 6."""
+    with World(BLOCKS) as world:
+        world.attach(world.learner("ptg"), seed=0)
+        before = score(world.episodes("unstack", [3], 50, "greedy", optimal=True))
+        world.episodes("unstack", [3], 100, "learn")
+        after = score(world.episodes("unstack", [3], 50, "greedy", optimal=True))
+        larger = score(world.episodes("unstack", [6], 30, "greedy", optimal=True))
+        text = world.text()
+    assert before["optimality"] < 0.9
+    assert after["optimality"] == 1.0 and after["exactly_optimal"] == 1.0
+    assert larger["optimality"] == 1.0
+    assert text.startswith("P-tree (acts when greedy):") and "Q-tree" in text
+
+
+def test_learn_feeds_the_live_monitor() -> None:
+    """learn_task gives the monitor's hub each evaluation (a plot point, the tree, a greedy
+    episode's last state) and learns exactly as without it."""
+    from relrl.monitor import Hub
+    from relrl.worlds.learn import LearnConfig, learn_task
+
+    config = LearnConfig(world=str(BLOCKS), task="stack", learner="ptg", train_sizes=[3],
+                         test_sizes=[4], episodes=40, block=20, eval_episodes=5,
+                         speed=False)
+    hub = Hub()
+    watched = learn_task(config, monitor=hub)
+    alone = learn_task(config)
+    assert watched["curve"] == alone["curve"] and watched["test"] == alone["test"]
+    assert [p[1] for p in hub._series] == [0, 20, 40]
+    assert [p[2][0] for p in hub._series] == [e["optimality"] for e in alone["curve"]]
+    assert hub.tree and hub.tree["nodes"]
+    assert hub.view["size"] == 3 and any(f.startswith("on(") for f in hub.view["percepts"])
+    assert hub.state["activity"] == "evaluating"
+
+
 def test_same_seed_same_episodes() -> None:
     def run() -> list:
         with World(BLOCKS) as world:
@@ -119,15 +155,16 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
 
     out = tmp_path / "exp"
     assert main(["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack",
-                 "--learners", "tg,qtable", "--seeds", "0", "--episodes", "20", "--block",
+                 "--learners", "tg,ptg,qtable", "--seeds", "0", "--episodes", "20", "--block",
                  "10", "--eval-episodes", "5", "--sizes", "3", "--test-sizes", "4",
                  "--workers", "1", "--out", str(out)]) == 0
     results = json.loads((out / "results.json").read_text())
-    assert {r["learner"] for r in results["summary"]} == {"tg", "qtable"}
+    assert {r["learner"] for r in results["summary"]} == {"tg", "ptg", "qtable"}
     assert results["optimal_check"][0]["rows"][0]["agree"] == \
         results["optimal_check"][0]["rows"][0]["searched"] > 0
     for name in ("summary.csv", "curves.csv", "test.csv", "step_cost.csv", "curves.png",
-                 "policies/blocks-stack-tg-s0.pl", "policies/blocks-stack-qtable-s0.pl"):
+                 "policies/blocks-stack-tg-s0.pl", "policies/blocks-stack-ptg-s0.pl",
+                 "policies/blocks-stack-qtable-s0.pl"):
         assert (out / name).is_file(), name
     text = render(load_run(out), "summary")
     assert "| blocks | stack | tg | 1 |" in text

@@ -1,0 +1,307 @@
+:- module(relrl_ptg,
+          [ ptg_init/2,           % +KB, +Params
+            ptg_p/5,              % +KB, +Facts, +Action, +Necessity, -P
+            ptg_choose/6,         % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
+            ptg_update/2,         % +KB, +Transition
+            ptg_size/2,           % +KB, -Size
+            ptg_explain/4,        % +KB, +Facts, +Necessity, -Explanation
+            ptg_save/2,           % +KB, +Stream
+            ptg_restore/2,        % +KB, +Terms
+            ptg_text/2,           % +KB, -Text
+            ptg_key/2             % +KB, -Key
+          ]).
+:- use_module(library(error)).
+:- use_module(library(lists)).
+:- use_module(library(apply)).
+:- use_module(library(pairs)).
+:- use_module(library(random)).
+:- use_module(tg).
+:- use_module(tg_tree, [tg_data/2, tg_get_tree/2]).
+:- use_module(tg_classes, [tg_class_member/3]).
+
+/** <module> ptg: P-learning beside TG's Q-tree
+
+Relational reinforcement learning's P-learning (Džeroski, De Raedt & Driessens, *Relational
+Reinforcement Learning*, Machine Learning 43, 2001): beside the Q-function, learn the
+function P(s, a) = 1 when a is optimal in s and 0 when not, as a first-order tree, and act
+by it. The optimal *policy* often depends on the objects far less than the values do: in
+blocks world Q(s, a) counts the moves still needed, which depends on the towers' heights and
+so on the number of blocks, while "move a clear block that stands on another onto the floor"
+is optimal for unstacking in a world of any size. A tree that predicts Q splits on heights
+seen in small worlds; a tree that predicts optimality need not.
+
+ptg is tg (tg.pl) with a second tree:
+
+  - **the Q-tree** is tg's own, under the knowledge base's key, learned exactly as tg learns
+    it (every transition, its Q-target, its splits), and it chooses while learning (tg's
+    Boltzmann exploration over classes of responses);
+  - **the P-tree** is a tree of the same code (tg_init/3 under the key of ptg_key/2): the
+    same language bias and candidate tests, examples (state, action, 0/1). After each
+    transition into a state s' that is not terminal, the Q-tree labels the classes of
+    responses allowed in s' (tg_class_values/6, the values the Q-target's max was taken
+    over): a class is optimal when its Q is within `p_margin` of the best. `p_pairs` times,
+    one optimal class and one that is not (when there is one), drawn uniformly, are
+    inserted with targets 1 and 0: the P-tree learns to tell them apart with as many
+    examples of each, and a learning step inserts a fixed number of P-examples whatever the
+    number of responses (RRL labels every action of every state it met);
+  - **greedy choices** (evaluation, acting on a learned policy) are by P, ties by Q, further
+    ties at random: a leaf's P is the share of its examples the Q-tree found optimal, so the
+    class most often optimal in states like this one wins.
+
+The P-tree's leaves move at rate max(1/n, `p_alpha`) (its labels change as the Q-tree
+learns); it splits like the Q-tree (`significance`, `min_examples`, `half_life`,
+`keep_examples`). Its other tg parameters are unused: it never explores.
+
+Params: tg's (tg_init/2) and p_margin, p_alpha, p_pairs.
+*/
+
+%!  ptg_key(+KB, -Key) is det.
+%
+%   Key is the key the P-tree of KB is kept under (tg_init/3).
+
+ptg_key(KB, Key) :-
+    atom_concat('$ptg:', KB, Key).
+
+params_key(KB, Key) :-
+    atom_concat('$ptg_params:', KB, Key).
+
+%!  ptg_init(+KB, +Params:list) is det.
+%
+%   Start KB's ptg learner afresh: tg's Q-tree (tg_init/2 with tg's parameters) and a P-tree
+%   of one leaf.
+
+ptg_init(KB, Params) :-
+    must_be(atom, KB),
+    must_be(list, Params),
+    maplist(param(Params), [p_margin, p_alpha, p_pairs], [Margin, PAlpha, Pairs0]),
+    (   Margin >= 0
+    ->  true
+    ;   domain_error(nonneg, Margin)
+    ),
+    Pairs is max(1, round(Pairs0)),
+    exclude(p_param, Params, QParams),
+    tg_init(KB, QParams),
+    selectchk(alpha=_, QParams, alpha=PAlpha, PParams),
+    ptg_key(KB, PK),
+    tg_init(PK, KB, PParams),
+    params_key(KB, K),
+    nb_setval(K, pp(Margin, Pairs)).
+
+p_param(Name=_) :-
+    memberchk(Name, [p_margin, p_alpha, p_pairs]).
+
+param(Params, Name, Value) :-
+    (   memberchk(Name=V, Params)
+    ->  must_be(number, V),
+        Value = V
+    ;   existence_error(ptg_parameter, Name)
+    ).
+
+ptg_params(KB, P) :-
+    params_key(KB, K),
+    (   nb_current(K, P0)
+    ->  P = P0
+    ;   existence_error(ptg_learner, KB)
+    ).
+
+%!  ptg_p(+KB, +Facts, +Action, +Necessity, -P) is det.
+%
+%   P is the P-tree's estimate that Action is optimal in the state Facts under Necessity.
+
+ptg_p(KB, Facts, A, N, P) :-
+    ptg_key(KB, PK),
+    tg_q(PK, Facts, A, N, P).
+
+%!  ptg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
+%
+%   With Mode greedy, Action is a member of the class of Allowed responses (every response
+%   when Allowed is []) with the largest P, ties broken by the largest Q, then at random. With Mode learn or explore, tg's choice
+%   (tg_choose/6: Boltzmann over the Q-tree's values, with its bonuses while learning).
+
+ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
+    (   Mode == greedy
+    ->  tg_class_values(KB, Facts, N, Allowed, Classes, Qs),
+        ptg_key(KB, PK),
+        maplist(class_p(PK, Facts, N), Classes, Qs, Scored),
+        max_member(s(BestP, _, _), Scored),
+        include(p_is(BestP), Scored, ByP),
+        max_member(s(_, BestQ, _), ByP),
+        include(q_is(BestQ), ByP, Ties),
+        random_member(s(_, _, Class), Ties),
+        tg_data(KB, D),
+        arg(6, D, Index),
+        tg_class_member(Index, Class, Action)
+    ;   tg_choose(KB, Facts, N, Allowed, Mode, Action)
+    ).
+
+%   s(P, Q, Class): P first, so that max_member/2 finds the largest P (standard order of
+%   terms compares numbers by value; a Q tie then by Q).
+class_p(PK, Facts, N, Class, Q, s(P, Q, Class)) :-
+    Class = cls(A, _),
+    tg_q(PK, Facts, A, N, P).
+
+p_is(P, s(P1, _, _)) :-
+    P1 =:= P.
+
+q_is(Q, s(_, Q1, _)) :-
+    Q1 =:= Q.
+
+%!  ptg_update(+KB, +Transition) is det.
+%
+%   Learn from a transition as tg does (tg_update/2); then, unless its next state is
+%   terminal, label the classes of the responses allowed there by the Q-tree and insert
+%   p_pairs pairs of P-examples (an optimal class, target 1; one that is not, target 0).
+
+ptg_update(KB, T) :-
+    tg_update(KB, T),
+    T = transition(_, _, _, _, _, S1, N1, Allowed1),
+    (   S1 == terminal
+    ->  true
+    ;   ptg_params(KB, pp(Margin, Pairs)),
+        tg_class_values(KB, S1, N1, Allowed1, Classes, Qs),
+        max_list(Qs, Best),
+        Cut is Best - Margin,
+        labelled(Qs, Classes, Cut, Optimal, Other),
+        ptg_key(KB, PK),
+        forall(between(1, Pairs, _),
+               label_pair(PK, S1, N1, Optimal, Other))
+    ).
+
+labelled([], [], _, [], []).
+labelled([Q|Qs], [C|Cs], Cut, Optimal, Other) :-
+    (   Q >= Cut
+    ->  Optimal = [C|Optimal1], Other = Other1
+    ;   Optimal = Optimal1, Other = [C|Other1]
+    ),
+    labelled(Qs, Cs, Cut, Optimal1, Other1).
+
+label_pair(PK, S, N, Optimal, Other) :-
+    random_member(cls(A, _), Optimal),
+    tg_insert(PK, S, A, N, 1),
+    (   Other == []
+    ->  true
+    ;   random_member(cls(B, _), Other),
+        tg_insert(PK, S, B, N, 0)
+    ).
+
+%!  ptg_size(+KB, -Size) is det.
+%
+%   Size is size(Positions, Details): the positions of both trees (tg_size/2's count for
+%   each), Details the Q-tree's (tg_size/2) and the P-tree's with names prefixed p_.
+
+ptg_size(KB, size(Positions, Details)) :-
+    tg_size(KB, size(QPos, QDetails)),
+    ptg_key(KB, PK),
+    tg_size(PK, size(PPos, PDetails0)),
+    Positions is QPos + PPos,
+    maplist(prefixed, PDetails0, PDetails),
+    append([QDetails, [p_positions=PPos], PDetails], Details).
+
+prefixed(Name=V, PName=V) :-
+    atom_concat(p_, Name, PName).
+
+%!  ptg_explain(+KB, +Facts, +Necessity, -Explanation) is det.
+%
+%   Explanation is ptg(Ranked): for every response, choice(Action, P, Q, Leaf, Path) by
+%   decreasing P, then Q; Leaf and Path are the P-tree's (as tg_explain/4 gives them).
+
+ptg_explain(KB, Facts, N, ptg(Ranked)) :-
+    ptg_key(KB, PK),
+    tg_explain(PK, Facts, N, tg(ByP)),
+    findall(k(NegP, NegQ)-choice(A, P, Q, Leaf, Path),
+            ( member(choice(A, P, Leaf, Path), ByP),
+              tg_q(KB, Facts, A, N, Q),
+              NegP is -P, NegQ is -Q ),
+            Keyed),
+    keysort(Keyed, Sorted),
+    pairs_values(Sorted, Ranked).
+
+%!  ptg_save(+KB, +Stream) is det.
+%
+%   Write both trees: tg's Q-tree (tg_tree/1, q/3 rules) and the P-tree (ptg_tree/1, p/3
+%   rules: the policy).
+
+ptg_save(KB, S) :-
+    tg_save(KB, S),
+    nl(S),
+    ptg_key(KB, PK),
+    tg_face(p, Face),
+    tg_save(PK, Face, S).
+
+%!  ptg_restore(+KB, +Terms:list) is det.
+%
+%   Rebuild both trees from a policy's terms (tg_restore/3 for each).
+
+ptg_restore(KB, Terms) :-
+    tg_restore(KB, Terms),
+    ptg_key(KB, PK),
+    tg_face(p, Face),
+    tg_restore(PK, Face, Terms).
+
+%!  ptg_text(+KB, -Text:string) is det.
+%
+%   Both trees drawn as text, the P-tree (the policy) first.
+
+ptg_text(KB, Text) :-
+    ptg_key(KB, PK),
+    tg_face(p, Face),
+    tg_text(PK, Face, PText),
+    tg_text(KB, QText),
+    format(string(Text), "P-tree (acts when greedy):~n~wQ-tree (explores, labels):~n~w",
+           [PText, QText]).
+
+policy_term(Term) :-
+    (   tg_policy_term(Term)
+    ->  true
+    ;   nonvar(Term),
+        (   Term = ptg_tree(_)
+        ->  true
+        ;   Term = (p(_, _, _) :- _)
+        ->  true
+        ;   Term = p(_, _, _)
+        )
+    ).
+
+% ---- the engine's hooks (see engine.pl) ----------------------------------------------------
+
+relrl_engine:learner(ptg).
+
+relrl_engine:learner_property(ptg, view(relational)).
+
+relrl_engine:learner_init(ptg, KB, Params) :-
+    ptg_init(KB, Params).
+
+relrl_engine:learner_state(ptg, KB, _Code, Facts) :-
+    tg_state(KB, Facts).
+
+relrl_engine:learner_choose(ptg, KB, Facts, N, Allowed, Mode, Action) :-
+    ptg_choose(KB, Facts, N, Allowed, Mode, Action).
+
+relrl_engine:learner_update(ptg, KB, Transition) :-
+    ptg_update(KB, Transition).
+
+relrl_engine:learner_explain(ptg, KB, Facts, N, Explanation) :-
+    ptg_explain(KB, Facts, N, Explanation).
+
+relrl_engine:learner_size(ptg, KB, Size) :-
+    ptg_size(KB, Size).
+
+relrl_engine:learner_save(ptg, KB, Stream) :-
+    ptg_save(KB, Stream).
+
+relrl_engine:learner_policy_info(ptg, KB, Info) :-
+    tg_policy_info(KB, Info).
+
+relrl_engine:learner_policy_term(ptg, Term) :-
+    policy_term(Term).
+
+relrl_engine:learner_restore(ptg, KB, Terms) :-
+    ptg_restore(KB, Terms).
+
+relrl_engine:learner_text(ptg, KB, Text) :-
+    ptg_text(KB, Text).
+
+relrl_engine:learner_graph(ptg, KB, Graph) :-
+    ptg_key(KB, PK),
+    tg_face(p, Face),
+    tg_graph(PK, Face, Graph).

@@ -1,0 +1,62 @@
+"""ptg: P-learning beside tg's Q-tree, held in Prolog (prolog/ptg.pl).
+
+Relational reinforcement learning's P-learning (Džeroski, De Raedt & Driessens, 2001): beside
+the Q-function, a first-order tree learns P(s, a) -- 1 when the Q-tree finds ``a`` optimal in
+``s``, 0 when not -- and greedy choices are made by P (ties by Q). The optimal policy often
+depends on the objects far less than the values do, so a P-tree learned in small worlds acts
+in larger ones where the Q-tree's values mislead it. A learner of worlds
+(:data:`relrl.worlds.WORLD_LEARNERS`); see docs/worlds.md.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from relrl.errors import ConfigError
+from relrl.learners.tg import TGLearner
+from relrl.terms import Term, format_term
+
+__all__ = ["PTGLearner"]
+
+
+class PTGLearner(TGLearner):
+    """tg's Q-tree (learned and exploring as tg does) and a P-tree that acts when greedy.
+
+    Parameters: tg's (the Q-tree's; :class:`~relrl.learners.tg.TGLearner`) and p_margin (a
+    response is labelled optimal when its Q is within this of the best response's),
+    p_alpha (a P-leaf's estimate moves at rate max(1/n, p_alpha): its labels change as the
+    Q-tree learns) and p_pairs (pairs of P-examples, one optimal response and one not,
+    inserted per learning step). The P-tree splits as the Q-tree does (significance,
+    min_examples, half_life, keep_examples).
+    """
+
+    name = "ptg"
+    engine_name = "ptg"
+    defaults = {**TGLearner.defaults, "p_margin": 0.0, "p_alpha": 0.02, "p_pairs": 1.0}
+
+    def _check_params(self) -> None:
+        super()._check_params()
+        p = self.params
+        if p["p_margin"] < 0:
+            raise ConfigError(f"p_margin must be >= 0, not {p['p_margin']}")
+        if not 0.0 <= p["p_alpha"] <= 1.0:
+            raise ConfigError(f"p_alpha must be in [0, 1], not {p['p_alpha']}")
+        if p["p_pairs"] < 1 or p["p_pairs"] != int(p["p_pairs"]):
+            raise ConfigError(f"p_pairs must be a whole number >= 1, not {p['p_pairs']}")
+
+    def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
+        """``ranked``: every response's P, Q and P-leaf, by P then Q; ``paths``: for each, the
+        P-tree's tests from the root to its leaf with the bindings that made them true;
+        ``path`` and ``leaf``: the best response's."""
+        _, choices = detail
+        ranked, paths = [], {}
+        for _, action, p, q, leaf, path in choices:
+            response = format_term(action)
+            ranked.append({"response": response, "p": p, "q": q, "leaf": leaf})
+            paths[response] = [{"test": str(text), "holds": outcome == "true",
+                                "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
+                               for (_, _, text, outcome, bindings) in path]
+        best = ranked[0]["response"] if ranked else None
+        return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
+                "path": paths.get(best, []) if best else [],
+                "leaf": ranked[0]["leaf"] if ranked else None}
