@@ -138,18 +138,18 @@ wm_insert(KB, New) :-
     ),
     Clock is Clock0 + 1,
     Oldest is Clock - Span,
-    duplicate_term(New, Fresh),
-    stamp(Fresh, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
-    keep_old(Old, Fresh, Oldest, KeptPairs, KeptElements),
+    stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
+    keep_old(Old, New, Oldest, KeptPairs, KeptElements),
     key(KB, Key),
-    nb_linkval(Key, wm(Clock, Span, Pairs, Elements, Now)).
+    nb_setval(Key, wm(Clock, Span, Pairs, Elements, Now)).
 
-%   The new memory is linked into the global variable, not copied as nb_setval/2 would
-%   (half an insertion's time). That is safe because nothing in it can be undone by
-%   backtracking: the new elements are a copy made here, the kept ones were stored by
-%   earlier insertions, and every list cell and pair is made by stamp/7 and keep_old/5
-%   below, which bind only variables younger than any choice point (if-then-else commits
-%   before it binds). nb_linkval/2 freezes the global stack, so the cells outlive the call.
+%   The new memory is copied into the global variable (nb_setval/2), never linked
+%   (nb_linkval/2): a linked term is only as safe as every binding that built it, and a
+%   signal handler that stores a term on the global stack in the middle of an insertion
+%   (an alarm re-arming itself did) freezes the stack, so that the list cells bound after
+%   it are trailed; the gateway's discarded frame, or any backtracking past the call, then
+%   undid them and left the stored memory with an unbound tail
+%   (tests/prolog/test_memory.plt, tests/relrl/test_memory_signals.py).
 
 %   The new elements stamped, in front of PairsTail, and alone (Now), in front of Tail.
 stamp([], _, PairsTail, PairsTail, [], Tail, Tail).

@@ -290,23 +290,9 @@ qtree_set_leaf(Tree, Id, Rep, Entries) :-
         T = qtree(_, Next, Nodes, _),
         integer(Id), Id >= 0, Id < Next,
         node(Nodes, Id, leaf(_, _))
-    ->  (   ground(Rep-Entries)
-        ->  link_node(T, Id, leaf(Rep, Entries))
-        ;   set_node(T, Id, leaf(Rep, Entries))
-        )
+    ->  set_node(T, Id, leaf(Rep, Entries))
     ;   existence_error(qtree_leaf, Tree-Id)
     ).
-
-%   A ground node linked into the tree, not copied (the control step replaces a leaf every
-%   time unit: copying its entries doubled what the replacement leaves to the garbage
-%   collector). Safe for a ground term: nothing in it can be undone by backtracking, and
-%   nb_linkarg/3 freezes the global stack, so it outlives the call. The tree never changes
-%   a node in place (a node is always replaced whole), so sharing parts of it with the
-%   caller's terms is harmless.
-link_node(T, Id, Node) :-
-    arg(3, T, Nodes),
-    I is Id + 1,
-    nb_linkarg(I, Nodes, Node).
 
 %!  qtree_grow(+Tree, +Parent, +Branch, +Rep, +Entries, -Id) is det.
 %
