@@ -8,9 +8,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(guard).
-:- use_module(engine, [engine_park/0, engine_forget/1]).
-:- use_module(state, [state_touch/0]).
-:- use_module(memory, [wm_clear/1]).
+:- use_module(engine, [engine_forget/1]).
 
 /** <module> Knowledge bases: their life cycle and loading
 
@@ -46,11 +44,11 @@ gw_new_kb(Module) :-
 
 %!  gw_drop_kb(+Module) is det.
 %
-%   Forget the clauses, working memory and engine state of a knowledge-base module.
+%   Forget the clauses of a knowledge-base module and everything relrl keeps for it
+%   (relrl_engine:engine_forget/1: its record, its learner's own clauses, its plans).
 
 gw_drop_kb(Module) :-
     must_be(atom, Module),
-    wm_clear(Module),
     engine_forget(Module),
     retractall(kb_module_(Module)),
     forall(( current_predicate(Module:Name/Arity),
@@ -69,8 +67,6 @@ gw_drop_kb(Module) :-
 
 gw_load(File, Module, Problems) :-
     must_be(atom, Module),
-    engine_park,                        % a directive may draw random numbers
-    state_touch,                        % or redefine a rule
     (   exists_file(File)
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),

@@ -18,6 +18,7 @@
 :- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(kbstate).
 
 /** <module> Working memory with age counters
 
@@ -38,38 +39,22 @@ argument of every predicate names it. This module is the only one that stores pe
 :- use_module(library(pairs)).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
-%   The memory of knowledge base KB is one term, wm(Clock, Span, Pairs, Elements, Now), in a
-%   global variable (nb_setval/2) named after KB: Clock counts insertions, Span is the expiry
+%   The memory of knowledge base KB is one term, wm(Clock, Span, Pairs, Elements, Now), the
+%   `memory` part of KB's record (kbstate.pl): Clock counts insertions, Span is the expiry
 %   age (or `default` until the domain's memory_span/1 is read), Pairs are Element-Stamp
 %   pairs, newest first; Elements are the same elements alone and Now those of the latest
 %   insertion (age 0), both in the same order: the perception predicates look elements up
 %   many times a step, and memberchk/2 over plain terms takes half the time of a look-up
-%   over pairs. A global term instead of asserted clauses keeps the robot's control step
-%   free of assert/retract churn.
+%   over pairs. A term in the record instead of asserted clauses keeps the robot's control
+%   step free of assert/retract churn. Readers take the term and then unify it with the
+%   wm/5 they want (State = wm(...)): a wm/5 pattern given to kb_get/3 would first be built
+%   on the global stack, every read.
 
-key(KB, Key) :-
-    (   key_(KB, Key0)
-    ->  Key = Key0
-    ;   atom_concat('$relrl_wm:', KB, Key),
-        nb_setval(Key, wm(0, default, [], [], [])),
-        assertz(key_(KB, Key))
-    ).
-
-:- dynamic key_/2.                  % KB, the name of its global variable (made once)
-
-%   The variable exists from the moment its name is made (key/2), so reading it is one
-%   nb_getval/2: the perception predicates read memory many times a step. Readers take the
-%   term and then unify it with the wm/5 they want (State = wm(...)): a wm/5 pattern given
-%   to nb_getval/2 or get/2 would first be built on the global stack, every read.
 get(KB, State) :-
-    (   key_(KB, Key)
-    ->  nb_getval(Key, State)
-    ;   State = wm(0, default, [], [], [])
-    ).
+    kb_get(KB, memory, State).
 
 put(KB, State) :-
-    key(KB, Key),
-    nb_setval(Key, State).
+    kb_set(KB, memory, State).
 
 %!  wm_span(+KB, -Span) is det.
 %
@@ -140,11 +125,10 @@ wm_insert(KB, New) :-
     Oldest is Clock - Span,
     stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
     keep_old(Old, New, Oldest, KeptPairs, KeptElements),
-    key(KB, Key),
-    nb_setval(Key, wm(Clock, Span, Pairs, Elements, Now)).
+    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
 
-%   The new memory is copied into the global variable (nb_setval/2), never linked
-%   (nb_linkval/2): a linked term is only as safe as every binding that built it, and a
+%   The new memory is copied into the record (kb_set/3), never linked (nb_linkval/2 or
+%   nb_linkarg/3): a linked term is only as safe as every binding that built it, and a
 %   signal handler that stores a term on the global stack in the middle of an insertion
 %   (an alarm re-arming itself did) freezes the stack, so that the list cells bound after
 %   it are trailed; the gateway's discarded frame, or any backtracking past the call, then
@@ -188,8 +172,7 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    key_(KB, Key),                      % none: no memory yet
-    nb_getval(Key, State),
+    get(KB, State),
     State = wm(_, _, _, Elements, _),
     element_in(Element, Elements).
 
@@ -198,8 +181,7 @@ wm_has(KB, Element) :-
 %   once(wm_has(KB, Element)).
 
 wm_has_chk(KB, Element) :-
-    key_(KB, Key),
-    nb_getval(Key, State),
+    get(KB, State),
     State = wm(_, _, _, Elements, _),
     memberchk(Element, Elements).
 

@@ -97,10 +97,9 @@ tg_init(KB, Params) :-
     tg_new_stats(Qinit, 0, K, 0, Keep, L),
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
-    atom_concat('$tg:', KB, DK),
     Half is max(0, round(Half0)),
-    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                       novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
+    tg_put_data(KB, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
+                         novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
     tg_put_tree(KB, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(KB),
     tg_compile_leaf(KB, Root),
@@ -648,7 +647,11 @@ tg_candidates(KB, LeafId, Texts) :-
 
 relrl_engine:learner(tg).
 
-relrl_engine:learner_property(tg, view(relational)).
+relrl_engine:learner_property(tg, Cap) :-
+    member(Cap, [view(relational), state, size, text, graph, policy, policy_info]).
+
+relrl_engine:learner_forget(tg, KB) :-
+    tg_forget(KB).
 
 relrl_engine:learner_init(tg, KB, Params) :-
     tg_init(KB, Params).
