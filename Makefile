@@ -16,8 +16,13 @@ BIN    := $(VENV)/bin
 #         test tools.
 DEMO_EXTRAS := plots
 TEST_EXTRAS := dev,speech,monitor,ray,mcap,foxglove
+# Stable-Baselines3 (`make sb3`), apart from the tests: torch's CPU build alone is 0.87 GB in
+# the environment (docs/rl-tools.md). It goes in first, pinned, so that Stable-Baselines3 does
+# not pull a CUDA build of several GB; elsewhere give the CPU build's index, e.g.
+#   make sb3 TORCH="torch --index-url https://download.pytorch.org/whl/cpu"
+TORCH ?= torch==2.13.0
 
-.PHONY: demo test setup setup-demo setup-test debs-demo debs-test lint clean
+.PHONY: demo test sb3 setup setup-demo setup-test debs-demo debs-test lint clean
 
 setup: setup-test
 setup-demo: debs-demo $(VENV)/.installed-demo
@@ -64,6 +69,13 @@ demo: setup-demo
 
 test: setup-test
 	$(BIN)/python -m pytest
+
+# Stable-Baselines3's PPO and DQN trained on relrl/SharedAttention-v1, each checked to learn.
+sb3: setup-test
+	$(BIN)/pip install -q $(TORCH)
+	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),$(TEST_EXTRAS),sb3]'
+	$(BIN)/python examples/sb3_shared_attention.py --algo ppo --steps 20000 --check --logdir runs/sb3
+	$(BIN)/python examples/sb3_shared_attention.py --algo dqn --steps 20000 --check --logdir runs/sb3
 
 lint: setup-test
 	$(BIN)/ruff check relrl perception head tests bench

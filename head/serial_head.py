@@ -53,7 +53,8 @@ class SerialLink:
             reason = getattr(exc, "strerror", None) or str(exc).splitlines()[0]
             raise PortUnavailable(
                 f"cannot open serial port {port!r}: {reason}; check the cable and the device "
-                "path (ls /dev/ttyUSB* /dev/ttyACM*), or use --port sim") from None
+                "path (ls /dev/ttyUSB* /dev/ttyACM*), or give sim for the simulated "
+                "head") from None
 
     def _lost(self, exc: BaseException) -> PortLost:
         reason = getattr(exc, "strerror", None) or str(exc) or type(exc).__name__

@@ -29,8 +29,8 @@ from typing import Any
 
 from relrl.errors import UserError
 
-__all__ = ["Run", "VIEWS", "load_run", "render", "render_report", "stale_blocks",
-           "update_file", "view"]
+__all__ = ["MULTI_VIEWS", "Run", "VIEWS", "load_run", "render", "render_many",
+           "render_report", "stale_blocks", "update_file", "view"]
 
 BLOCK = re.compile(r"<!-- relrl-report (?P<path>\S+) (?P<view>[\w-]+) -->\n"
                    r"(?P<body>.*?)<!-- /relrl-report -->", re.S)
@@ -140,6 +140,22 @@ def view(experiment: str, name: str) -> Callable[[View], View]:
     return register
 
 
+#: (experiment, view name) -> renderer of several runs side by side (a block naming
+#: ``path,path`` in a Markdown file).
+MULTI_VIEWS: dict[tuple[str, str], Callable[[list[Run]], str]] = {}
+
+
+def render_many(runs: list[Run], name: str, labels: list[str]) -> str:
+    """The Markdown of one view of several runs side by side, with their provenance lines."""
+    kinds = {r.experiment for r in runs}
+    fn = MULTI_VIEWS.get((runs[0].experiment, name)) if len(kinds) == 1 else None
+    if fn is None:
+        raise UserError(f"no view {name!r} of several {'/'.join(sorted(kinds))} runs side by "
+                        f"side (known: {', '.join(sorted(v for _, v in MULTI_VIEWS)) or 'none'})")
+    return _ended(fn(runs)) + "\n" + "\n".join(provenance(r, lb) for r, lb in zip(runs, labels,
+                                                                                    strict=True))
+
+
 def render(run: Run, name: str, label: str | None = None) -> str:
     """The Markdown of one view of a run, with its provenance line."""
     fn = VIEWS.get((run.experiment, name))
@@ -147,7 +163,13 @@ def render(run: Run, name: str, label: str | None = None) -> str:
         known = sorted(v for e, v in VIEWS if e == run.experiment)
         raise UserError(f"{run.path}: no view {name!r} of a {run.experiment!r} run "
                         f"(known: {', '.join(known) or 'none'})")
-    return fn(run) + "\n" + provenance(run, label or str(run.path))
+    return _ended(fn(run)) + "\n" + provenance(run, label or str(run.path))
+
+
+def _ended(body: str) -> str:
+    """A view's Markdown ending in a newline, so the provenance line after it is a paragraph
+    of its own (not a row of the table above it)."""
+    return body if body.endswith("\n") else body + "\n"
 
 
 def render_report(paths: list[str | Path], out: Path) -> str:
@@ -180,8 +202,12 @@ def _blocks(md: Path) -> list[tuple[re.Match[str], str]]:
     text = md.read_text(encoding="utf-8")
     out = []
     for m in BLOCK.finditer(text):
-        run = load_run(md.parent / m["path"])
-        out.append((m, render(run, m["view"], m["path"])))
+        paths = m["path"].split(",")
+        if len(paths) == 1:
+            out.append((m, render(load_run(md.parent / paths[0]), m["view"], paths[0])))
+        else:
+            runs = [load_run(md.parent / p) for p in paths]
+            out.append((m, render_many(runs, m["view"], paths)))
     return out
 
 
@@ -267,6 +293,9 @@ def _exp2_table1(run: Run) -> str:
     r = run.results
     paper = r.get("paper", {}).get("table1", {})
     keys = sorted(r["summary"])
+    if not all((r["summary"][k].get("table1") or {}).get("all_executions") for k in keys):
+        raise UserError(f"{run.path / 'results.json'}: no Table 1 in this run (symbolic "
+                        "perception, or no naming executions)")
     outcomes = list(paper) or sorted({o for k in keys
                                       for o in r["summary"][k]["table1"]["all_executions"]})
     header = ["measure (%)", "paper"] + keys
@@ -303,7 +332,7 @@ def _exp2_short(run: Run) -> str:
     for k in sorted(r["summary"]):
         s = r["summary"][k]
         fig6 = s["fig6"]
-        t1 = s["table1"]["all_executions"]
+        t1 = (s.get("table1") or {}).get("all_executions") or {}
         rows.append([k, _f(fig6[-1]["cgi_mean"]) if fig6 else "—",
                      f"{t1['success'][0]:.1f}" if "success" in t1 else "—"])
     if "success" in paper:
@@ -345,3 +374,113 @@ def _worlds_cost(run: Run) -> str:
     return table(["world", "task", "learner", "seed", "learning steps/s",
                   "µs per learning step by size", "cost ratio, largest / smallest",
                   "size ratio"], rows)
+
+
+_CLAIM_ROWS = {"after_first_run": "all three near 0.8 CGI after the first 500-unit run",
+               "later": "then contingency flat; ETG and Q-learning rise to a plateau",
+               "eye_contacts": "eye contacts: contingency most, Q-learning fewest"}
+
+
+def _claim_figures(values: dict[str, dict[str, float]]) -> str:
+    short = {"contingency": "C", "qlearning": "Q", "etg": "ETG"}
+    parts = []
+    for what, d in values.items():
+        label = {"cgi_after_first_run": "run 1", "cgi_final": "final",
+                 "eye_contacts_mean": "eye contacts"}.get(what, what)
+        fmt = "{:.1f}" if what == "eye_contacts_mean" else "{:.2f}"
+        parts.append(f"{label} " + ", ".join(f"{short.get(n, n)} {fmt.format(v)}"
+                                             for n, v in sorted(d.items())))
+    return "; ".join(parts)
+
+
+def _claims_of(run: Run) -> dict[str, Any]:
+    claims = run.results.get("claims")
+    if not claims:
+        raise UserError(f"{run.path / 'results.json'}: no \"claims\" (a run of an earlier "
+                        "relrl, or without the paper's three learners)")
+    return claims
+
+
+def _sis_claims_side_by_side(runs: list[Run]) -> str:
+    """The paper's three claims judged on each run (results.json's ``claims``), one column
+    per run (its setting: ``fixed task`` or the preset)."""
+    claims = [_claims_of(r) for r in runs]
+    header = ["the paper's claim"] + [f"`{r.results['config'].get('preset') or 'fixed task'}`"
+                                      for r in runs]
+    rows = []
+    for key in [k for k in _CLAIM_ROWS if k in claims[0]] + \
+            [k for k in claims[0] if k not in _CLAIM_ROWS]:
+        row = [_CLAIM_ROWS.get(key, key)]
+        for c in claims:
+            verdict = {True: "**held**", False: "not held", None: "not judged"}[c[key]["held"]]
+            row.append(f"{verdict}: {_claim_figures(c[key]['values'])}")
+        rows.append(row)
+    return table(header, rows)
+
+
+MULTI_VIEWS[("sis", "claims")] = _sis_claims_side_by_side
+
+
+@view("sis", "claims")
+def _sis_claims(run: Run) -> str:
+    """The paper's three claims judged on this run (results.json's ``claims``)."""
+    return _sis_claims_side_by_side([run])
+
+
+# ---- the scaling benchmark ----------------------------------------------------------------
+
+
+def _sizes(rows: dict[str, Any]) -> list[str]:
+    return sorted(rows, key=int)
+
+
+@view("scaling", "summary")
+def _scaling_summary(run: Run) -> str:
+    r = run.results
+    cfg, learn = r["config"], r["summary"]["learn"]
+    head = (f"{len(r['seeds'])} seed(s), sizes {', '.join(map(str, cfg['sizes']))} toy "
+            f"places; an evaluation every {cfg['block']:,} learning units ({cfg['eval_runs']} "
+            f"runs of {cfg['eval_steps']} units), budget {cfg['budget']:,}, threshold CGI "
+            f"{cfg['threshold']}.\n\n")
+    rows = []
+    for learner, by_size in learn.items():
+        for size in _sizes(by_size):
+            s = by_size[size]
+            rows.append([learner, int(size), f"{s['reached']}/{s['seeds']}",
+                         _f(s["steps_to_threshold"], 0), _f(s["cgi_final"]),
+                         _f(s["memory_positions"], 0), _f(s.get("candidates_per_leaf"), 1)])
+    return head + table(["learner", "places P", "reached 0.9", "learning units to 0.9 (mean)",
+                         "final CGI", "memory (positions)", "candidate tests per leaf"], rows)
+
+
+@view("scaling", "transfer")
+def _scaling_transfer(run: Run) -> str:
+    r = run.results
+    transfer = r["summary"].get("transfer", {})
+    if not transfer:
+        raise UserError(f"{run.path / 'results.json'}: no transfer jobs in this run")
+    kind = r["config"].get("transfer")
+    rows = []
+    for learner, by_size in transfer.items():
+        for size in _sizes(by_size):
+            s = by_size[size]
+            rows.append([learner, int(size), _f(s.get("cgi_trained")), _f(s.get("cgi_unseen")),
+                         f"{s['seeds']}"])
+    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, then acting with no "
+                     "learning in each world", "places": "places held out while learning",
+            "kinds": "toy kinds held out while learning"}.get(kind, kind)
+    return (f"Zero-shot transfer ({what}).\n\n"
+            + table(["learner", "places P", "CGI trained", "CGI unseen", "seeds"], rows))
+
+
+@view("scaling", "short")
+def _scaling_short(run: Run) -> str:
+    learn = run.results["summary"]["learn"]
+    rows = []
+    for learner, by_size in learn.items():
+        sizes = _sizes(by_size)
+        reached = [f"{by_size[p]['reached']}/{by_size[p]['seeds']}" for p in sizes]
+        memory = [_f(by_size[p]["memory_positions"], 0) for p in sizes]
+        rows.append([learner, ", ".join(sizes), " · ".join(reached), " · ".join(memory)])
+    return table(["learner", "places P", "seeds reaching CGI 0.9, per P", "memory (positions), "
+                  "per P"], rows)

@@ -82,3 +82,17 @@ def test_the_demo_installs_no_test_tools() -> None:
 def test_the_tests_install_every_extra_they_use() -> None:
     assert {"plots", "dev", "speech", "monitor", "ray", "mcap", "foxglove"} <= \
         _pip_extras("setup-test")
+
+
+def test_stable_baselines3_is_apart_and_gets_torchs_cpu_build_first() -> None:
+    """SB3 is not in the tests' set-up (torch's CPU build alone is 0.87 GB); ``make sb3``
+    installs torch pinned before the extra, so the extra cannot pull a CUDA build."""
+    assert "sb3" not in _pip_extras("setup-test")
+    assert "sb3" in _pip_extras("sb3")
+    proc = subprocess.run([_make(), "-n", "-B", "-C", str(ROOT), "sb3"], capture_output=True,
+                          text=True, check=True)
+    lines = proc.stdout.splitlines()
+    torch = next(i for i, line in enumerate(lines) if "pip install -q torch==" in line)
+    extra = next(i for i, line in enumerate(lines) if "sb3]'" in line)
+    assert torch < extra
+    assert sum("sb3_shared_attention.py" in line and "--check" in line for line in lines) == 2

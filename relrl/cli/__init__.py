@@ -67,13 +67,18 @@ def build_parser() -> argparse.ArgumentParser:
                            epilog=f"example:\n  {example}" if example else None,
                            formatter_class=argparse.RawDescriptionHelpFormatter)
         mod.add_arguments(p)
-        _add_verbosity(p, argparse.SUPPRESS)  # also after the subcommand
+        _add_verbosity(p, argparse.SUPPRESS)  # also after the subcommand (and its own ones)
         p.set_defaults(_run=mod.run)
     return parser
 
 
 def _add_verbosity(parser: argparse.ArgumentParser, default: object) -> None:
-    """``-v``/``-q`` (where a subcommand has not taken the letters for itself)."""
+    """``-v``/``-q`` (where a subcommand has not taken the letters for itself), also on the
+    subcommands of a subcommand (``relrl experiment sis -q``)."""
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for child in action.choices.values():
+                _add_verbosity(child, argparse.SUPPRESS)
     taken = parser._option_string_actions
     if "-v" not in taken and "--verbose" not in taken:
         parser.add_argument("-v", "--verbose", action="count", default=default,

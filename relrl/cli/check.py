@@ -75,14 +75,14 @@ def run(args: argparse.Namespace) -> int:
         problems.extend(validate(kb))
         if args.world:
             problems.extend(world_warnings(kb, args.world))
+        checked = [] if problems else [_check_policy(kb, p, problems) for p in args.policy]
+        if problems:  # the problems alone: a listing of a broken domain would bury them
+            _print_problems(problems)
+            return 2
         if not args.quiet:
             print(describe(kb))
         for warning in bias_warnings(kb):     # a valid domain, a bias that will not scale
             print(warning, file=sys.stderr)
-        checked = [] if problems else [_check_policy(kb, p, problems) for p in args.policy]
-        if problems:
-            _print_problems(problems)
-            return 2
         if not args.quiet:
             print(f"ok: {', '.join(args.domain)} is valid")
             for line in checked:

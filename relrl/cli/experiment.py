@@ -8,12 +8,14 @@ import math
 import os
 from pathlib import Path
 
+from relrl.cli.recorded import add_config_option, apply_record, finish_record
 from relrl.outdir import add_out_options
 
 HELP = ("run the experiments (sis: the paper's Experiment 1, with relrl's relational learner tg "
         "beside the paper's three; scaling: every learner in worlds that grow, with zero-shot "
         "transfer; worlds: tasks of worlds written in Prolog, blocks world first)")
 EXAMPLE = ("relrl experiment sis --quick --out runs/exp1-quick\n"
+           "  relrl experiment sis --config runs/exp1-quick/results.json --out runs/exp1-again\n"
            "  relrl experiment scaling --quick --out runs/scaling-quick\n"
            "  relrl experiment worlds --quick --out runs/worlds-quick")
 
@@ -93,6 +95,7 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
                    help="seconds one control step may run before the run stops, naming the "
                         "rule (default 60)")
     p.add_argument("--quick", action="store_true", help="a short run")
+    add_config_option(p)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -103,7 +106,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                 parser_class=type(parser))
     sis = sub.add_parser("sis", help="the paper's Experiment 1 (the learners in the SIS)",
                          description="The paper's Experiment 1: learning curves (CGI), eye "
-                                     "contacts and memory of each learner in the simulator.")
+                                     "contacts and memory of each learner in the simulator.",
+                         epilog="examples:\n"
+                                "  relrl experiment sis --out runs/exp1\n"
+                                "  relrl experiment sis --preset paper-2012 --learners "
+                                "contingency,qlearning,etg --seeds 0,1,2,3,4 --out "
+                                "runs/paper-2012\n"
+                                "  relrl experiment sis --config runs/exp1/results.json --out "
+                                "runs/exp1-again",
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
     _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
     from relrl.experiments.sis import PRESETS
 
@@ -124,7 +135,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     sc = sub.add_parser("scaling", help="every learner in worlds that grow; transfer",
                         description="Time to CGI >= 0.9, final CGI, memory and steps/s of "
                                     "every learner as the world grows (P toy places), and "
-                                    "zero-shot transfer to places never trained on.")
+                                    "zero-shot transfer to places never trained on.",
+                        epilog="examples:\n"
+                               "  relrl experiment scaling --quick --out runs/scaling-quick\n"
+                               "  relrl experiment scaling --learners tg --sizes "
+                               "5,9,17,33,65,129 --out runs/scaling-tg\n"
+                               "  relrl experiment scaling --learners tg --sizes 5 --transfer "
+                               "sizes --transfer-sizes 9,33,129 --out runs/transfer",
+                        formatter_class=argparse.RawDescriptionHelpFormatter)
     _common(sc, default_learners=",".join(LEARNERS), default_seeds="0,1,2")
     sc.add_argument("--sizes", default="5,9,17,33", help="world sizes P (default 5,9,17,33)")
     sc.add_argument("--world", default="", metavar="NAME=VALUE,...",
@@ -159,7 +177,12 @@ def _add_worlds(sub) -> None:
                        description="Learning curves, evaluation on other sizes with no "
                                    "further learning, memory and step cost of the learners "
                                    "of worlds (tg, qtable) on tasks of worlds written in "
-                                   "Prolog; the worlds' stated optimum checked by search.")
+                                   "Prolog; the worlds' stated optimum checked by search.",
+                       epilog="examples:\n"
+                              "  relrl experiment worlds --quick --out runs/worlds-quick\n"
+                              "  relrl experiment worlds --tasks stack,unstack,on --seeds "
+                              "0,1,2 --out runs/worlds",
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
     w.add_argument("--worlds", default=None, metavar="FILE,FILE",
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
     w.add_argument("--tasks", default="stack,unstack,on",
@@ -245,6 +268,7 @@ def build_config(args: argparse.Namespace):
     from relrl.learners import LEARNERS
     from relrl.sim.caregiver import make_caregiver
 
+    record = apply_record(args, "sis")
     config = SISConfig.from_preset(args.preset, seeds=_ints(args.seeds or "0", "--seeds"))
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
@@ -264,7 +288,7 @@ def build_config(args: argparse.Namespace):
         if not Path(args.domain).is_file():
             raise ConfigError(f"--domain {args.domain}: no such file")
         config.domain = str(Path(args.domain).resolve())
-    return config
+    return finish_record(config, record)
 
 
 def build_scaling_config(args: argparse.Namespace):
@@ -274,6 +298,7 @@ def build_scaling_config(args: argparse.Namespace):
     from relrl.learners import LEARNERS
     from relrl.sim.world import World
 
+    record = apply_record(args, "scaling")
     quick = QUICK_SCALING if args.quick else {}
     config = ScalingConfig(seeds=_ints(args.seeds or quick.get("seeds", "0,1,2"), "--seeds"))
     config.sizes = _ints(args.sizes, "--sizes")
@@ -324,7 +349,7 @@ def build_scaling_config(args: argparse.Namespace):
     config.transfer_from = args.transfer_from
     if config.transfer == "kinds" and world.kinds < 2:
         raise ConfigError("--transfer kinds needs at least 2 toy kinds: add --world kinds=4")
-    return config
+    return finish_record(config, record)
 
 
 def run(args: argparse.Namespace) -> int:

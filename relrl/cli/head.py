@@ -26,16 +26,26 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--timeout", type=float, default=0.5,
                         help="seconds to wait for each controller answer (default: 0.5)")
     actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
-    look = actions.add_parser("look", help="turn to a direction and wait for the move to end")
+
+    def action(name: str, help: str, example: str) -> argparse.ArgumentParser:
+        return actions.add_parser(name, help=help, description=help,
+                                  epilog=f"example:\n  {example}",
+                                  formatter_class=argparse.RawDescriptionHelpFormatter)
+
+    look = action("look", "turn to a direction and wait for the move to end",
+                  "relrl head --port /dev/ttyUSB0 look left_down")
     look.add_argument("direction", help="left, left_down, down, right_down, right or centre")
     look.add_argument("--stay", action="store_true",
                       help="leave the head there (default: return to centre on exit)")
-    emit = actions.add_parser("emit", help="play the motor script of a response")
+    emit = action("emit", "play the motor script of a response",
+                  "relrl head emit 'look(right)'        # on the simulated head")
     emit.add_argument("response", help="a response term, e.g. 'look(left)' or name_object")
-    status = actions.add_parser("status", help="print servo positions, motion and errors")
+    status = action("status", "print servo positions, motion and errors",
+                    "relrl head --port /dev/ttyUSB0 status --json")
     status.add_argument("--json", action="store_true", help="print one JSON object")
-    cal = actions.add_parser("calibrate", help="jog each servo from stdin keys and write the "
-                             "calibration file (keys: + - [ ] m c x n p w q ?)")
+    cal = action("calibrate", "jog each servo from stdin keys and write the calibration file "
+                 "(keys: + - [ ] m c x n p w q ?)",
+                 "relrl head --port /dev/ttyUSB0 --protocol ssc32 calibrate -o myhead.toml")
     cal.add_argument("--output", "-o", default=None, metavar="FILE",
                      help="file to write (default: the --calibration file, or ./head.toml "
                           "when using the shipped example)")

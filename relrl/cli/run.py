@@ -75,8 +75,7 @@ def run(args: argparse.Namespace) -> int:
             summary = _claim_and_run(args, episode, opts, stop, session)
         print(_report(summary))
         if args.out:
-            policy = f", {summary['policy']}" if "policy" in summary else ""
-            print(f"wrote {args.out}/trace.jsonl, summary.json{policy}")
+            print(_wrote(args.out, summary.get("written", [])))
         if "policy_error" in summary:  # the run's product is missing: not a success
             raise OutputError(f"the policy was not saved: {summary['policy_error']} (the "
                               f"summary and the trace are in {args.out})")
@@ -103,7 +102,16 @@ def _claim_and_run(args, episode, opts, stop, session) -> dict:
         summary = _run(episode, opts, stop)
         if not summary["partial"] and "policy_error" not in summary:
             out.status = "complete"
-    return summary
+        written = out.written
+    return {**summary, "written": written}
+
+
+def _wrote(folder: str, files: list[str]) -> str:
+    """``wrote 5 files to runs/x: summary.json, trace.jsonl, ...`` (the most telling first)."""
+    first = ("summary.json", "trace.jsonl", "session.mcap")
+    ordered = [f for f in first if f in files] + [f for f in files if f not in first]
+    return f"wrote {len(files)} file{'s' * (len(files) != 1)} to {folder}: " + \
+        ", ".join(ordered)
 
 
 def _run(episode, opts, stop) -> dict:

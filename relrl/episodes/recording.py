@@ -20,6 +20,10 @@ A recorded session (``--out DIR --record``) is one MCAP file beside the run's ou
     domain.pl        the domain
     trace.jsonl      one StepView per time unit (``--out``; the frame index when one was
                      recorded)
+    events.out.tfevents.relrl
+                     the time units' scalars for TensorBoard (``--out``: reward, the
+                     necessity units' outputs, running CGI, eye contacts, working memory;
+                     each evaluation's CGI, each naming execution's outcomes)
     summary.json, timing.json, policy, plots, run.log
 
 ``relrl replay DIR`` (or ``relrl replay DIR/session.mcap``) serves the monitor's page over
@@ -36,8 +40,10 @@ from pathlib import Path
 from typing import Any
 
 from relrl.episodes.provenance import provenance
+from relrl.monitor.tap import TreeWatch, leaf_of
 from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
 from relrl.outdir import open_stream, write_atomic, write_json_atomic
+from relrl.tensorboard import EVENT_FILE, ScalarLog
 
 __all__ = ["RECORDED", "RECORDING", "SessionTap", "write_manifest"]
 
@@ -46,7 +52,8 @@ RECORDED = ("session.json", "episode.toml", "domain.pl", "session.mcap")
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")
-#: seconds between checks of whether the learner's tree changed.
+#: seconds between checks of whether the learner's tree changed (and at once when a step's
+#: leaf is not in the tree last sent: the tree has split).
 TREE_PERIOD = 1.0
 #: the recording's file in the session folder.
 RECORDING = "session.mcap"
@@ -65,6 +72,15 @@ class _Rate:
     def took(self) -> None:
         if self.rate > 0:
             self._next = time.perf_counter() + 1.0 / self.rate
+
+
+def _scalars(row: dict[str, Any]) -> dict[str, Any]:
+    """A trace row's numbers for TensorBoard (what is not a number is left out there)."""
+    metrics = row.get("metrics") or {}
+    return {"reward": row.get("reward"), "memory/working_memory": row.get("memory_size"),
+            **{f"necessity/{k}": v for k, v in (row.get("activation") or {}).items()},
+            **{f"gaze/{k}": metrics.get(k) for k in ("cgi", "shifts", "eye_contacts",
+                                                     "opportunities")}}
 
 
 def _copy_script(episode: Any, folder: Path) -> dict[str, str]:
@@ -114,6 +130,7 @@ class SessionTap:
                  live_rate: float = 10.0) -> None:
         self.run, self.out, self.env, self.head, self.hub = run, out, env, head, hub
         self.trace = None
+        self.scalars: ScalarLog | None = None
         self.recording = record and out is not None
         self.recorder, self._own = recorder, False
         self.quality = int(record_quality)
@@ -123,6 +140,7 @@ class SessionTap:
         self.files: dict[str, str] = {}
         try:
             self.trace = open_stream(out / "trace.jsonl") if out is not None else None
+            self.scalars = ScalarLog(out / EVENT_FILE) if out is not None else None
             if self.recording:
                 if self.recorder is None:
                     from relrl.recording.recorder import Recorder
@@ -140,9 +158,7 @@ class SessionTap:
         except BaseException:
             self.close()
             raise
-        self._tree_key: Any = None
-        self._tree_graph: dict[str, Any] | None = None
-        self._tree_next = 0.0
+        self.tree = TreeWatch(run.learner, TREE_PERIOD)
         self._seen: tuple[Any, Any, Any] = (None, None, None)
         self._asked = False
         from relrl.terms import format_term
@@ -213,6 +229,7 @@ class SessionTap:
         if self.trace is not None:
             self.trace.write(line + "\n")
             self.trace.flush()
+            self.scalars.add(run.t, _scalars(row))
         if publish:
             hub.publish(dict(row), frame)
         if sent:  # the writer process encodes the channels from the line
@@ -222,42 +239,44 @@ class SessionTap:
             self.recorder.unit(time.time_ns(), line.encode(),
                                encode_jpeg(framed, self.quality) if framed is not None
                                else None)
-        self._tree(run.t)
+        self._tree(run.t, leaf_of(view.explanation, view.response))
         return row
 
-    def _tree(self, t: int, force: bool = False) -> None:
-        if self.hub is None and self.recorder is None:
+    def _tree(self, t: int, leaf: str | None = None, force: bool = False) -> None:
+        """The learner's tree to the monitor and the recording when it changed."""
+        if (self.hub is None and self.recorder is None) or \
+                not self.tree.changed(leaf, force=force):
             return
-        now = time.perf_counter()
-        if not force and now < self._tree_next:
-            return
-        self._tree_next = now + TREE_PERIOD
-        from relrl.monitor.graph import shown_graph
-
-        graph = shown_graph(self.run.learner, self._tree_graph)
-        self._tree_graph = graph
-        key = json.dumps(graph, sort_keys=True)
-        if key == self._tree_key:
-            return
-        self._tree_key = key
         if self.hub is not None:
-            self.hub.set_tree(graph)
+            self.hub.set_tree(self.tree.graph)
         if self.recorder is not None:
-            self.recorder.tree(t, graph)
+            self.recorder.tree(t, self.tree.graph)
 
     def event(self, kind: str, **data: Any) -> None:
-        """A session event (evaluation, naming execution) for the monitor and the recording."""
+        """A session event (evaluation, naming execution) for the monitor, the recording and
+        TensorBoard (an evaluation at its time unit, a naming execution at its number)."""
+        if self.scalars is not None:
+            if kind == "evaluation":
+                self.scalars.add(self.run.t, {"evaluation/cgi_mean": data.get("cgi_mean"),
+                                              "evaluation/cgi_std": data.get("cgi_std")})
+            elif kind == "naming":
+                self.scalars.add(data.get("execution", 0), {
+                    f"naming/{k}": v for k, v in (data.get("counts") or {}).items()})
         if self.hub is not None:
             self.hub.event(kind, t=self.run.t, **data)
         if self.recorder is not None:
             self.recorder.event(kind, self.run.t, **data)
 
     def finish(self) -> dict[str, Any]:
-        """The session ended: the last tree, the last frame (when every unit is recorded).
+        """The session ended: the last tree, the last frame (when every unit is recorded);
+        TensorBoard's event file written out and closed (here, while the session's own
+        errors and signals are still handled, not in the clean-up after them).
 
         Returns:
             what was recorded (frames, bytes), for ``session.json``.
         """
+        if self.scalars is not None:
+            self.scalars.close()
         self._tree(self.run.t, force=True)
         frame, percept, looked = self._seen
         if self.recording and self._frame_rate.rate <= 0 and frame is not None:
@@ -278,7 +297,7 @@ class SessionTap:
     def close(self, manifest: dict[str, Any] | None = None,
               summary: dict[str, Any] | None = None) -> None:
         """Close the recording -- with what was run and its summary in it, when given --
-        and the trace (safe twice)."""
+        the trace and TensorBoard's event file (safe twice)."""
         try:
             if self.recording and self.recorder is not None:
                 self.recorder.close_file({name: value for name, value in (
@@ -288,3 +307,5 @@ class SessionTap:
                 self.recorder.close()
             if self.trace is not None and not self.trace.closed:
                 self.trace.close()
+            if self.scalars is not None:
+                self.scalars.close()

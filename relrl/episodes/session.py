@@ -36,14 +36,15 @@ from relrl.episodes.recording import RECORDED, SessionTap, write_manifest
 from relrl.episodes.script import Episode
 from relrl.outdir import check_inside, deferred_signals, write_json_atomic
 from relrl.progress import progress
+from relrl.tensorboard import EVENT_FILE
 from relrl.terms import format_term
 
 __all__ = ["RUN_FILES", "STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial",
            "policy_save_problem", "run_episode", "run_outputs"]
 
 #: the files and folders (``name/``) a session writes into its output folder.
-RUN_FILES = ("trace.jsonl", "summary.json", "timing.json", "run.log", "rewards.png",
-             "cgi.png", "table1.png") + RECORDED
+RUN_FILES = ("trace.jsonl", EVENT_FILE, "summary.json", "timing.json", "run.log",
+             "rewards.png", "cgi.png", "table1.png") + RECORDED
 #: the longest file name most file systems take, in bytes (the folder is asked at the run).
 NAME_MAX = 255
 
@@ -224,6 +225,12 @@ def _live_line(t: int, phase: str, record: Any, outcome: str | None, said: str |
     return text
 
 
+def _status(opts: RunOptions, activity: str, detail: str = "", **data: Any) -> None:
+    """Tell the live monitor what the session is doing now (nothing without a monitor)."""
+    if opts.monitor is not None:
+        opts.monitor.status(activity, detail, **data)
+
+
 def _on_step(run: _Run, record: Any, phase: str) -> None:
     """Naming, metrics, the trace and the monitor (:class:`SessionTap`), live output."""
     info = record.info
@@ -284,12 +291,18 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     if episode.policy_save and (problem := policy_save_problem(episode.policy_save)):
         raise ConfigError(f"{episode.path}: {problem}")
     t0 = time.perf_counter()
+    _status(opts, "starting", f"loading the domain {Path(episode.domain).name} and building "
+                              "the world")
     run = _Run(episode, opts)
     where = provenance(opts)
+    unit_name = f"{episode.time_unit}s"
     env = actuator = None
     bar = None
     failed = False
     try:
+        if opts.camera is not None:
+            _status(opts, "waiting for the camera", f"opening camera {opts.camera}: the "
+                    "session starts with its first frame")
         env, actuator = _world(episode, opts)
         run.tap = SessionTap(run, out, env, getattr(actuator, "head", None), hub=opts.monitor,
                              record=opts.record, record_rate=opts.record_rate,
@@ -308,13 +321,22 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                        enabled=not opts.live)
 
         def evaluate() -> None:
-            point = fruits.evaluate_cgi(run.agent, episode, eval_seeds, stop)
+            first = run.units == 0
+            activity = "initial evaluation" if first else "evaluating"
+            detail = (("the robot before any learning" if first else
+                       f"after {run.units} {unit_name} of learning (paused meanwhile)")
+                      + f": {len(eval_seeds)} runs of {ev['steps']} {unit_name} without "
+                        f"learning, on the {where['evaluation']}")
+            point = fruits.evaluate_cgi(
+                run.agent, episode, eval_seeds, stop,
+                on_run=lambda k: _status(opts, activity, detail, done=k,
+                                         total=len(eval_seeds)))
             point["units"], point["control_steps_learning"] = run.units, run.t
             point["on"] = where["evaluation"]
             _flag_cut_short(point, "cgi_runs", len(eval_seeds))
             run.curve.append(point)
             run.tap.event("evaluation", cgi_mean=point["cgi_mean"], cgi_std=point["cgi_std"],
-                          on=where["evaluation"])
+                          on=where["evaluation"], units=run.units)
             line = (f"evaluation{where['evaluation_label']} after {run.units} "
                     f"{episode.time_unit}s: CGI "
                     f"{point['cgi_mean']:.3f} +- {point['cgi_std']:.3f}")
@@ -325,13 +347,21 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
 
         cycles = episode.time_unit == "interaction"
         bound = fruits.unit_bound(episode) if cycles else 1
+        shown = None  # the phase the monitor's status line names
         for unit in range(1, episode.steps + 1):
             if stop():
                 break
             if ev and (unit - 1) % ev["every"] == 0:
                 evaluate()
+                shown = None
             phase = episode.phase_at(unit)
             phase_name = phase.name
+            if phase is not shown:
+                shown = phase
+                _status(opts, "learning" if phase.learning else "acting",
+                        f"phase {phase.name!r} ({phase.steps} {unit_name}"
+                        + ("" if phase.learning else ", without learning") + ")",
+                        phase=phase.name, steps=episode.steps)
             for _ in range(bound):   # one time unit: a control step, or a whole cycle
                 if stop():
                     break
@@ -354,6 +384,10 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             for k in range(episode.naming["executions"]):
                 if stop():
                     break
+                _status(opts, "naming", "declarative pointing: the robot points at a fruit "
+                        "and names it, and keeps learning; execution "
+                        f"{k + 1} of {episode.naming['executions']}, on the "
+                        f"{where['naming']}", done=k, total=episode.naming["executions"])
                 res = fruits.naming_execution(run.agent, episode, episode.seed * 1000 + k,
                                               stop=stop)
                 res["on"] = where["naming"]
@@ -369,6 +403,11 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                 log.info(line)
                 bar.update(1)
             bar.close()
+        _status(opts, "stopped" if stop() else "finished",
+                (f"stopped by {_signal_name(stop)}" if stop() else "the session ended")
+                + f" after {run.units} of {episode.steps} {unit_name}"
+                + (f"; writing the summary and the policy to {out}" if out is not None
+                   else ""))
         recorded = run.tap.finish()
         summary = _summary(run, stopped=stop(), why=_signal_name(stop))
         summary["where"] = {k: v for k, v in where.items() if not k.endswith("_label")}
@@ -386,6 +425,8 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         return summary
     except BaseException as exc:  # a lost device, a fault, a full disk, a second Ctrl-C
         failed = True
+        _status(opts, "stopped", f"stopped by {type(exc).__name__}"
+                + (f": {str(exc).splitlines()[0]}" if str(exc) else ""))
         if out is not None and not run.saved:
             keep_partial(run, out, t0, exc)
         elif out is not None:  # stopped while drawing the plots: the rest is written

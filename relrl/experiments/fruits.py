@@ -124,7 +124,8 @@ def unit_bound(episode: Any) -> int:
 
 
 def evaluate_cgi(agent: Any, episode: Any, seeds: list[int],
-                 stop: Callable[[], bool] = lambda: False) -> dict[str, Any]:
+                 stop: Callable[[], bool] = lambda: False,
+                 on_run: Callable[[int], None] | None = None) -> dict[str, Any]:
     """Evaluate gaze following: one run of ``evaluation.steps`` time units per seed, without
     learning, fruits placed by the pre-established cycle and only the robot's first turn of
     each presentation checked; the CGI (Eq. 5) of each run.
@@ -137,7 +138,8 @@ def evaluate_cgi(agent: Any, episode: Any, seeds: list[int],
     face to follow her gaze has no CGI; it counts as 0 and is counted in ``no_shift_runs``.
 
     A stop request ends the evaluation at once; only the runs that finished are counted
-    (fewer ``cgi_runs`` than seeds tell the caller the point was cut short).
+    (fewer ``cgi_runs`` than seeds tell the caller the point was cut short). ``on_run(k)``
+    is called before run ``k`` (from 0) starts: the session's monitor says which run is on.
     """
     from relrl.episodes.world import EpisodeWorld
     from relrl.loop import Interaction
@@ -151,9 +153,11 @@ def evaluate_cgi(agent: Any, episode: Any, seeds: list[int],
     values, contacts, shifts, no_shift, steps = [], [], [], 0, 0
     states, done = set(agent.states), agent.steps
     with agent.preserved():
-        for seed in seeds:
+        for k, seed in enumerate(seeds):
             if stop():
                 break
+            if on_run is not None:
+                on_run(k)
             agent.reseed(int(seed))
             metrics = GazeMetrics(hold=episode.caregiver.get("contact_hold", 3))
             run = Interaction(env, agent, on_step=lambda r, m=metrics: m.add(r.info["record"]))

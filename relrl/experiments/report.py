@@ -14,13 +14,14 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["OUTPUTS", "aggregate", "pyplot_or_note", "save_figure", "skip_plots",
-           "summary_table", "write_csv", "write_json_atomic", "write_outputs"]
+__all__ = ["OUTPUTS", "aggregate", "cgi_figure", "plot", "pyplot_or_note", "save_figure",
+           "skip_plots", "summary_table", "tensorboard_runs", "write_csv", "write_json_atomic",
+           "write_outputs"]
 
 #: the files Experiment 1 writes into its folder (checked for links before it runs).
 OUTPUTS = ("results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
            "memory.csv", "cgi_places.csv", "fig5_cgi.png", "fig4_eye_contacts.png",
-           "cgi_places.png", "PLOTS.txt")
+           "cgi_places.png", "PLOTS.txt", "tensorboard/")
 
 
 def write_json_atomic(path: Path, data: Any) -> None:
@@ -190,8 +191,38 @@ def write_outputs(out_dir: Path, results: dict[str, Any], timing: dict[str, Any]
                                          for g in ("trained", "held_out")])
         written.append(write_csv(out_dir / "cgi_places.csv",
                                  ["learner", "point", "cgi_trained", "cgi_held_out"], rows))
+    written += tensorboard_runs(out_dir, results)
     written += plot(out_dir, summary) if not results.get("partial") else skip_plots(out_dir)
     return written
+
+
+def _curve_scalars(c: dict[str, Any]) -> dict[str, Any]:
+    """An evaluation point's scalars for TensorBoard."""
+    memory = c.get("memory") or {}
+    return {"cgi/mean": c["cgi_mean"], "cgi/std": c.get("cgi_std"),
+            "cgi_literal/mean": c["cgi_literal_mean"],
+            **{f"memory/{k}": v for k, v in memory.items()}}
+
+
+def tensorboard_runs(out_dir: Path, results: dict[str, Any]) -> list[Path]:
+    """The curves as TensorBoard runs (``tensorboard --logdir OUT/tensorboard``): one per
+    learner, pooled over seeds (CGI at each evaluation point by learning time units, the
+    cumulative eye contacts by opportunity), and one per job, ``LEARNER-seedS`` (its CGI
+    and memory at each point)."""
+    from relrl.tensorboard import write_event_file
+
+    base = out_dir / "tensorboard"
+    files = []
+    for name, s in results["summary"].items():
+        points = [(c["learning_steps"], _curve_scalars(c)) for c in s["curve"]]
+        points += [(i, {"eye_contacts/cumulative": v}) for i, v in
+                   enumerate(s["eye_contacts"]["cumulative_mean"], start=1)]
+        files.append(write_event_file(base / name, points))
+    for job in results["jobs"]:
+        files.append(write_event_file(base / f"{job['learner']}-seed{job['seed']}",
+                                      [(c["learning_steps"], _curve_scalars(c))
+                                       for c in job["curve"]]))
+    return files
 
 
 def skip_plots(out_dir: Path) -> list[Path]:
@@ -223,6 +254,48 @@ def pyplot_or_note(out_dir: Path) -> tuple[Any, list[Path]]:
     return plt, []
 
 
+def _run_label(summary: dict[str, Any]) -> str:
+    """The x label of the curves: runs, with the learning time units between two."""
+    for s in summary.values():
+        curve = s["curve"]
+        if len(curve) > 1:
+            block = curve[1]["learning_steps"] - curve[0]["learning_steps"]
+            return f"run (evaluation point; {block:,} learning time units each)"
+    return "run (evaluation point)"
+
+
+def _below(ax: Any, columns: int = 2, handles: list[Any] | None = None) -> None:
+    """The legend under the axes, where it covers no curve (``handles`` in that order,
+    filled column by column); whole-number runs on x."""
+    from matplotlib.ticker import MaxNLocator
+
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.legend(**({"handles": handles} if handles else {}), loc="upper center",
+              bbox_to_anchor=(0.5, -0.16), ncol=columns, fontsize=8, frameon=False)
+
+
+def cgi_figure(plt: Any, summary: dict[str, Any]) -> tuple[Any, Any]:
+    """Fig. 5: each learner's CGI (mean ± s.d.) at each evaluation point, and Eq. 5 taken
+    literally (dashed); the legend below the axes, runs as whole numbers."""
+    fig, ax = plt.subplots(figsize=(7, 4.8))
+    handles = []  # a learner's curve, then its literal one: one column each
+    for name, s in summary.items():
+        steps = [c["point"] for c in s["curve"]]
+        bars = ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
+                           yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3,
+                           capsize=3, label=name)
+        handles += [bars, *ax.plot(steps, [c["cgi_literal_mean"] for c in s["curve"]],
+                                   ls="--", lw=1, color=bars[0].get_color(),
+                                   label=f"{name} (Eq. 5 literally)")]
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel(_run_label(summary))
+    ax.set_ylabel("CGI (mean ± s.d.)")
+    ax.set_title("Fig. 5 — learning evolution (Social Interactive Simulator)")
+    ax.grid(alpha=0.3)
+    _below(ax, columns=max(1, min(4, len(summary))), handles=handles)
+    return fig, ax
+
+
 def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     """Fig. 4 and Fig. 5 as PNG files (and, with held-out places, the CGI on trained and
     held-out places); nothing (and a note) without matplotlib."""
@@ -230,40 +303,24 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
     if plt is None:
         return note
 
-    def finish(fig, ax, name: str, xlabel: str, ylabel: str, title: str) -> Path:
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        ax.set_title(title)
-        ax.legend()
-        ax.grid(alpha=0.3)
-        fig.tight_layout()
-        return save_figure(fig, out_dir / name, dpi=120)
+    def save(fig: Any, name: str) -> Path:
+        return save_figure(fig, out_dir / name, dpi=120, bbox_inches="tight")
 
-    files = []
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    for name, s in summary.items():
-        steps = [c["point"] for c in s["curve"]]
-        bars = ax.errorbar(steps, [c["cgi_mean"] for c in s["curve"]],
-                           yerr=[c["cgi_std"] for c in s["curve"]], marker="o", ms=3,
-                           capsize=3, label=name)
-        ax.plot(steps, [c["cgi_literal_mean"] for c in s["curve"]], ls="--", lw=1,
-                color=bars[0].get_color(), label=f"{name} (Eq. 5 literally)")
-    ax.set_ylim(-0.05, 1.05)
-    files.append(finish(fig, ax, "fig5_cgi.png",
-                        "run (evaluation point; 500 learning time units each)",
-                        "CGI (mean ± s.d.)",
-                        "Fig. 5 — learning evolution (Social Interactive Simulator)"))
-    fig, ax = plt.subplots(figsize=(7, 4.2))
+    files = [save(cgi_figure(plt, summary)[0], "fig5_cgi.png")]
+    fig, ax = plt.subplots(figsize=(7, 4.8))
     for name, s in summary.items():
         cum = s["eye_contacts"]["cumulative_mean"]
         ax.plot(range(1, len(cum) + 1), cum,
                 label=f"{name} ({s['eye_contacts']['mean']:.0f} ± "
                       f"{s['eye_contacts']['std']:.0f})")
-    files.append(finish(fig, ax, "fig4_eye_contacts.png", "eye-contact opportunity",
-                        "eye contacts established (cumulative)",
-                        "Fig. 4 — capacity of attention (first opportunities)"))
+    ax.set_xlabel("eye-contact opportunity")
+    ax.set_ylabel("eye contacts established (cumulative)")
+    ax.set_title("Fig. 4 — capacity of attention (first opportunities)")
+    ax.grid(alpha=0.3)
+    _below(ax, columns=min(4, max(1, len(summary))))
+    files.append(save(fig, "fig4_eye_contacts.png"))
     if any("cgi_places" in s for s in summary.values()):
-        fig, ax = plt.subplots(figsize=(7, 4.2))
+        fig, ax = plt.subplots(figsize=(7, 4.8))
         for i, (name, s) in enumerate(summary.items()):
             groups = s.get("cgi_places", {})
             for group, style in (("trained", "-"), ("held_out", "--")):
@@ -272,8 +329,10 @@ def plot(out_dir: Path, summary: dict[str, Any]) -> list[Path]:
                 ax.plot(points, [values[p] for p in points], style, marker="o", ms=3,
                         color=f"C{i}", label=f"{name}, {group.replace('_', '-')} places")
         ax.set_ylim(-0.05, 1.05)
-        files.append(finish(fig, ax, "cgi_places.png",
-                            "run (evaluation point; 500 learning time units each)",
-                            "CGI (pooled shifts)",
-                            "Gaze following on trained and held-out places"))
+        ax.set_xlabel(_run_label(summary))
+        ax.set_ylabel("CGI (pooled shifts)")
+        ax.set_title("Gaze following on trained and held-out places")
+        ax.grid(alpha=0.3)
+        _below(ax, columns=min(4, 2 * max(1, len(summary))))
+        files.append(save(fig, "cgi_places.png"))
     return files

@@ -30,7 +30,7 @@ __all__ = ["OUTPUTS", "run_scaling", "scaling_table"]
 #: the files and folders the scaling benchmark writes (checked for links before it runs).
 OUTPUTS = ("results.json", "timing.json", "scaling.csv", "transfer.csv", "curves.csv",
            "speed.csv", "memory_vs_size.png", "time_to_threshold.png", "transfer.png",
-           "PLOTS.txt", "domains/")
+           "PLOTS.txt", "domains/", "tensorboard/")
 
 def _label(args: tuple) -> str:
     _, learner, size, seed, kind = args
@@ -126,8 +126,23 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                         "steps_per_second", "gateway_calls_per_step"],
           [[t["learner"], t["size"], t["seed"], t["kind"], t["learning_steps_per_second"],
             t["steps_per_second"], t["gateway_calls_per_step"]] for t in timing["jobs"]])
+    files += tensorboard_runs(out, results)
     files += plot(out, results) if not results.get("partial") else skip_plots(out)
     return files
+
+
+def tensorboard_runs(out: Path, results: dict[str, Any]) -> list[Path]:
+    """Every job's curve as a TensorBoard run, ``tensorboard/LEARNER-pSIZE-seedS`` (with
+    ``-transfer`` for a transfer job): CGI and memory by learning time units."""
+    from relrl.tensorboard import write_event_file
+
+    return [write_event_file(
+        out / "tensorboard" / (f"{j['learner']}-p{j['size']}-seed{j['seed']}"
+                               + ("-transfer" if j["kind"] == "transfer" else "")),
+        [(c["learning_steps"], {"cgi/mean": c["cgi_mean"],
+                                "cgi_literal/mean": c["cgi_literal_mean"],
+                                "memory/positions": c["memory_positions"]})
+         for c in j["curve"]]) for j in results["jobs"]]
 
 
 def plot(out: Path, results: dict[str, Any]) -> list[Path]:

@@ -11,17 +11,23 @@ control characters and unpaired surrogates are replaced, backslashes and ``<...>
 DOT meaning (no HTML-like labels, so no links in the picture), and node names are generated
 (``n0``, ``n1``, ...), never taken from the graph. What ``dot`` still refuses is a
 :class:`GraphError`.
+
+For the monitor, :func:`picture` gives the SVG with what the page needs to mark a leaf and
+its path in it: the name each node got (:func:`node_names`) and each node's parent, and
+:data:`LEAF_LEGENDS` says what a learner's leaf labels mean.
 """
 
 from __future__ import annotations
 
 import re
 import subprocess
+from dataclasses import dataclass, field
 from typing import Any
 
 from relrl.errors import UserError
 
-__all__ = ["GraphError", "learner_graph", "render", "to_dot"]
+__all__ = ["EMPTY_LEAF", "LEAF_LEGENDS", "GraphError", "Picture", "learner_graph",
+           "node_names", "picture", "render", "to_dot"]
 
 #: the longest label line drawn; longer lines are cut with an ellipsis.
 LABEL_WIDTH = 48
@@ -31,6 +37,31 @@ LABEL_LINES = 12
 LEAF_ENTRIES = 4
 #: control characters (but the line break) and unpaired surrogates: replaced in labels.
 _UNPRINTABLE = re.compile("[\x00-\x09\x0b-\x1f\x7f\ud800-\udfff]")
+#: the label of a leaf that holds nothing yet (a new tree is one such leaf).
+EMPTY_LEAF = "(empty leaf: nothing learned here yet)"
+#: what the labels of each learner's tree say (the page's legend under the tree). The
+#: labels are the learners' own, made in Prolog (qtree.pl for etg, tg_knowledge.pl for tg);
+#: tests/monitor check that real trees read as described here.
+LEAF_LEGENDS: dict[str, list[dict[str, str]]] = {
+    "etg": [
+        {"example": "look(left) 29.45 [socialize]",
+         "says": "an entry of the leaf: a response, its Q, and in brackets the necessity "
+                 "that was active when it was learned ([none]: no necessity was active); "
+                 "the best Q first"},
+        {"example": "stimulus(face)",
+         "says": "a test of the state: yes (solid) when it holds, no (dashed) when not"},
+        {"example": "null",
+         "says": "a branch no state has reached yet"},
+    ],
+    "tg": [
+        {"example": "Q=29.45 (n=12)",
+         "says": "a leaf: the Q of the (state, response) pairs that reach it, and n, how "
+                 "many examples it has learned from"},
+        {"example": "at(T, P), look(P)",
+         "says": "a first-order test over the state and the response, with variables "
+                 "(T a toy, P a place): yes (solid) when some binding makes it true"},
+    ],
+}
 
 
 class GraphError(UserError):
@@ -56,6 +87,45 @@ def shown_graph(learner: Any, previous: dict[str, Any] | None) -> dict[str, Any]
     except QueryTimeout as exc:
         logging.getLogger(__name__).warning("the tree was not redrawn: %s", exc)
         return previous
+
+
+def node_names(graph: dict[str, Any]) -> dict[str, str]:
+    """The name each node gets in the picture, by its id (as text): ``n0``, ``n1``, ... in
+    the order of the nodes; an id given twice keeps its first name."""
+    names: dict[str, str] = {}
+    for node in graph.get("nodes") or ():
+        names.setdefault(str(node["id"]), f"n{len(names)}")
+    return names
+
+
+@dataclass(frozen=True)
+class Picture:
+    """A tree drawn for the monitor.
+
+    Attributes:
+        svg: the picture (SVG).
+        names: node id (as text) -> the node's name in the picture (its ``<title>``).
+        parents: a node's name -> its parent's name (the root has none).
+    """
+
+    svg: bytes
+    names: dict[str, str] = field(default_factory=dict)
+    parents: dict[str, str] = field(default_factory=dict)
+
+
+def picture(graph: dict[str, Any]) -> Picture:
+    """The tree as SVG, with the names and parents the page marks a path with.
+
+    Raises:
+        GraphError: as :func:`render`.
+    """
+    names = node_names(graph)
+    parents: dict[str, str] = {}
+    for edge in graph.get("edges") or ():
+        tail, head = names.get(str(edge["from"])), names.get(str(edge["to"]))
+        if tail is not None and head is not None:
+            parents.setdefault(head, tail)
+    return Picture(render(graph), names, parents)
 
 
 def _cut(text: Any, width: int = LABEL_WIDTH) -> str:
@@ -91,11 +161,14 @@ def to_dot(graph: dict[str, Any], title: str = "") -> Any:
     styles = {"test": {"shape": "box", "style": "filled", "fillcolor": "#dbe9f6"},
               "leaf": {"shape": "box", "style": "rounded,filled", "fillcolor": "#e6f4e1"},
               "null": {"shape": "plaintext", "fontcolor": "#888888"}}
-    names: dict[str, str] = {}  # the graph's node ids -> n0, n1, ...: no id reaches dot
+    names = node_names(graph)  # the graph's node ids -> n0, n1, ...: no id reaches dot
     for node in graph.get("nodes") or ():
-        name = names.setdefault(str(node["id"]), f"n{len(names)}")
-        dot.node(name, _text(node.get("label", "")),
-                 **styles.get(str(node.get("kind", "leaf")), styles["leaf"]))
+        name = names[str(node["id"])]
+        kind = str(node.get("kind", "leaf"))
+        label = node.get("label", "")
+        if kind == "leaf" and not str(label).strip():
+            label = EMPTY_LEAF
+        dot.node(name, _text(label), **styles.get(kind, styles["leaf"]))
     for edge in graph.get("edges") or ():
         tail, head = names.get(str(edge["from"])), names.get(str(edge["to"]))
         if tail is None or head is None:  # an edge to no node is not drawn

@@ -1,7 +1,8 @@
 """The live side of the monitor: what the control loop hands over, and at what rate.
 
 The control loop runs in the main thread (it alone may call Prolog); the web server runs in
-a thread of its own. They meet here, and the loop never waits for the server:
+a process of its own (:mod:`relrl.monitor.live`). They meet here, and the loop never waits
+for the server:
 
 * every time unit the loop adds one point to the necessity series (:meth:`Hub.tick`: a
   lock and a list append);
@@ -9,7 +10,11 @@ a thread of its own. They meet here, and the loop never waits for the server:
   :class:`~relrl.monitor.view.StepView` with a reference to the camera frame
   (:meth:`Hub.publish`); views in between are never built;
 * the server reads the newest view when it sends; a browser that is slow only ever gets the
-  newest one, so views and frames in between are dropped, never queued.
+  newest one, so views and frames in between are dropped, never queued;
+* what the session is doing (:meth:`Hub.status`: starting, waiting for the camera, the
+  initial evaluation, learning, evaluating, naming, saving, finished) is handed over when it
+  changes, so the page says it from the session's own state -- before the first time unit
+  too, when there is no view yet.
 
 Frames are JPEG-encoded once per published frame, by the thread that hands them to the web
 server's process (:mod:`relrl.monitor.live`). There a second hub, fed with
@@ -24,12 +29,15 @@ import time
 from collections import deque
 from typing import Any
 
-__all__ = ["Hub"]
+__all__ = ["ACTIVITIES", "Hub"]
 
 #: points of the necessity series kept for a browser that connects late.
 SERIES_KEEP = 2000
 #: points sent in one message at most (the newest; the page plots the last 600).
 SERIES_SEND = 600
+#: what a session can be doing, as :meth:`Hub.status` and the page's status line name it.
+ACTIVITIES = ("starting", "waiting for the camera", "initial evaluation", "learning",
+              "acting", "evaluating", "naming", "saving", "finished", "stopped")
 
 
 class Hub:
@@ -59,6 +67,7 @@ class Hub:
         self.tree_version = 0
         self.events: list[dict[str, Any]] = []
         self.finished = False
+        self.state: dict[str, Any] | None = None
         self._jpeg: tuple[int, bytes] | None = None
 
     # -- the control loop's side (cheap) --------------------------------------------------
@@ -101,6 +110,24 @@ class Hub:
             self.events.append({"kind": kind, **data})
             self.version += 1
 
+    def status(self, activity: str, detail: str = "", **data: Any) -> None:
+        """What the session is doing now (called when that changes, not every time unit).
+
+        Args:
+            activity: one of :data:`ACTIVITIES`.
+            detail: one sentence for the page (what, on what, how long).
+            data: JSON-ready facts the page shows as progress: ``done`` and ``total`` (runs
+                of an evaluation, executions of naming), ``phase``, ``steps``.
+
+        Raises:
+            ValueError: an activity that is not one of :data:`ACTIVITIES`.
+        """
+        if activity not in ACTIVITIES:
+            raise ValueError(f"unknown activity {activity!r} (one of {', '.join(ACTIVITIES)})")
+        with self._lock:
+            self.state = {"activity": activity, "detail": detail, **data}
+            self.version += 1
+
     def finish(self) -> None:
         """The session has ended (the page says so)."""
         with self._lock:
@@ -125,7 +152,8 @@ class Hub:
             series = [[t, ys, r] for n, t, ys, r in points[-keep:] if n > series_count]
             msg = {"info": {"rate": self.rate, **self.info}, "view": self.view,
                    "series": series, "tree_version": self.tree_version,
-                   "events": list(self.events), "finished": self.finished}
+                   "events": list(self.events), "status": self.state,
+                   "finished": self.finished}
             return msg, self.version, count
 
     def jpeg(self, quality: int = 80) -> tuple[int, bytes] | None:
@@ -176,6 +204,7 @@ class Hub:
                     self._series_count += 1
                     self._series.append((self._series_count, t, ys, r))
                 self.events = list(msg.get("events") or ())
+                self.state = msg.get("status")
                 self.finished = bool(msg.get("finished"))
             if "tree" in update:
                 self.tree_version, self.tree = update["tree"]

@@ -282,7 +282,7 @@ class ReplaySource:
 
     def __init__(self, recording: Recording) -> None:
         self.rec = recording
-        self._svg: dict[int, bytes | Exception | None] = {}
+        self._svg: dict[int, Any] = {}
         self._lock = threading.Lock()
 
     def info(self) -> dict[str, Any]:
@@ -318,8 +318,9 @@ class ReplaySource:
     def frame_jpeg(self, index: int) -> bytes | None:
         return self.rec.frame_bytes(index)
 
-    def tree_svg(self, t: int | None = None) -> bytes | None:
-        """The tree as it was at time unit ``t`` (default: the end) as SVG.
+    def tree_picture(self, t: int | None = None) -> Any:
+        """The tree as it was at time unit ``t`` (default: the end), drawn
+        (a :class:`~relrl.monitor.graph.Picture`), or ``None``.
 
         Raises:
             GraphError: the tree cannot be drawn.

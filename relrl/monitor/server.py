@@ -2,8 +2,11 @@
 
 One page (``static/index.html``, plain JavaScript, no build step) serves both the live
 session and a replay. Live: ``/api/events`` streams the newest view as server-sent events at
-the hub's rate, ``/frame.jpg`` is the newest camera frame, ``/tree.svg`` the learner's tree.
-Replay: ``/api/step/{t}``, ``/api/series``, ``/frames/{i}.jpg`` and ``/tree.svg?t=``.
+the hub's rate, ``/frame.jpg`` is the newest camera frame, ``/tree.svg`` the learner's tree
+and ``/api/tree`` the same picture with what the page marks the current leaf and its path
+with (the nodes' names and parents) and the legend of the learner's leaves.
+Replay: ``/api/step/{t}``, ``/api/series``, ``/frames/{i}.jpg``, ``/tree.svg?t=`` and
+``/api/tree?t=``.
 
 Read-only by construction: every route answers GET (and HEAD) only, anything else is 405,
 and no handler touches the robot or the knowledge base (they read the hub or the recording).
@@ -34,6 +37,7 @@ from typing import Any
 
 from relrl.errors import ConfigError
 from relrl.monitor.bounds import Limits, bounded_protocol
+from relrl.monitor.graph import LEAF_LEGENDS, Picture
 from relrl.monitor.schema import finite
 
 __all__ = ["Endpoint", "LiveSource", "MonitorServer", "build_app", "host_of", "is_loopback",
@@ -263,7 +267,9 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
             return _text("no frame (frames are /frames/N.jpg, N from 1)", 404)
         return _jpeg(await asyncio.to_thread(source.frame_jpeg, index))
 
-    async def tree(request: Any) -> Any:
+    async def drawing(request: Any) -> Any:
+        """The tree's picture at ``?t=`` (replay; live: the newest), or the answer saying
+        why there is none."""
         from relrl.monitor.graph import GraphError
 
         text = request.query_params.get("t")
@@ -271,12 +277,25 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
         if text is not None and t is None:
             return _text(f"t must be a time unit (a whole number), not {text[:40]!r}", 400)
         try:
-            svg = await asyncio.to_thread(source.tree_svg, t)
+            drawn = await asyncio.to_thread(source.tree_picture, t)
         except GraphError as exc:
             return _text(f"the tree cannot be drawn: {exc}", 422)
-        if svg is None:
-            return _text("no tree", 404)
-        return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-store"})
+        return drawn if drawn is not None else _text("no tree", 404)
+
+    async def tree(request: Any) -> Any:
+        drawn = await drawing(request)
+        if not isinstance(drawn, Picture):
+            return drawn
+        return Response(drawn.svg, media_type="image/svg+xml",
+                        headers={"Cache-Control": "no-store"})
+
+    async def tree_json(request: Any) -> Any:
+        drawn = await drawing(request)
+        if not isinstance(drawn, Picture):
+            return drawn
+        return _json({"svg": drawn.svg.decode("utf-8", "replace"), "names": drawn.names,
+                      "parents": drawn.parents,
+                      "legend": LEAF_LEGENDS.get(str(source.info().get("learner")), [])})
 
     async def step(request: Any) -> Any:
         t = whole(request.path_params["t"])
@@ -290,6 +309,7 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
         return Response(status_code=204)
 
     routes = [Route("/", index), Route("/api/info", info), Route("/tree.svg", tree),
+              Route("/api/tree", tree_json),
               Route("/favicon.ico", no_icon),
               Mount("/static", StaticFiles(directory=STATIC))]
     if source.mode == "live":
@@ -301,15 +321,16 @@ def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None =
     return _Guard(app, token, hosts or {"127.0.0.1", "localhost", "::1"})
 
 
-def drawn(graph: dict[str, Any] | None) -> bytes | Exception | None:
-    """The tree's SVG, the :class:`~relrl.monitor.graph.GraphError` saying why it cannot be
-    drawn (kept, so a tree that fails is not drawn again), or ``None`` for no tree."""
-    from relrl.monitor.graph import GraphError, render
+def drawn(graph: dict[str, Any] | None) -> Picture | Exception | None:
+    """The tree's :class:`~relrl.monitor.graph.Picture`, the
+    :class:`~relrl.monitor.graph.GraphError` saying why it cannot be drawn (kept, so a tree
+    that fails is not drawn again), or ``None`` for no tree."""
+    from relrl.monitor.graph import GraphError, picture
 
     if not graph or not graph.get("nodes"):
         return None
     try:
-        return render(graph)
+        return picture(graph)
     except GraphError as exc:
         log.warning("the tree cannot be drawn: %s", exc)
         return exc
@@ -323,7 +344,7 @@ class LiveSource:
     def __init__(self, hub: Any) -> None:
         self.hub = hub
         self.period = hub.period
-        self._svg: tuple[int, bytes | Exception | None] = (-1, None)
+        self._svg: tuple[int, Picture | Exception | None] = (-1, None)
         self._svg_lock = threading.Lock()
 
     def info(self) -> dict[str, Any]:
@@ -335,8 +356,8 @@ class LiveSource:
     def jpeg(self) -> tuple[int, bytes] | None:
         return self.hub.jpeg()
 
-    def tree_svg(self, t: int | None = None) -> bytes | None:
-        """The newest tree as SVG (``t`` is for replay; live shows the newest).
+    def tree_picture(self, t: int | None = None) -> Picture | None:
+        """The newest tree drawn (``t`` is for replay; live shows the newest).
 
         Raises:
             GraphError: the tree cannot be drawn.

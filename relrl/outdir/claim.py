@@ -101,6 +101,13 @@ class OutDir:
             _remove_internal(fd)
             raise OutputError(f"{path}: cannot write there ({reason(exc)})") from None
 
+    @property
+    def written(self) -> list[str]:
+        """The files this command wrote into the folder so far (``name`` or ``sub/name``),
+        sorted; folders are left out."""
+        with self._lock:
+            return sorted(n for n in self._written if not n.endswith("/"))
+
     @classmethod
     @contextlib.contextmanager
     def claim(cls, path: str | Path | None, *, command: str, overwrite: bool = False,

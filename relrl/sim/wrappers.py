@@ -1,5 +1,9 @@
 """Gymnasium wrappers for outside agents.
 
+:class:`EpisodeScalars` writes every finished episode's return, length and gaze metrics (the
+CGI and the rest that ``info`` holds at truncation) as TensorBoard scalars, whatever agent
+library steps the environment (Stable-Baselines3, a loop of your own).
+
 :class:`RelationalObservation` replaces the observation vector by the *relational view* of the
 time unit: the ground facts a relational learner reads (the ``relation/1`` templates of the
 generated domains and ``examples/domains/sis.pl``; docs/tg.md), as a sorted tuple of Prolog
@@ -28,6 +32,7 @@ from __future__ import annotations
 
 import string
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
@@ -35,7 +40,11 @@ from gymnasium import spaces
 
 from relrl.terms import Term
 
-__all__ = ["RelationalObservation", "relational_facts"]
+__all__ = ["EpisodeScalars", "RelationalObservation", "relational_facts"]
+
+#: what ``info`` holds at an episode's end that :class:`EpisodeScalars` writes.
+EPISODE_METRICS = ("cgi", "cgi_literal", "eye_contacts", "opportunities", "shifts",
+                   "mutual_gaze_events")
 
 _CHARSET = string.ascii_lowercase + string.digits + "_(),"
 
@@ -107,3 +116,56 @@ class RelationalObservation(gym.ObservationWrapper, gym.utils.RecordConstructorA
     def observation(self, observation: Any) -> tuple[str, ...]:
         """The relational view of the last time unit (computed from its percepts)."""
         return self._last
+
+
+class EpisodeScalars(gym.Wrapper, gym.utils.RecordConstructorArgs):
+    """Every finished episode as TensorBoard scalars in ``folder`` (``tensorboard --logdir``
+    reads it while the agent trains): ``episode/return``, ``episode/length`` and the gaze
+    metrics ``info`` holds at the episode's end (``episode/cgi``, ``episode/eye_contacts``,
+    ...), at the number of steps taken so far (the x axis of Stable-Baselines3's logs).
+    :attr:`episodes` keeps the same numbers for the program.
+
+    Example:
+        >>> env = EpisodeScalars(gym.make("relrl/SharedAttention-v1"), "runs/ppo")
+        ... # doctest: +SKIP
+        >>> model = PPO("MlpPolicy", env).learn(50_000)                      # doctest: +SKIP
+
+    Args:
+        env: the environment (``relrl/SharedAttention-v0`` or ``-v1``: any world).
+        folder: where the event file goes (created when missing).
+    """
+
+    def __init__(self, env: gym.Env, folder: str | Path) -> None:
+        from relrl.tensorboard import EVENT_FILE, ScalarLog
+
+        gym.utils.RecordConstructorArgs.__init__(self, folder=str(folder))
+        gym.Wrapper.__init__(self, env)
+        self.log = ScalarLog(Path(folder) / EVENT_FILE)
+        self.episodes: list[dict[str, float]] = []
+        self.steps = 0
+        self._return = 0.0
+        self._length = 0
+
+    def reset(self, **kwargs: Any) -> tuple[Any, dict[str, Any]]:
+        """Reset the wrapped environment; a new episode starts."""
+        self._return, self._length = 0.0, 0
+        return self.env.reset(**kwargs)
+
+    def step(self, action: Any) -> tuple[Any, float, bool, bool, dict[str, Any]]:
+        """Step the wrapped environment; at an episode's end, write its scalars."""
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.steps += 1
+        self._return += float(reward)
+        self._length += 1
+        if terminated or truncated:
+            episode = {"return": self._return, "length": float(self._length),
+                       **{k: info[k] for k in EPISODE_METRICS if k in info}}
+            self.episodes.append(episode)
+            self.log.add(self.steps, {f"episode/{k}": v for k, v in episode.items()})
+            self._return, self._length = 0.0, 0
+        return obs, reward, terminated, truncated, info
+
+    def close(self) -> None:
+        """Write what is left and close the event file and the environment."""
+        self.log.close()
+        super().close()

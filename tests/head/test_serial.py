@@ -131,7 +131,7 @@ def test_a_lost_port_raises_port_lost_and_reopen_recovers(tmp_path, fast_cal):
 
 
 def test_missing_device_is_port_unavailable_with_a_hint(fast_cal):
-    with pytest.raises(PortUnavailable, match="/dev/ttyNOPE.*--port sim"):
+    with pytest.raises(PortUnavailable, match="/dev/ttyNOPE.*give sim for the simulated head"):
         open_head("/dev/ttyNOPE", "ssc32", fast_cal)
 
 

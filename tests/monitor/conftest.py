@@ -73,6 +73,41 @@ def page(chromium, tmp_path: Path) -> Iterator[object]:
     context.close()
 
 
+#: what :func:`screen` reads of the page: the header, the status line, the timeline, panels.
+_SHOWN = r"""() => {
+    const out = {};
+    for (const el of document.querySelectorAll('header, #status, #timeline, section.panel')) {
+        const r = el.getBoundingClientRect();
+        if (!r.width || !r.height || el.hidden) continue;
+        let text = el.innerText;
+        for (const c of el.querySelectorAll('canvas'))
+            if (c.dataset.note) text += `\n[${c.id}: ${c.dataset.note}]`;
+        out[el.id || el.tagName.toLowerCase()] = text.replace(/\s+/g, " ").trim();
+    }
+    return out;
+}"""
+
+
+def screen(page, path: Path) -> dict[str, str]:
+    """A full-page screenshot into ``path``, and what it shows: the visible text of the
+    header, the status line, the timeline and each panel by its id (white space made one
+    space), with the note a canvas draws when it has nothing to plot (``[frame: no frame
+    yet · ...]``) -- what a test compares a screenshot by."""
+    page.screenshot(path=str(path), full_page=True)
+    assert path.stat().st_size > 10_000, "an empty screenshot"
+    return page.evaluate(_SHOWN)
+
+
+def wait_until(condition, timeout: float = 30.0, what: str = "the page") -> None:
+    """Poll ``condition()`` every 0.1 s until it is true."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return
+        time.sleep(0.1)
+    raise AssertionError(f"{what} did not come in {timeout:.0f} s")
+
+
 class RelrlProcess:
     """``relrl ARGS`` in a subprocess; :meth:`url` waits for the monitor's address."""
 

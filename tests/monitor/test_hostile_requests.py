@@ -2,7 +2,7 @@
 traceback -- on real sockets on loopback, with real symbolic links and files.
 
 ``REPLAY_CASES`` (requests to ``relrl replay``'s server over recordings that load) and
-``LIVE_CASES`` (requests to a live session's server) hold 21 cases: each is a request and the
+``LIVE_CASES`` (requests to a live session's server) hold 27 cases: each is a request and the
 status it must get; no answer is ever a 500, and nothing is logged as an error.
 """
 
@@ -66,6 +66,11 @@ REPLAY_CASES: list[tuple[str, dict[str, str], str, int]] = [
     ("tree-t-superscript-two", {}, "/tree.svg?t=%C2%B2", 400),
     ("tree-t-5000-digits", {}, f"/tree.svg?t={DIGITS}", 400),
     ("tree-t-word", {}, "/tree.svg?t=one", 400),
+    ("api-tree-label-html-link", {"trees.jsonl": _tree(EVIL)}, "/api/tree", 200),
+    ("api-tree-label-5000-lines", {"trees.jsonl": _tree("line\n" * 5000)}, "/api/tree", 200),
+    ("api-tree-label-surrogate", {"trees.jsonl": _tree("a\udc80b")}, "/api/tree", 200),
+    ("api-tree-t-superscript-two", {}, "/api/tree?t=%C2%B2", 400),
+    ("api-tree-t-5000-digits", {}, f"/api/tree?t={DIGITS}", 400),
     ("step-5000-digits", {}, f"/api/step/{DIGITS}", 404),
     ("step-superscript-two", {}, "/api/step/%C2%B2", 404),
     ("step-negative", {}, "/api/step/-1", 404),
@@ -76,6 +81,7 @@ REPLAY_CASES: list[tuple[str, dict[str, str], str, int]] = [
 LIVE_CASES: list[tuple[str, str, int]] = [
     ("live-tree-t-superscript-two", "/tree.svg?t=%C2%B2", 400),
     ("live-tree-evil-label", "/tree.svg", 200),
+    ("live-api-tree-evil-label", "/api/tree", 200),
     ("live-step-5000-digits", f"/api/step/{DIGITS}", 404),
     ("live-nan-events", "/api/events", 200),
 ]
@@ -98,6 +104,17 @@ def test_replay_answers_without_a_500(tmp_path, caplog, changes, path, status) -
         json.loads(body, parse_constant=lambda c: pytest.fail(f"{c} in the JSON"))
     if path.startswith("/tree.svg") and status == 200:
         _assert_inert_svg(headers, body)
+    if path.startswith("/api/tree") and status == 200:
+        _assert_inert_tree(body)
+
+
+def _assert_inert_tree(body: bytes) -> None:
+    """The page's copy of the tree: the same inert SVG, the names of both nodes."""
+    tree = json.loads(body)
+    svg = tree["svg"]
+    assert svg.count('class="node"') == 2, svg[:2000]
+    assert "href" not in svg and "<a " not in svg and "<script" not in svg
+    assert sorted(tree["names"].values()) == ["n0", "n1"] and tree["parents"] == {"n1": "n0"}
 
 
 def _assert_inert_svg(headers: dict, body: bytes) -> None:
@@ -133,6 +150,8 @@ def test_a_live_session_answers_without_a_500(live_server, capfd, path, status) 
         assert msg["view"]["reward"] is None and msg["series"] == [[1, [None], None]]
     if path == "/tree.svg":
         _assert_inert_svg(headers, body)
+    if path == "/api/tree":
+        _assert_inert_tree(body)
     err = capfd.readouterr().err  # the server's process writes to this terminal too
     assert "Traceback" not in err and "Exception" not in err, err
 
@@ -261,3 +280,24 @@ def test_the_pictures_policy_alone_stops_a_link_script(page, tmp_path, monkeypat
         page.wait_for_timeout(300)
         assert page.evaluate("window.name") != "pwned"
 
+
+
+def test_the_pages_copy_of_the_tree_holds_no_link(page, tmp_path, monkeypatch) -> None:
+    """The page draws the tree inside itself: with the labels' escaping taken away, the
+    link reaches /api/tree's SVG -- and the page copies only drawing elements and their
+    geometry, so no link, script or style of it is in the page."""
+    import relrl.monitor.graph as graph
+
+    monkeypatch.setattr(graph, "_text", lambda text, width=0: str(text))
+    folder = write_recording(tmp_path / "rec", **{"trees.jsonl": _tree(EVIL)})
+    with start_replay(folder) as server:
+        page.goto(server.url)
+        page.wait_for_selector("#tree svg g.node")
+        svg = page.evaluate("async () => (await (await fetch('api/tree')).json()).svg")
+        assert "<a " in svg and "javascript:" in svg  # the markup went through the server
+        assert page.locator("#tree a").count() == 0
+        assert "javascript" not in page.inner_html("#tree")
+        for target in page.locator("#tree text").all()[:6]:
+            target.click(force=True)
+        page.wait_for_timeout(300)
+        assert page.evaluate("window.name") != "pwned" and not page.errors

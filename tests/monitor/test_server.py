@@ -15,7 +15,8 @@ from relrl.errors import ConfigError
 from relrl.monitor import Hub, start_live
 from relrl.monitor.server import LiveSource, MonitorServer, is_loopback, parse_address
 
-PATHS = ["/", "/api/info", "/api/events", "/frame.jpg", "/tree.svg", "/static/monitor.js"]
+PATHS = ["/", "/api/info", "/api/events", "/frame.jpg", "/tree.svg", "/api/tree",
+         "/static/monitor.js", "/static/plots.js", "/static/tree.js"]
 
 
 def _request(port: int, method: str, path: str, headers: dict | None = None
@@ -57,6 +58,9 @@ def test_every_endpoint_answers_get_and_refuses_writes() -> None:
                 assert b"read-only" in body
         assert _request(server.port, "GET", "/frame.jpg")[1][:2] == b"\xff\xd8"  # a JPEG
         assert b"<svg" in _request(server.port, "GET", "/tree.svg")[1]
+        tree = json.loads(_request(server.port, "GET", "/api/tree")[1])
+        assert "<svg" in tree["svg"] and tree["names"] == {"0": "n0", "1": "n1", "2": "n2"}
+        assert tree["parents"] == {"n1": "n0", "n2": "n0"}
         status, body = _request(server.port, "GET", "/api/events")
         msg = json.loads(body.decode().split("data: ", 1)[1])
         assert msg["view"]["t"] == 1 and msg["series"] == [[1, [0.5], -1.0]]
@@ -160,3 +164,62 @@ def test_a_tree_query_out_of_time_keeps_the_last_tree(caplog) -> None:
     last = {"nodes": [{"id": 0, "kind": "leaf", "label": "x"}], "edges": []}
     assert shown_graph(Slow(), last) is last
     assert "the tree was not redrawn" in caplog.text
+
+
+def test_the_hub_hands_over_what_the_session_does() -> None:
+    """The status reaches the page before any view, and through the server's process."""
+    hub = Hub(rate=50)
+    hub.status("initial evaluation", "the robot before any learning", done=0, total=3)
+    msg, version, count = hub.message(-1, 0)
+    assert msg["view"] is None and msg["status"] == {
+        "activity": "initial evaluation", "detail": "the robot before any learning",
+        "done": 0, "total": 3}
+    hub.status("learning", "phase 'fruits'", phase="fruits", steps=300)
+    assert hub.message(version, count)[0]["status"]["activity"] == "learning"
+    served = Hub(rate=50)
+    served.apply(hub.changes({}))
+    assert served.message(-1, 0)[0]["status"] == hub.state
+    with pytest.raises(ValueError, match="unknown activity 'dreaming'"):
+        hub.status("dreaming")
+
+
+def test_a_session_tells_the_monitor_each_thing_it_does(tmp_path) -> None:
+    """Every status a session sets, in order: from its own state, not guessed."""
+    from relrl.episodes import RunOptions, load_episode, run_episode
+    from tests.monitor.conftest import episode
+
+    class Recording(Hub):
+        def status(self, activity, detail="", **data):
+            super().status(activity, detail, **data)
+            seen.append((activity, data.get("done"), data.get("phase")))
+
+    seen: list = []
+    script = episode(tmp_path, steps=30, perception="symbolic",
+                     extra="[evaluation]\nevery = 20\nruns = 2\nsteps = 10\n"
+                           "[naming]\nexecutions = 2\n")
+    run_episode(load_episode(script), RunOptions(monitor=Recording(rate=50), plots=False))
+    assert seen == [("starting", None, None),
+                    ("initial evaluation", 0, None), ("initial evaluation", 1, None),
+                    ("learning", None, "no objects"), ("learning", None, "fruits"),
+                    ("evaluating", 0, None), ("evaluating", 1, None),
+                    ("learning", None, "fruits"),
+                    ("naming", 0, None), ("naming", 1, None),
+                    ("finished", None, None)]
+
+
+def test_a_session_on_a_camera_says_it_waits_for_it(tmp_path) -> None:
+    from relrl.episodes import RunOptions, load_episode, run_episode
+    from tests.monitor.conftest import episode
+
+    class Recording(Hub):
+        def status(self, activity, detail="", **data):
+            super().status(activity, detail, **data)
+            seen.append((activity, detail))
+
+    seen: list = []
+    script = episode(tmp_path, steps=12)
+    run_episode(load_episode(script), RunOptions(monitor=Recording(rate=50), plots=False,
+                                                 camera="synthetic://?looking_at=centre"))
+    assert [a for a, _ in seen] == ["starting", "waiting for the camera", "learning",
+                                    "learning", "finished"]
+    assert "camera synthetic://?looking_at=centre" in seen[1][1]

@@ -92,3 +92,49 @@ def test_shipped_docs_match_the_runs_they_cite() -> None:
     docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
     stale = [line for md in docs for line in stale_blocks(md)]
     assert stale == [], "re-render with `relrl report --update FILE.md`:\n" + "\n".join(stale)
+
+
+def test_the_claims_of_two_runs_side_by_side(sis_run: Path, tmp_path: Path) -> None:
+    """A block may name two runs (``a,b``): the paper's claims judged on each, one column per
+    setting, and both runs' provenance."""
+    for name, preset in (("fixed", None), ("paper", "paper-2012")):
+        shutil.copytree(sis_run, tmp_path / name)
+        results = json.loads((tmp_path / name / "results.json").read_text())
+        results["config"]["preset"] = preset
+        results["claims"] = {"after_first_run": {"held": preset is None, "values": {
+            "cgi_after_first_run": {"contingency": 0.5, "etg": 0.75, "qlearning": 0.8}}}}
+        (tmp_path / name / "results.json").write_text(json.dumps(results))
+    md = tmp_path / "doc.md"
+    md.write_text("<!-- relrl-report fixed,paper claims -->\n<!-- /relrl-report -->\n")
+    assert update_file(md) == 1
+    text = md.read_text()
+    assert "| the paper's claim | `fixed task` | `paper-2012` |" in text
+    assert "**held**: run 1 C 0.50, ETG 0.75, Q 0.80 | not held: run 1 C 0.50" in text
+    assert "`fixed/results.json`" in text and "`paper/results.json`" in text
+    assert stale_blocks(md) == []
+
+
+def test_the_provenance_line_never_joins_the_table_above_it(sis_run: Path,
+                                                            monkeypatch: pytest.MonkeyPatch
+                                                            ) -> None:
+    """A view whose Markdown does not end in a newline still gets its provenance as a
+    paragraph of its own (else Markdown reads it as one more row of the table)."""
+    from relrl import report
+
+    monkeypatch.setitem(report.VIEWS, ("sis", "bare"), lambda run: "| a |\n|---|\n| 1 |")
+    assert "| 1 |\n\n*From `exp1/results.json`" in render(load_run(sis_run), "bare", "exp1")
+
+
+def test_a_symbolic_experiment2_run_has_no_table1_and_says_so(tmp_path: Path) -> None:
+    """Experiment 2 with symbolic perception names no fruit (no Table 1): the short view
+    shows a dash, the Table 1 view is a one-line error, not a traceback."""
+    summary = {"tg/interaction": {
+        "fig6": [{"units": 0, "cgi_mean": 0.5, "cgi_sd_over_seeds": 0.1},
+                 {"units": 100, "cgi_mean": 1.0, "cgi_sd_over_seeds": 0.0}],
+        "table1": {"all_executions": None, "executions": 25, "without_presentation": 25}}}
+    (tmp_path / "results.json").write_text(json.dumps({"experiment": "exp2",
+                                                       "summary": summary}))
+    short = render(load_run(tmp_path), "short", "exp2")
+    assert "| tg/interaction | 1.00 | — |" in short
+    with pytest.raises(UserError, match="no Table 1"):
+        render(load_run(tmp_path), "table1", "exp2")

@@ -1,15 +1,15 @@
 // relrl monitor: one page for the live session (server-sent events) and the replay (a
 // timeline over the recorded trace). Plain JavaScript, no build step. Read-only: the page only
-// ever sends GET requests.
+// ever sends GET requests. plots.js draws the canvases, tree.js the learned tree.
 "use strict";
 
 const token = new URLSearchParams(location.search).get("token");
 const $ = (id) => document.getElementById(id);
-const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf"];
 const KEEP = 600;            // points of the necessity plot
 
 const state = { info: null, series: [], view: null, necessities: [], tree: -1,
-                frameShown: null, frameLoading: false, cursor: null };
+                frameShown: null, frameLoading: false, cursor: null, status: null,
+                events: [] };
 
 function url(path, params = {}) {
   const q = new URLSearchParams(params);
@@ -39,9 +39,24 @@ function row(tbody, cells, cls) {
   tbody.appendChild(tr);
 }
 
+function items(ul, values, none) {
+  clear(ul);
+  for (const v of values) {
+    const li = document.createElement("li");
+    li.textContent = v;
+    ul.appendChild(li);
+  }
+  if (!values.length && none) {
+    const li = document.createElement("li");
+    li.className = "note";
+    li.textContent = none;
+    ul.appendChild(li);
+  }
+}
+
 function fmt(x, digits = 3) { return x == null ? "–" : Number(x).toFixed(digits); }
 
-// -- the header -------------------------------------------------------------------------
+// -- the header and the status line -------------------------------------------------------
 
 function showInfo(info) {
   state.info = info;
@@ -59,63 +74,82 @@ function showInfo(info) {
   if (lines.length) { $("where").hidden = false; $("where").textContent = lines.join(" · "); }
   const legend = $("legend");
   clear(legend);
-  state.necessities.forEach((n, i) => {
+  const key = (colour, label) => {
     const s = document.createElement("span");
     const sw = document.createElement("i");
-    sw.style.background = COLOURS[i % COLOURS.length];
+    sw.style.background = colour;
     s.appendChild(sw);
-    s.appendChild(document.createTextNode(n));
+    s.appendChild(document.createTextNode(label));
     legend.appendChild(s);
-  });
-  const r = document.createElement("span");
-  const sw = document.createElement("i");
-  sw.style.background = "#999";
-  r.appendChild(sw);
-  r.appendChild(document.createTextNode("reward (lower strip)"));
-  legend.appendChild(r);
+  };
+  state.necessities.forEach((n, i) => key(COLOURS[i % COLOURS.length], n));
+  key("#999", "reward (lower strip)");
   if (info.perception === "symbolic")
     $("frame-note").textContent = "symbolic perception: facts are written directly, no frames";
 }
 
-// -- one time unit ----------------------------------------------------------------------
-
-function showView(v) {
-  if (!v) return;
-  state.view = v;
-  text("t", v.t);
-  text("phase", v.phase);
-  text("reward", v.reward);
-  text("state", v.state);
-  text("response", v.response || "nothing (no response allowed)");
-  const now = Object.entries(v.activation || {}).map(([k, y]) => `${k} ${fmt(y, 2)}`);
-  $("necessity-now").textContent = `active: ${v.necessity || "none"} · ${now.join(", ")}`;
-  // percepts and working memory
-  const ul = $("percepts");
-  clear(ul);
-  for (const p of v.percepts || []) {
-    const li = document.createElement("li");
-    li.textContent = p;
-    ul.appendChild(li);
+// "run 2 of 5", "time unit 34 of 300": how far the current activity is.
+function progressOf(s) {
+  if (s.total) {
+    const done = Math.min(s.done ?? 0, s.total);
+    const what = s.activity === "naming" ? "execution" : "run";
+    return [done, s.total, `${what} ${Math.min(done + 1, s.total)} of ${s.total}`];
   }
+  if ((s.activity === "learning" || s.activity === "acting") && s.steps) {
+    const u = state.view ? (state.view.unit ?? state.view.t) : 0;
+    return [u, s.steps, `time unit ${u} of ${s.steps}`];
+  }
+  return [null, null, ""];
+}
+
+function showStatus() {
+  const s = state.status;
+  if (!s) return;
+  $("status").dataset.activity = s.activity;
+  $("status-activity").textContent = s.activity[0].toUpperCase() + s.activity.slice(1);
+  $("status-detail").textContent = s.detail ? `— ${s.detail}` : "";
+  const [done, total, count] = progressOf(s);
+  const bar = $("status-progress");
+  bar.hidden = total == null;
+  if (total != null) { bar.max = total; bar.value = done; }
+  $("status-count").textContent = count;
+}
+
+// Before the first time unit: what each picture will show, and what the session does now.
+function showWaiting() {
+  if (state.view) return;
+  const s = state.status;
+  const now = s ? `${s.activity}${progressOf(s)[2] ? " · " + progressOf(s)[2] : ""}`
+                : "connecting to the session";
+  const frame = $("frame");
+  if (state.info && state.info.perception === "symbolic")
+    drawNote(frame, ["symbolic perception: no frames", now], true);
+  else
+    drawNote(frame, ["no frame yet", now, "the robot's view appears when learning starts"],
+             true);
+  drawNecessities($("plot"), [], null, ["no time unit of learning yet", now]);
+  showEvaluations();
+}
+
+// -- one time unit: every panel's function, in VIEW_PANELS ------------------------------
+
+function showPercepts(v) {
+  items($("percepts"), v.percepts || [], "none in this time unit");
   const mem = $("memory").tBodies[0];
   clear(mem);
   for (const [age, el] of v.memory || []) row(mem, [age, el]);
   $("memory-size").textContent = v.memory_size == null ? "" : `${v.memory_size} elements`;
-  showExplanation(v);
-  showHead(v.head);
-  const m = v.metrics || {};
-  text("cgi", m.cgi == null ? "n/a" : fmt(m.cgi));
-  text("shifts", `${m.correct_shifts ?? "–"}/${m.shifts ?? "–"}`);
-  text("contacts", `${m.eye_contacts ?? "–"}/${m.opportunities ?? "–"}`);
-  const cg = v.caregiver || {};
-  const objs = Object.entries(cg.objects || {}).map(([p, k]) => `${k} at ${p}`).join(", ");
-  $("caregiver").textContent = `caregiver looks ${cg.look ?? "?"}${cg.estimated ?
-    " (estimated from perception)" : ""}${cg.mode ? ", " + cg.mode : ""}${objs ? "; " + objs :
-    ""}; robot looks ${v.focus ?? "?"}${v.heard && v.heard.length ? "; heard " +
-    v.heard.join(", ") : ""}${v.said ? '; says "' + v.said + '"' : ""}`;
+}
+
+function showNecessityNow(v) {
+  text("reward", v.reward);
+  text("state", v.state);
+  const now = Object.entries(v.activation || {}).map(([k, y]) => `${k} ${fmt(y, 2)}`);
+  $("necessity-now").textContent = `active: ${v.necessity || "none"} · ${now.join(", ")}`;
 }
 
 function showExplanation(v) {
+  text("response", v.response || "nothing (no response allowed)");
   const e = v.explanation || {};
   const box = $("explanation");
   box.dataset.t = v.t;
@@ -144,7 +178,8 @@ function showExplanation(v) {
   $("allowed").textContent = `allowed: ${(v.allowed || []).join(", ")}`;
 }
 
-function showHead(h) {
+function showHead(v) {
+  const h = v.head;
   const tb = $("head").tBodies[0];
   clear(tb);
   if (!h) { $("head-note").textContent = "no head in this session (--head PORT drives one)"; return; }
@@ -152,6 +187,38 @@ function showHead(h) {
     row(tb, [name, s.us, (s.offset_us > 0 ? "+" : "") + s.offset_us, s.deg]);
   $("head-note").textContent = `looking ${h.looking_at || "?"}; ` +
     `angles nominal (0.09°/µs); ${h.clamped} values clamped to the calibration so far`;
+}
+
+function showGaze(v) {
+  const m = v.metrics || {};
+  text("cgi", m.cgi == null ? "n/a" : fmt(m.cgi));
+  text("shifts", `${m.correct_shifts ?? "–"}/${m.shifts ?? "–"}`);
+  text("contacts", `${m.eye_contacts ?? "–"}/${m.opportunities ?? "–"}`);
+  const cg = v.caregiver || {};
+  const objs = Object.entries(cg.objects || {}).map(([p, k]) => `${k} at ${p}`).join(", ");
+  $("caregiver").textContent = `caregiver looks ${cg.look ?? "?"}${cg.estimated ?
+    " (estimated from perception)" : ""}${cg.mode ? ", " + cg.mode : ""}${objs ? "; " + objs :
+    ""}; robot looks ${v.focus ?? "?"}${v.heard && v.heard.length ? "; heard " +
+    v.heard.join(", ") : ""}${v.said ? '; says "' + v.said + '"' : ""}`;
+}
+
+// The leaf this time unit's response came from (tg: the chosen response's own leaf).
+function showLeaf(v) {
+  const e = v.explanation || {};
+  const mine = (e.ranked || []).find((r) => r.response === v.response && r.leaf != null);
+  markLeaf(mine ? mine.leaf : e.leaf ?? null);
+}
+
+const VIEW_PANELS = [showPercepts, showNecessityNow, showExplanation, showHead, showGaze,
+                     showLeaf];
+
+function showView(v) {
+  if (!v) return;
+  state.view = v;
+  text("t", v.t);
+  text("phase", v.phase);
+  for (const panel of VIEW_PANELS) panel(v);
+  showStatus();
 }
 
 // -- the camera frame with what perception found ------------------------------------------
@@ -163,6 +230,7 @@ function drawFrame(img, overlay) {
   }
   const g = c.getContext("2d");
   g.drawImage(img, 0, 0);
+  delete c.dataset.note;
   const lines = [];
   if (overlay && overlay.face) {
     const [x, y, w, h] = overlay.face.box;
@@ -205,81 +273,40 @@ function loadFrame(src, key, overlay) {
   img.src = src;
 }
 
-// -- the necessity plot -----------------------------------------------------------------
-
 function drawPlot() {
-  const c = $("plot");
-  const w = c.clientWidth || c.width;
-  if (c.width !== w) c.width = w;
-  const g = c.getContext("2d");
-  const H = c.height, strip = 40, top = 8, plotH = H - strip - top - 14;
-  g.clearRect(0, 0, c.width, H);
-  const pts = state.series;
-  c.dataset.points = String(pts.length);
-  if (!pts.length) return;
-  let lo = 0, hi = 1, rlo = 0, rhi = 0;
-  for (const [, ys, r] of pts) {
-    for (const y of ys) { if (y < lo) lo = y; if (y > hi) hi = y; }
-    if (r < rlo) rlo = r; if (r > rhi) rhi = r;
-  }
-  const t0 = pts[0][0], t1 = Math.max(pts[pts.length - 1][0], t0 + 1);
-  const X = (t) => 30 + (c.width - 36) * (t - t0) / (t1 - t0);
-  const Y = (y) => top + plotH * (1 - (y - lo) / (hi - lo || 1));
-  g.strokeStyle = "#d9dde2"; g.fillStyle = "#616e7c"; g.font = "10px sans-serif";
-  for (const y of [lo, (lo + hi) / 2, hi]) {
-    g.beginPath(); g.moveTo(30, Y(y)); g.lineTo(c.width, Y(y)); g.stroke();
-    g.fillText(y.toFixed(1), 2, Y(y) + 3);
-  }
-  g.fillText(`t ${t0}`, 30, H - 2);
-  g.fillText(`t ${t1}`, c.width - 44, H - 2);
-  const n = pts[0][1].length;
-  for (let k = 0; k < n; k++) {
-    g.beginPath();
-    g.strokeStyle = COLOURS[k % COLOURS.length]; g.lineWidth = 1.5;
-    pts.forEach(([t, ys], i) => (i ? g.lineTo(X(t), Y(ys[k])) : g.moveTo(X(t), Y(ys[k]))));
-    g.stroke();
-  }
-  // reward strip
-  const base = H - 14 - strip / 2, scale = (strip / 2 - 2) / Math.max(1, rhi, -rlo);
-  for (const [t, , r] of pts) {
-    g.fillStyle = r > 0 ? "#2f8132" : r < 0 ? "#b3261e" : "#999";
-    g.fillRect(X(t) - 1, r > 0 ? base - r * scale : base, 2, Math.max(1, Math.abs(r) * scale));
-  }
-  if (state.cursor != null) {
-    g.strokeStyle = "#1f2933"; g.setLineDash([4, 3]);
-    g.beginPath(); g.moveTo(X(state.cursor), top); g.lineTo(X(state.cursor), H - 14); g.stroke();
-    g.setLineDash([]);
-  }
+  drawNecessities($("plot"), state.series, state.cursor,
+                  ["no time unit of learning yet", state.status ? state.status.activity : ""]);
 }
 
-// -- events (evaluations, naming) -------------------------------------------------------
+// -- evaluations (the CGI curve) and naming ---------------------------------------------
 
 function showEvents(events) {
-  const ul = $("events");
-  clear(ul);
-  for (const e of events || []) {
-    const li = document.createElement("li");
-    const sim = e.on && e.on !== "simulator" ? " (SIMULATED)" : "";
-    li.textContent = e.kind === "evaluation"
-      ? `t ${e.t}: evaluation${sim} CGI ${fmt(e.cgi_mean)} ± ${fmt(e.cgi_std)}`
-      : `t ${e.t}: naming execution ${e.execution}${sim}: ${JSON.stringify(e.counts)}`;
-    if (sim) li.className = "sim";
-    ul.appendChild(li);
-  }
-  if (!ul.firstChild) ul.appendChild(document.createTextNode("none yet"));
+  state.events = events || [];
+  showEvaluations();
+  const naming = state.events.filter((e) => e.kind === "naming").map((e) =>
+    `t ${e.t}: execution ${e.execution}${e.on && e.on !== "simulator" ? " (SIMULATED)" : ""}` +
+    `: ${Object.entries(e.counts || {}).map(([k, n]) => `${k} ${n}`).join(", ")}`);
+  items($("naming"), naming, "no naming execution yet");
 }
 
-function showTree(param) {
-  const img = $("tree");
-  img.onload = () => { img.hidden = false; $("tree-note").textContent = ""; };
-  img.onerror = () => {
-    img.hidden = true;
-    $("tree-note").textContent = "(no tree: this learner has none yet)";
-    fetch(img.src, { cache: "no-store" }).then(async (r) => {   // say why, when it is not 404
-      if (r.status !== 404) $("tree-note").textContent = `(${(await r.text()).trim()})`;
-    }).catch(() => {});
-  };
-  img.src = url("tree.svg", param);
+function showEvaluations() {
+  const points = state.events.filter((e) => e.kind === "evaluation" && e.cgi_mean != null)
+    .map((e) => ({ t: e.t ?? 0, units: e.units, mean: e.cgi_mean, std: e.cgi_std ?? 0,
+                   simulated: !!(e.on && e.on !== "simulator") }));
+  const info = state.info || {};
+  const tMax = Math.max(info.last ?? 0, info.steps ?? 0, state.view ? state.view.t : 0);
+  const s = state.status;
+  const running = s && (s.activity === "initial evaluation" || s.activity === "evaluating");
+  const empty = running ? [`the ${s.activity === "evaluating" ? "evaluation" : s.activity} ` +
+                           "is running", progressOf(s)[2]]
+                        : ["no evaluation yet", "the episode's script says when"];
+  const cursor = info.mode === "replay" ? state.cursor : null;
+  drawCgi($("cgi-plot"), points, tMax, cursor, empty);
+  const shown = points.filter((p) => cursor == null || p.t <= cursor);
+  const last = shown[shown.length - 1];
+  $("cgi-last").textContent = last ? `last: CGI ${fmt(last.mean, 2)} ± ${fmt(last.std, 2)} ` +
+    `at t ${last.t}${last.units != null ? ` (after ${last.units} time units of learning)` : ""}` +
+    (last.simulated ? " · SIMULATED on the scripted world" : "") : "";
 }
 
 // -- live -------------------------------------------------------------------------------
@@ -293,18 +320,22 @@ function live() {
       state.infoText = info;
       showInfo({ mode: "live", ...msg.info });
     }
+    if (msg.status) state.status = msg.status;
     for (const p of msg.series || []) state.series.push(p);
     if (state.series.length > KEEP) state.series.splice(0, state.series.length - KEEP);
-    drawPlot();
     const v = msg.view;
     if (v) {
       showView(v);
       if (v.frame_seq != null) loadFrame(url("frame.jpg", { seq: v.frame_seq }), v.frame_seq,
                                          v.overlay);
     }
+    showStatus();
+    if (state.view) drawPlot(); else showWaiting();
     showEvents(msg.events);
-    if (msg.tree_version !== state.tree) { state.tree = msg.tree_version;
-                                           showTree({ v: msg.tree_version }); }
+    if (msg.tree_version !== state.tree) {
+      state.tree = msg.tree_version;
+      loadTree({ v: msg.tree_version }).catch(() => {});
+    }
     if (msg.finished) {
       $("mode").textContent = "finished"; $("mode").className = "pill finished"; es.close();
     }
@@ -312,6 +343,9 @@ function live() {
   es.onerror = () => {
     if ($("mode").textContent !== "finished") {
       $("mode").textContent = "connection lost"; $("mode").className = "pill lost";
+      state.status = { activity: "connection lost", detail: "the session's monitor stopped " +
+                       "answering (the session ended, or its process was stopped)" };
+      showStatus();
     }
   };
 }
@@ -325,6 +359,16 @@ async function replay(info) {
   state.series = await getJSON("api/series");
   showEvents(info.events);
   let playing = null, pending = null, busy = false;
+  function say() {    // the player's state, in the status line
+    const t = Number(scrub.value), v = state.view;
+    const at = `t ${t} of ${info.last}${v && v.phase ? `, phase "${v.phase}"` : ""}`;
+    state.status = playing ? { activity: "playing", detail: `${at} · ❚❚ (or space) pauses` }
+      : t >= info.last ? { activity: "at the end", detail: `${at} · press ▶ to play from ` +
+                           "the start" }
+      : { activity: "paused", detail: `press ▶ to play (or space); drag the slider or step ` +
+          `with ← → · ${at}` };
+    showStatus();
+  }
   async function go(t) {
     if (busy) { pending = t; return; }
     busy = true;
@@ -335,11 +379,17 @@ async function replay(info) {
         (v.frame_t != null ? ` · frame of t ${v.frame_t}` : " · no frame recorded");
       showView(v);
       drawPlot();
+      showEvaluations();
       if (v.frame_index != null)
         loadFrame(url(`frames/${v.frame_index}.jpg`), v.frame_index, v.overlay_of_frame ||
                   (v.frame_t === v.t ? v.overlay : null));
-      if (v.tree_version !== state.tree) { state.tree = v.tree_version;
-                                           showTree({ t: v.t }); }
+      else if (state.frameShown == null)
+        drawNote($("frame"), ["no frame recorded", "at or before this time unit"], true);
+      if (v.tree_version !== state.tree) {
+        state.tree = v.tree_version;
+        loadTree({ t: v.t }).catch(() => {});
+      }
+      say();
     } finally {
       busy = false;
       if (pending != null) { const p = pending; pending = null; go(p); }
@@ -350,29 +400,36 @@ async function replay(info) {
                                                Number(scrub.value) + d)); go(Number(scrub.value)); };
   $("prev").onclick = () => step(-1);
   $("next").onclick = () => step(1);
+  const pause = () => { clearInterval(playing); playing = null; $("play").textContent = "▶"; };
   $("play").onclick = () => {
-    if (playing) { clearInterval(playing); playing = null; $("play").textContent = "▶"; return; }
+    if (playing) { pause(); say(); return; }
+    if (Number(scrub.value) >= info.last) { scrub.value = info.first; go(info.first); }
     $("play").textContent = "❚❚";
     playing = setInterval(() => {
-      if (Number(scrub.value) >= info.last) { $("play").onclick(); return; }
+      if (Number(scrub.value) >= info.last) { pause(); say(); return; }
       step(1);
     }, 200);
+    say();
   };
   document.addEventListener("keydown", (e) => {
+    if (e.target === scrub && e.key.startsWith("Arrow")) return;   // the slider moves itself
     if (e.key === "ArrowLeft") step(-1);
     if (e.key === "ArrowRight") step(1);
+    if (e.key === " " && e.target.tagName !== "BUTTON") { e.preventDefault(); $("play").onclick(); }
   });
+  say();
   go(info.first);
 }
 
 async function main() {
   const info = await getJSON("api/info");
   showInfo(info);
+  setUpTree();
   showEvents([]);
+  showWaiting();
   if (info.mode === "replay") await replay(info); else live();
 }
 
-window.addEventListener("resize", drawPlot);
-$("tree").addEventListener("click", () => $("tree").classList.toggle("fit"));
+window.addEventListener("resize", () => { drawPlot(); showEvaluations(); });
 main().catch((e) => { $("mode").textContent = "error"; $("mode").className = "pill lost";
                       console.error(e); });
