@@ -11,8 +11,14 @@ import pytest
 
 from relrl.bridge.calls import prolog
 from relrl.engine import Engine, StepResult
-from relrl.errors import (PolicyError, PrologError, PrologLoadError, QueryTimeout,
-                          RelrlError, RuleError)
+from relrl.errors import (
+    PolicyError,
+    PrologError,
+    PrologLoadError,
+    QueryTimeout,
+    RelrlError,
+    RuleError,
+)
 from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from relrl.loop import Agent, Interaction
