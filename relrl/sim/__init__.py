@@ -8,7 +8,7 @@ See ``docs/simulator.md`` and ``docs/benchmark.md``. Quick start::
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(("look", "centre"))
     print(info["percepts"], env.metrics()["cgi"])
-    big = World(places=17, colours=3, scene=True).env()
+    big = SharedAttentionEnv(world=World(places=17, colours=3, scene=True))
 """
 
 from __future__ import annotations

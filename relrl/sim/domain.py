@@ -17,6 +17,7 @@ is ``toy(P)``, with its colour and kind.
 from __future__ import annotations
 
 import textwrap
+from dataclasses import fields
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -45,8 +46,6 @@ def _section(title: str) -> str:
 
 
 def _args(world: World) -> str:
-    from dataclasses import fields
-
     default = type(world)()
     changed = [f"{f.name}={getattr(world, f.name)!r}" for f in fields(world)
                if getattr(world, f.name) != getattr(default, f.name)]
