@@ -14,6 +14,7 @@ See ``docs/simulator.md`` and ``docs/benchmark.md``. Quick start::
 from __future__ import annotations
 
 from relrl.envs import register_envs
+from relrl.reward import PAPER_REWARD, Reward
 from relrl.sim.caregiver import (
     EVALUATION_SEQUENCE,
     Caregiver,
@@ -37,7 +38,6 @@ from relrl.sim.metrics import (
     summarize,
 )
 from relrl.sim.places import PLACES, TOY_PLACES, Layout, layout, place_names
-from relrl.sim.reward import PAPER_REWARD, Reward
 from relrl.sim.sis import ENV_ID, ENV_ID_V1, RESPONSES, SharedAttentionEnv
 from relrl.sim.world import World
 
