@@ -138,10 +138,11 @@ class World:
         """This world's domain file (see :mod:`relrl.sim.domain`)."""
         return domain_text(self)
 
-    def write_domain(self, folder: str | Path) -> Path:
-        """Write this world's domain to ``folder/NAME.pl`` (unchanged files are left alone;
-        a new one appears whole, through a rename). Returns the path."""
-        path = Path(folder) / f"{self.name}.pl"
+    def write_domain(self, folder: str | Path, stem: str | None = None) -> Path:
+        """Write this world's domain to ``folder/STEM.pl``, ``STEM`` this world's
+        :attr:`name` by default (unchanged files are left alone; a new one appears whole,
+        through a rename). Returns the path."""
+        path = Path(folder) / f"{stem or self.name}.pl"
         text = self.domain_text()
         if path.is_file() and not path.is_symlink() and path.read_text() == text:
             return path
