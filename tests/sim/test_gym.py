@@ -13,7 +13,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from relrl.kb import KnowledgeBase
-from relrl.sim import ENV_ID, ENV_ID_V1, GazeMetrics, World
+from relrl.sim import ENV_ID, ENV_ID_V1, GazeMetrics, SharedAttentionEnv, World
 from relrl.sim.policies import GazeFollower, RandomPolicy
 from relrl.sim.wrappers import RelationalObservation, relational_facts
 
@@ -52,7 +52,7 @@ def test_v0_observation_is_unchanged_by_v1() -> None:
 
 def test_v1_observation_encodes_the_scene() -> None:
     world = World(places=9, colours=3, kinds=2, scene=True, field=50)
-    env = world.env(observation=1, max_steps=None)
+    env = SharedAttentionEnv(world=world, observation=1, max_steps=None)
     rp = RandomPolicy(2, env.places)
     _, info = env.reset(seed=2)
     names = [f for f, _ in env.observation_fields]
@@ -78,7 +78,8 @@ def test_the_wrapper_gives_what_the_domains_relations_give(world: World, tmp_pat
     """The relational view computed in Python equals the generated domain's relation/1."""
     kb = KnowledgeBase(world.write_domain(tmp_path))
     try:
-        env = RelationalObservation(world.env(observation=1, max_steps=None))
+        env = RelationalObservation(SharedAttentionEnv(world=world, observation=1,
+                                                       max_steps=None))
         follower, rp = GazeFollower(), RandomPolicy(3, env.unwrapped.places)
         obs, info = env.reset(seed=3)
         for t in range(400):
