@@ -53,15 +53,18 @@ free_number(N0, N) :-
 %!  gw_drop_kb(+Module) is det.
 %
 %   Forget everything relrl keeps for a knowledge base (relrl_engine:engine_forget/1: its
-%   record, its learner's own clauses, its plans), unload the files loaded into it and
-%   destroy the module itself, as library(modules) destroys a temporary module: a process
-%   that makes and drops knowledge bases all day keeps no trace of them.
+%   record, its learner's own clauses, its plans), unload the domain files consulted into
+%   it and destroy the module itself, as library(modules) destroys a temporary module: a
+%   process that makes and drops knowledge bases all day keeps no trace of them. Module
+%   files a domain loaded (use_module(library(lists))) stay loaded: the rest of the
+%   process uses them too; only their record of being loaded into Module goes.
 
 gw_drop_kb(Module) :-
     must_be(atom, Module),
     engine_forget(Module),
     (   retract(kb_module_(Module, _))
-    ->  forall(source_file_property(File, load_context(Module, _, _)),
+    ->  forall(( source_file_property(File, load_context(Module, _, _)),
+                 \+ source_file_property(File, module(_)) ),
                unload_file(File)),
         retractall(system:'$load_context_module'(_, Module, _)),
         '$destroy_module'(Module),

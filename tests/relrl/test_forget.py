@@ -15,7 +15,8 @@ from typing import Any
 
 import pytest
 
-from tests.conftest import ROOT
+from relrl.kb import KnowledgeBase
+from tests.conftest import ROOT, SIS
 
 CYCLES = 500
 WARM_UP = 20            #: cycles before the measure starts (caches, the learners' code)
@@ -47,3 +48,18 @@ def test_dropped_knowledge_bases_leave_nothing(cycles: dict[str, dict[str, Any]]
     assert figures["left_module"] == "[]", figures["module"]
     assert figures["left_globals"] == "[]"
     assert figures["left_clauses"] == "[]"
+
+
+def test_dropping_a_knowledge_base_leaves_the_libraries_it_loaded(tmp_path) -> None:
+    """A domain's use_module/1 of a library loaded before (lists) or by it alone (ugraphs):
+    dropping its knowledge base unloads the domain, never the libraries others use."""
+    domain = tmp_path / "d.pl"
+    domain.write_text(SIS.read_text() + ":- use_module(library(lists)).\n"
+                      ":- use_module(library(ugraphs)).\n"
+                      "edges(E) :- vertices_edges_to_ugraph([a, b], [a-b], G), edges(G, E).\n")
+    for _ in range(2):
+        with KnowledgeBase(domain) as kb:
+            assert kb.query("edges(E)")[0][0][0][2] == "[a-b]"
+    with KnowledgeBase(SIS) as kb:
+        solutions, _ = kb.query("lists:member(x, [x]), ugraphs:vertices_edges_to_ugraph([], [], G)")
+        assert solutions == [[("G", [], "[]")]]
