@@ -38,24 +38,27 @@ part(kept, 7).                      % Slot-Snapshot pairs (engine_keep/2)
 
 empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [])).
 
-record(KB, Record) :-
-    (   key_(KB, Key)
-    ->  nb_getval(Key, Record)
-    ;   must_be(atom, KB),
-        atom_concat('$relrl_kb:', KB, Key),
-        empty(Empty),
-        nb_setval(Key, Empty),
-        assertz(key_(KB, Key)),
-        nb_getval(Key, Record)
-    ).
+new_record(KB, Record) :-
+    must_be(atom, KB),
+    atom_concat('$relrl_kb:', KB, Key),
+    empty(Empty),
+    nb_setval(Key, Empty),
+    assertz(key_(KB, Key)),
+    nb_getval(Key, Record).
 
 %!  kb_get(+KB, +Part, -Value) is det.
 %
 %   Value is the Part of KB's record (the stored term itself). A part never set has its
 %   empty value: `none`, an empty memory, [] for the units and the kept snapshots.
+%
+%   (kb_get/3 and kb_set/3 look the record up themselves: they run some twenty times an
+%   ETG step, and a predicate of its own for the look-up cost 20 of its ~450 inferences.)
 
 kb_get(KB, Part, Value) :-
-    record(KB, Record),
+    (   key_(KB, Key)
+    ->  nb_getval(Key, Record)
+    ;   new_record(KB, Record)
+    ),
     (   part(Part, I)
     ->  arg(I, Record, Value)
     ;   domain_error(kb_part, Part)
@@ -66,7 +69,10 @@ kb_get(KB, Part, Value) :-
 %   Part of KB's record becomes a copy of Value.
 
 kb_set(KB, Part, Value) :-
-    record(KB, Record),
+    (   key_(KB, Key)
+    ->  nb_getval(Key, Record)
+    ;   new_record(KB, Record)
+    ),
     (   part(Part, I)
     ->  nb_setarg(I, Record, Value)
     ;   domain_error(kb_part, Part)

@@ -50,12 +50,6 @@ argument of every predicate names it. This module is the only one that stores pe
 %   wm/5 they want (State = wm(...)): a wm/5 pattern given to kb_get/3 would first be built
 %   on the global stack, every read.
 
-get(KB, State) :-
-    kb_get(KB, memory, State).
-
-put(KB, State) :-
-    kb_set(KB, memory, State).
-
 %!  wm_span(+KB, -Span) is det.
 %
 %   Span is the largest age an element of KB's memory can reach before it expires. The
@@ -63,7 +57,7 @@ put(KB, State) :-
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, Span0, _, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -87,16 +81,16 @@ domain_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, Elements, Now),
-    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
+    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
 %!  wm_clock(+KB, -Clock) is det.
 %
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, _, _, _).
 
 %!  wm_insert(+KB, +Elements:list) is det.
@@ -115,7 +109,7 @@ wm_insert(KB, New) :-
     ->  instantiation_error(E)
     ;   true
     ),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock0, Span0, Old, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -125,7 +119,7 @@ wm_insert(KB, New) :-
     Oldest is Clock - Span,
     stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
     keep_old(Old, New, Oldest, KeptPairs, KeptElements),
-    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
+    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
 %   The new memory is copied into the record (kb_set/3), never linked (nb_linkval/2 or
 %   nb_linkarg/3): a linked term is only as safe as every binding that built it, and a
@@ -161,7 +155,7 @@ keep_old([P|Ps], New, Oldest, Pairs, Elements) :-
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, _, _),
     member(Element-Stamp, Pairs),
     Age is Clock - Stamp.
@@ -172,7 +166,7 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     element_in(Element, Elements).
 
@@ -181,7 +175,7 @@ wm_has(KB, Element) :-
 %   once(wm_has(KB, Element)).
 
 wm_has_chk(KB, Element) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     memberchk(Element, Elements).
 
@@ -190,7 +184,7 @@ wm_has_chk(KB, Element) :-
 %   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
 
 wm_now(KB, Element) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, _, Now),
     element_in(Element, Now).
 
@@ -207,7 +201,7 @@ element_in(Element, Elements) :-
 %   (at(S, Place)) in KB's memory.
 
 wm_has_stimulus(KB, S) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     member(E, Elements),
     compound(E),
@@ -231,7 +225,7 @@ sense_name(at).
 %   pass over it (the state code's).
 
 wm_stamped(KB, Clock, Pairs) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, _, _).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
@@ -252,16 +246,16 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, Span, _, _, _),
-    put(KB, wm(0, Span, [], [], [])).
+    kb_set(KB, memory, wm(0, Span, [], [], [])).
 
 %!  wm_size(+KB, -Size:nonneg) is det.
 %
 %   Size is the number of elements in KB's memory.
 
 wm_size(KB, Size) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, Pairs, _, _),
     length(Pairs, Size).
 
@@ -275,7 +269,7 @@ wm_size(KB, Size) :-
 %   @error domain_error(working_memory_state, State) if State is not such a term.
 
 wm_state(KB, wm(Clock, Span, Pairs)) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, Span, Pairs, _, _).
 
 wm_set_state(KB, State) :-
@@ -283,7 +277,7 @@ wm_set_state(KB, State) :-
     (   State = wm(Clock, Span, Pairs), integer(Clock), is_list(Pairs),
         maplist(stamped, Pairs, Elements)
     ->  findall(E, ( member(E-S, Pairs), S =:= Clock ), Now),
-        put(KB, wm(Clock, Span, Pairs, Elements, Now))
+        kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now))
     ;   domain_error(working_memory_state, State)
     ).
 
