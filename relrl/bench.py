@@ -127,10 +127,13 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     import platform
 
     from relrl import __version__
+    from relrl.machine import machine_info
     from relrl.sim.policies import bench_step_rate
 
-    out: dict[str, Any] = {"relrl_version": __version__, "python": platform.python_version(),
-                           "cpus": os.cpu_count()}
+    # "experiment" and "machine_info" make the file a run record ``relrl report`` renders
+    out: dict[str, Any] = {"experiment": "bench", "relrl_version": __version__,
+                           "python": platform.python_version(), "cpus": os.cpu_count(),
+                           "machine_info": machine_info()}
     # Each learner's step is set against gateway calls timed right before and right after
     # it (their mean): a machine whose speed drifts during the run (other jobs, the clock)
     # moves both sides of each ratio together.

@@ -113,8 +113,8 @@ def provenance(run: Run, label: str) -> str:
     from relrl.machine import describe
 
     command = run.manifest.get("command") or run.results.get("command")
-    machine = run.timing.get("machine_info") or {"machine": run.timing.get("machine"),
-                                                  "python": run.timing.get("python")}
+    machine = (run.timing.get("machine_info") or run.results.get("machine_info")
+               or {"machine": run.timing.get("machine"), "python": run.timing.get("python")})
     when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
     line = f"*From `{label}/results.json`"
     if command:
@@ -285,6 +285,14 @@ def _sis_short(run: Run) -> str:
     return table(["learner", "CGI after run 1", "CGI final", "eye contacts", "positions"], rows)
 
 
+@view("sis", "curves")
+def _sis_curves(run: Run) -> str:
+    """Each learner's CGI curve, point by point (mean over the seeds), before learning first."""
+    rows = [[name, " ".join(f"{p['cgi_mean']:.2f}" for p in s["curve"])]
+            for name, s in run.results["summary"].items()]
+    return table(["learner", "CGI at each evaluation point (mean over the seeds)"], rows)
+
+
 # ---- Experiment 2 --------------------------------------------------------------------------
 
 
@@ -341,6 +349,59 @@ def _exp2_short(run: Run) -> str:
                  rows)
 
 
+# ---- relrl bench ------------------------------------------------------------------------
+
+
+@view("bench", "summary")
+def _bench_summary(run: Run) -> str:
+    """What ``relrl bench --json FILE`` measured: rates and ratios, each beside its target."""
+    r = run.results
+    learners = r["learners"]
+    rows: list[list[Any]] = [["one gateway call, one binding (median)",
+                              f"{r['gateway_call_us']:.1f} µs", "—"]]
+    for name in ("etg", "tg", "qlearning", "contingency"):
+        if name in learners:
+            f = learners[name]
+            rows.append([f"{name}: learning steps/s on the simulator (calls per step)",
+                         f"{f['steps_per_second']:,.0f} ({f['gateway_calls_per_step']:.2f})",
+                         "tg ≥ 3,000; ≤ 1.5 calls" if name == "tg" else "≤ 1.5 calls"])
+    etg = learners.get("etg", {})
+    if etg:
+        rows.append(["ETG agent step, in gateway calls' worth of time",
+                     f"{etg['step_in_gateway_calls']:.2f}", "≤ 3"])
+    rows.append(["tg's step against ETG's (CPU time)", _f(r.get("tg_step_in_etg_steps")),
+                 "≤ 2"])
+    by_size = r.get("tg_step_by_size", {}).get("ratio", {})
+    if by_size:
+        big = max(by_size, key=int)
+        rows.append([f"tg's learning step at P = {big} against P = 5",
+                     f"{by_size[big]:.2f}", "≤ 1.5"])
+    side = r.get("etg_prolog_side", {})
+    if "cpu_us_per_step" in side:
+        rows.append(["the Prolog side of an ETG step, plain swipl (inferences)",
+                     f"{side['cpu_us_per_step']:.1f} µs ({side['inferences_per_step']:.0f})",
+                     "—"])
+    rows.append(["simulator step() alone, steps/s",
+                 f"{r['sis_env_steps_per_second']['steps_per_second']:,.0f}", "—"])
+    for key, label in (("monitor", "ETG steps/s with the live monitor, against without"),
+                       ("recording", "a session's time units/s recording MCAP, against the "
+                                     "trace alone")):
+        part = r.get(key, {})
+        if "ratio" in part:
+            low, high = part.get("ratio_range", [None, None])
+            spread = f" (pairs {low:.2f}–{high:.2f})" if low is not None else ""
+            rows.append([label, f"{part['ratio']:.2f}{spread}", "≥ 0.9"])
+    photos = r.get("perception", {})
+    for key, label in (("fps_photos_320x240_cold", "perception, real photos 320x240, one "
+                                                   "thread, frames/s"),
+                       ("fps_photos_320x240_cold_2threads", "the same, two threads")):
+        if key in photos:
+            rows.append([label, f"{photos[key]:.1f}", "≥ 60"])
+    met = sum(bool(v) for v in r.get("targets", {}).values())
+    return (f"{r.get('cpus')} CPUs; {met} of {len(r.get('targets', {}))} targets met.\n\n"
+            + table(["what", "measured", "target"], rows))
+
+
 # ---- Worlds written in Prolog --------------------------------------------------------------
 
 
@@ -356,6 +417,20 @@ def _worlds_summary(run: Run) -> str:
             f"{cfg['eval_episodes']} episodes; a score is optimal / steps per episode (0 for "
             "a missed goal), the test sizes with no further learning.\n\n")
     return head + worlds_table(r)
+
+
+@view("worlds", "short")
+def _worlds_short(run: Run) -> str:
+    """Each task and learner: optimality on the training sizes and on the largest test size."""
+    r = run.results
+    train, test = r["config"]["train_sizes"], r["config"]["test_sizes"]
+    rows = [[f"{Path(x['world']).stem}: {x['task']}", x["learner"],
+             f"{x['train_optimality']:.3f} ({x['train_optimality_min']:.3f})",
+             _f(x["test"][str(max(test))]["optimality"], 3), _f(x["memory_positions"], 0)]
+            for x in r["summary"]]
+    return table(["world: task", "learner",
+                  f"of optimal, {min(train)}–{max(train)} blocks (worst seed)",
+                  f"{max(test)} blocks, no learning", "memory (positions)"], rows)
 
 
 @view("worlds", "cost")
@@ -453,24 +528,44 @@ def _scaling_summary(run: Run) -> str:
                          "final CGI", "memory (positions)", "candidate tests per leaf"], rows)
 
 
-@view("scaling", "transfer")
-def _scaling_transfer(run: Run) -> str:
+def _transfer_of(run: Run) -> tuple[dict[str, Any], str]:
+    """A scaling run's transfer summary, and what was transferred, in words."""
     r = run.results
     transfer = r["summary"].get("transfer", {})
     if not transfer:
         raise UserError(f"{run.path / 'results.json'}: no transfer jobs in this run")
     kind = r["config"].get("transfer")
+    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, then acting with no "
+                     "learning in each world", "places": "places held out while learning",
+            "kinds": "toy kinds held out while learning"}.get(kind, str(kind))
+    return transfer, what
+
+
+@view("scaling", "transfer")
+def _scaling_transfer(run: Run) -> str:
+    transfer, what = _transfer_of(run)
     rows = []
     for learner, by_size in transfer.items():
         for size in _sizes(by_size):
             s = by_size[size]
             rows.append([learner, int(size), _f(s.get("cgi_trained")), _f(s.get("cgi_unseen")),
                          f"{s['seeds']}"])
-    what = {"sizes": f"learned at P = {r['config'].get('transfer_from')}, then acting with no "
-                     "learning in each world", "places": "places held out while learning",
-            "kinds": "toy kinds held out while learning"}.get(kind, kind)
     return (f"Zero-shot transfer ({what}).\n\n"
             + table(["learner", "places P", "CGI trained", "CGI unseen", "seeds"], rows))
+
+
+@view("scaling", "transfer-short")
+def _scaling_transfer_short(run: Run) -> str:
+    """Transfer in one row per learner: the CGI trained → unseen at each size."""
+    transfer, what = _transfer_of(run)
+    rows = []
+    for learner, by_size in transfer.items():
+        sizes = _sizes(by_size)
+        rows.append([learner, what, ", ".join(sizes), " · ".join(
+            f"{_f(by_size[p].get('cgi_trained'))} → {_f(by_size[p].get('cgi_unseen'))}"
+            for p in sizes)])
+    return table(["learner", "zero-shot transfer", "places P",
+                  "CGI trained → unseen (no learning), per P"], rows)
 
 
 @view("scaling", "short")

@@ -100,6 +100,8 @@ def test_relrl_check_from_another_folder(installed) -> None:
     proc = _run([installed["relrl"], "check", "examples/domains/fruits.pl"], installed)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines()[-1] == "ok: examples/domains/fruits.pl is valid"
+    proc = _run([installed["relrl"], "check", "--world", "examples/worlds/blocks.pl"], installed)
+    assert proc.returncode == 0, proc.stderr
     bad = installed["work"] / "bad.pl"
     bad.write_text("stimulus(face).\nresponse(look(centre)).\nfoo(X) :- bar(.\n")
     proc = _run([installed["relrl"], "check", "bad.pl"], installed)

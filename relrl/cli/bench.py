@@ -59,6 +59,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         figures = bench_all(steps=args.steps, perception=not args.no_perception,
                             faces=not args.no_faces)
+        figures["command"] = args.command_line
         _print(figures)
     if path is not None:
         write_json_atomic(path, figures)

@@ -7,17 +7,18 @@ from pathlib import Path
 
 __all__ = ["EXAMPLE", "HELP", "add_arguments", "run"]
 
-HELP = "list the example domains, episodes and head calibrations relrl ships; copy them"
+HELP = "list the example domains, episodes, head calibrations and worlds relrl ships; copy them"
 EXAMPLE = "relrl examples --copy . && relrl check examples/domains/fruits.pl"
 
 #: the kinds of shipped example files, by folder.
-_KINDS = {"domains": "*.pl", "episodes": "*.toml", "heads": "*.toml"}
+_KINDS = {"domains": "*.pl", "episodes": "*.toml", "heads": "*.toml", "worlds": "*.pl"}
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl examples``."""
     parser.add_argument("--copy", metavar="DIR",
-                        help="copy the examples into DIR/examples (DIR/examples must not exist)")
+                        help="copy the examples into DIR/examples (DIR is made if missing; "
+                             "DIR/examples must not exist)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -35,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
         print("copy them here with: relrl examples --copy .")
         return 0
     target_dir = Path(args.copy)
-    if not target_dir.is_dir():
+    if target_dir.exists() and not target_dir.is_dir():
         raise ConfigError(f"--copy {args.copy}: not a folder")
     target = target_dir / "examples"
     if target.exists():

@@ -41,6 +41,13 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
     assert rec["mcap_bytes_per_unit"] > 0
     assert "recording_units_ratio>=0.9" in figures["targets"]
     assert "steps_per_second" in capsys.readouterr().out
+    # the file is a run record: relrl report renders it with the command that made it
+    path.rename(tmp_path / "results.json")
+    from relrl.report import load_run, render
+
+    text = render(load_run(tmp_path), "summary", "bench")
+    assert f"{figures['learners']['tg']['steps_per_second']:,.0f} (1.00)" in text
+    assert "made by `relrl bench --no-perception --steps 200 --json" in text
 
 
 def test_perception_photo_target_line(monkeypatch) -> None:
