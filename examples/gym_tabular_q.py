@@ -18,8 +18,8 @@ from collections import defaultdict
 import gymnasium as gym
 import numpy as np
 
-from relrl.sim import evaluate  # importing relrl.sim registers relrl/SharedAttention-v0, -v1
-from relrl.sim.wrappers import RelationalObservation, relational_facts
+from relrl.sim import World, evaluate  # importing relrl.sim registers the environments
+from relrl.sim.wrappers import RelationalObservation, RelationalView
 
 
 def key(obs) -> tuple:
@@ -62,13 +62,18 @@ def main(argv: list[str] | None = None) -> dict:
     q = train(env, args.steps, args.seed)
     n = env.action_space.n
 
+    env.close()
+    view = RelationalView(World(**world)) if args.relational else None
+
     def greedy(obs, info):
-        state = relational_facts(info["percepts"]) if args.relational else key(obs)
+        state = view(info["percepts"]) if view is not None else key(obs)
         values = q.get(state)
         return int(np.argmax(values)) if values is not None else 0   # unseen: look at the face
 
     # the protocol of relrl's experiments: 10 runs x 500 time units, no learning
     result = evaluate(greedy, world=world, runs=10, steps=500, seed=args.seed, observation=1)
+    if view is not None:
+        view.close()
     print(f"tabular Q-learning, {args.steps:,} time units, P={args.places}"
           f"{', relational keys' if args.relational else ''}: {len(q):,} table rows "
           f"({len(q) * n:,} positions)")

@@ -8,7 +8,7 @@ The public surface::
     SceneView, render              # the synthetic camera's scene and renderer
     open_camera(src) -> Camera     # 0, cam://0, video file, folder, synthetic://
     ART2, FruitNamer               # colour categories named by a caregiver (Table 1)
-    PLACES, POSES, COLOURS         # the shared vocabulary
+    PLACES, POSES, COLOURS, HUES   # the shared vocabulary
     bench(...) -> dict             # speed and face-detection figures
 
 Heavy imports (OpenCV) happen on first use, so importing this package is cheap.
@@ -23,6 +23,7 @@ __all__ = [
     # colour naming
     "ART2",
     "COLOURS",
+    "HUES",
     # vocabulary
     "PLACES",
     "POSES",
@@ -44,7 +45,8 @@ _WHERE = {
     "format_fact": "perception.facts", "SceneView": "perception.render",
     "render": "perception.render", "open_camera": "perception.camera",
     "ART2": "perception.art2", "FruitNamer": "perception.art2",
-    "PLACES": "perception.vocab", "POSES": "perception.vocab", "COLOURS": "perception.vocab",
+    "PLACES": "perception.vocabulary", "POSES": "perception.vocabulary",
+    "COLOURS": "perception.vocabulary", "HUES": "perception.vocabulary",
 }
 
 

@@ -27,9 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from perception.camera import Camera
 from perception.errors import CameraError
 from perception.imagesize import check_frame_size
+from perception.source import Camera
 
 __all__ = ["IMAGE_TYPES", "BagCamera", "parse_bag_source"]
 

@@ -44,7 +44,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from perception.vocab import GAZE_POSE, PLACES
+from perception.vocabulary import GAZE_POSE, PLACES
 
 __all__ = ["FreeCoresPool", "bench", "interaction_views", "lfw_figures", "pose_figures"]
 
@@ -207,7 +207,7 @@ def pose_figures(pool=None) -> dict[str, int]:
     executor of a pooled search (the same faces as without)."""
     from perception.faces import FaceTracker
     from perception.render import SceneView, render
-    from perception.vocab import POSES
+    from perception.vocabulary import POSES
 
     tracker = FaceTracker(pool=pool)
     right = 0

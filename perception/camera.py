@@ -25,17 +25,17 @@ Every source is a context manager; ``read()`` returns the next BGR frame or ``No
 
 from __future__ import annotations
 
-import abc
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
-from typing import Self
 from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 
+from perception.bag import BagCamera, parse_bag_source
 from perception.errors import CameraError, ImageError
 from perception.imagesize import check_frame_size, header_size
 from perception.render import SceneView, render
+from perception.source import Camera
 
 __all__ = ["SOURCES", "Camera", "SyntheticCamera", "open_camera", "read_image"]
 
@@ -76,38 +76,6 @@ def _cv_reason(exc: Exception) -> str:
     """The one useful line of an OpenCV error."""
     lines = [x.strip() for x in str(exc).splitlines() if x.strip()]
     return lines[-1] if lines else type(exc).__name__
-
-
-class Camera(abc.ABC):
-    """Base class of camera sources: override :meth:`read` and, if needed, :meth:`_release`."""
-
-    name = "camera"
-
-    def __init__(self) -> None:
-        self._closed = False
-
-    @abc.abstractmethod
-    def read(self) -> np.ndarray | None:
-        """The next BGR frame, or ``None`` when the source has no more."""
-
-    def _release(self) -> None:  # noqa: B027 - an optional hook
-        """Free the device (called once by :meth:`close`)."""
-
-    def close(self) -> None:
-        """Release the source; safe to call twice."""
-        if not self._closed:
-            self._closed = True
-            self._release()
-
-    def __enter__(self) -> Self:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def __iter__(self) -> Iterator[np.ndarray]:
-        while (frame := self.read()) is not None:
-            yield frame
 
 
 class _Capture(Camera):
@@ -237,8 +205,6 @@ def _webcam(rest: str) -> Camera:
 def _recording(path: str) -> Camera:
     """Every frame of a session folder's ``session.mcap``, in order (not paced: perception
     run again on what the robot saw)."""
-    from perception.bag import BagCamera
-
     folder = Path(path)
     if (folder / "session.mcap").is_file():
         return BagCamera(folder / "session.mcap", paced=False)
@@ -250,8 +216,6 @@ def _recording(path: str) -> Camera:
 
 
 def _bag(source: str) -> Camera:
-    from perception.bag import BagCamera, parse_bag_source
-
     path, topic = parse_bag_source(source)
     return BagCamera(path, topic)
 

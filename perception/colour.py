@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from perception.vocab import COLOURS
+from perception.vocabulary import HUES
 
 __all__ = ["ColourSummary", "colour_name", "colour_summary", "hsi"]
 
@@ -29,7 +29,7 @@ class ColourSummary:
         hue: most frequent HSI hue in degrees (0..360), ``None`` when the area is grey.
         saturation: median HSI saturation (0..1) of the pixels near the modal hue.
         intensity: median HSI intensity (0..1) of the area.
-        name: colour name from :data:`perception.vocab.COLOURS`, or ``None``.
+        name: colour name from :data:`perception.vocabulary.COLOURS`, or ``None``.
     """
 
     r: int
@@ -56,11 +56,11 @@ def hsi(pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def colour_name(hue: float | None) -> str | None:
-    """The name of a hue (degrees) from :data:`COLOURS`; ``None`` for no hue."""
+    """The name of a hue (degrees) from :data:`perception.vocabulary.HUES`; ``None`` for no hue."""
     if hue is None:
         return None
     h = hue % 360.0
-    for name, (lo, hi) in COLOURS.items():
+    for name, (lo, hi) in HUES.items():
         if (lo <= h < hi) if lo < hi else (h >= lo or h < hi):
             return name
     return None  # pragma: no cover - the ranges cover the circle

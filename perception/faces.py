@@ -19,7 +19,7 @@ Detection (a small real-time tracker rather than a brute-force search):
   half the wall time on two free cores. A face found cancels the later cascades' tasks not yet
   started.
 
-Pose (classes of :data:`perception.vocab.POSES`, in the image's frame):
+Pose (classes of :data:`perception.vocabulary.POSES`, in the image's frame):
 
 * a profile-cascade face is ``left_2`` (nose to image-left) or ``right_2``, with a nominal pan
   of -/+ 70 degrees;
@@ -84,7 +84,7 @@ class Face:
     Attributes:
         box: ``(x, y, w, h)``.
         detector: ``"frontal"``, ``"profile"`` (nose to image-left) or ``"profile_mirrored"``.
-        pose: one of :data:`perception.vocab.POSES`.
+        pose: one of :data:`perception.vocabulary.POSES`.
         pan: degrees, positive with the nose to the image's right.
         tilt: degrees, negative looking down.
     """

@@ -19,7 +19,7 @@ import numpy as np
 from perception.appearance import Appearance, Variation
 from perception.art2 import OUTCOMES, ART2Params, FruitNamer, colour_features
 from perception.render import SceneView, render
-from perception.vocab import OBJECT_PLACES
+from perception.vocabulary import OBJECT_PLACES
 
 __all__ = ["FRUITS", "confusion_table", "fruit_session", "table1"]
 

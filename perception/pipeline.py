@@ -16,7 +16,7 @@ process or on the same machine competes for them).
 ``at(object, Place)`` is the place the head looks at when the caller says so
 (``looking_at=...``, the robot knows where its head points); otherwise it is read from where the
 area is in the image: thirds across (left, centre column, right) and halves down, giving one of
-:data:`perception.vocab.PLACES` (upper middle is ``centre``).
+:data:`perception.vocabulary.PLACES` (upper middle is ``centre``).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ from perception.faces import Face, FaceParams, FaceTracker
 from perception.facts import Fact
 from perception.imagesize import check_frame_size
 from perception.saliency import SaliencyParams, SalientArea, most_salient, saliency_map
-from perception.vocab import PLACES
+from perception.vocabulary import PLACES
 
 __all__ = ["Perceiver", "Percept", "annotate", "perceive"]
 

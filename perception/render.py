@@ -5,8 +5,8 @@ which toy or fruit is at which place, the light) and :func:`render` draws a BGR 
 real perception pipeline then reads, so a simulated episode runs on real pixels.
 
 Looking at ``centre`` shows the caregiver (head and shoulders) in one of the six poses of
-:data:`perception.vocab.POSES`; looking at any other place shows the object at that place on the
-wall or the table, or the empty background.
+:data:`perception.vocabulary.POSES`; looking at any other place shows the object at that
+place on the wall or the table, or the empty background.
 
 How the faces are drawn (and why the real detector finds them): the frontal, slightly turned
 (``left_1``/``right_1``) and ``down`` faces are cartoon faces -- a skin ellipse with dark eyes,
@@ -27,7 +27,7 @@ import numpy as np
 
 from perception.appearance import Appearance, FruitLook, blur_kernel
 from perception.errors import PerceptionError
-from perception.vocab import COLOURS, OBJECT_PLACES, PLACES, POSES
+from perception.vocabulary import COLOURS, OBJECT_PLACES, PLACES, POSES
 
 __all__ = ["OBJECT_KINDS", "SceneView", "render"]
 
@@ -45,11 +45,11 @@ class SceneView:
     """What the camera sees: filled in by the simulator, drawn by :func:`render`.
 
     Attributes:
-        looking_at: the place the head looks at (one of :data:`perception.vocab.PLACES`).
+        looking_at: the place the head looks at (one of :data:`perception.vocabulary.PLACES`).
         face_pose: the caregiver's head pose (one of :data:`POSES`), or ``None`` when nobody
             is there; only drawn when ``looking_at == "centre"``.
         objects: place -> object kind (``apple``, ``lemon``, ``orange``, ``lime``) or a colour
-            name (a toy block of that colour, see :data:`perception.vocab.COLOURS`).
+            name (a toy block of that colour, see :data:`perception.vocabulary.COLOURS`).
         lighting: brightness gain of the scene light (1.0 normal, 0.5 dim, 1.4 bright).
         seed: seeds the small random parts (object jitter, sensor noise, light tint).
         appearance: how a camera in a real room sees the scene (light colour and white

@@ -1,11 +1,11 @@
 """The vocabulary every package of the project shares: places, head poses, colours, fruits, and
 what each world perceives.
 
-Perception owns the percept vocabulary: this module imports nothing but the standard library
-(importing it does not import OpenCV or numpy), so ``head`` reads its place names from here
-without importing relrl, and ``relrl.vocabulary`` re-exports it for relrl's users. Everything
-is in the robot's frame: ``left`` is the robot's left, which is also the left of the camera
-image.
+Perception owns the percept vocabulary, and this is its one module: it imports nothing but
+the standard library (importing it does not import OpenCV or numpy), so ``head`` reads its
+place names from here without importing relrl, and relrl reads them from here too.
+Everything is in the robot's frame: ``left`` is the robot's left, which is also the left of
+the camera image.
 
 Places and poses
     :data:`PLACES` are where the head can look, ``centre`` (the caregiver's face) first; the
@@ -42,6 +42,7 @@ __all__ = [
     "COLOURS",
     "FRUIT_COLOURS",
     "GAZE_POSE",
+    "HUES",
     "OBJECT_PLACES",
     "PLACES",
     "POSES",
@@ -73,8 +74,18 @@ GAZE_POSE: dict[str, str] = {
 #: when it looks at the robot.
 SIS_POSES: tuple[str, ...] = ("frontal",) + OBJECT_PLACES
 
+#: the colour names perception gives a salient object, with the HSI hue range (degrees,
+#: start inclusive) each covers when saturated.
+HUES: dict[str, tuple[float, float]] = {
+    "red": (340.0, 14.0),
+    "orange": (14.0, 40.0),
+    "yellow": (40.0, 70.0),
+    "green": (70.0, 170.0),
+    "blue": (170.0, 260.0),
+    "purple": (260.0, 340.0),
+}
 #: the colour names perception gives a salient object.
-COLOURS: tuple[str, ...] = ("red", "orange", "yellow", "green", "blue", "purple")
+COLOURS: tuple[str, ...] = tuple(HUES)
 #: the colour of each fruit of experiment 2.
 FRUIT_COLOURS: dict[str, str] = {"apple": "red", "orange": "orange", "lemon": "yellow",
                                  "lime": "green"}

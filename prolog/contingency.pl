@@ -242,6 +242,13 @@ contingency_size(KB, size(Rules, Rules)) :-
 %   ---- The engine's hooks (see engine.pl) ------------------------------------------------
 
 relrl_engine:learner(contingency).
+relrl_engine:learner_property(contingency, Cap) :-
+    member(Cap, [size, text, knowledge, policy, snapshot]).
+
+relrl_engine:learner_forget(contingency, KB) :-
+    retractall(learned_(KB, _, _, _, _)),
+    retractall(authored_(KB, _, _, _, _)),
+    retractall(matched_(KB, _)).
 
 relrl_engine:learner_init(contingency, KB, _Params) :-
     contingency_init(KB).

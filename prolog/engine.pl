@@ -14,7 +14,7 @@
             engine_resume/2,          % +KB, +Slot
             engine_reseed/2,          % +KB, +Seed
             engine_forget/1,          % +KB
-            engine_park/0,
+            engine_pause/0,
             engine_claim_random/1,    % +KB
             engine_param/3,           % +KB, ?Name, ?Value
             engine_params/2,          % +KB, -Params
@@ -38,7 +38,7 @@
 :- use_module(state).
 :- use_module(motivation).
 :- use_module(rules).
-:- use_module(gvar).
+:- use_module(kbstate).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The control step, inside Prolog
@@ -81,13 +81,20 @@ Each knowledge base owns its random stream, so two agents in one process give th
 trajectories as each alone. Learners just use library(random): SWI-Prolog has one random
 generator (per thread), and the engine keeps in it the stream of the knowledge base that
 stepped last, swapping only when another knowledge base steps (a robot stepping one agent
-never saves or restores the generator's 2.5 KB state). Anything else that may draw numbers
-first puts that stream away with engine_park/0: the engine's other predicates that touch
-the generator do, and so does relrl's gateway before every call that is not a step (a
-user's query, loading a file, keep and resume, ...). A Prolog program that calls
-engine_step/6 itself and draws numbers of its own between steps calls engine_park/0 first.
-A step that raises an error leaves the stream where the step stopped (as it leaves working
-memory and the learner).
+never saves or restores the generator's 2.5 KB state). The engine's own predicates that
+touch the generator first put that stream away with its knowledge base (park/0).
+
+## Between steps
+
+Two things a step keeps from the last one must be let go of before anything else runs:
+the random stream the generator holds, and the check that the domain's rules still read
+some facts straight off working memory (relrl_state:state_touch/0). engine_pause/0 does
+both. relrl's gateway calls it before every call that is not a step (a goal, a user's
+query or its next answer, loading a file, keep and resume, ...), so no caller of the
+gateway has a rule to follow; a Prolog program that calls engine_step/6 itself calls it
+before it draws random numbers of its own or changes rules between steps. A step that
+raises an error leaves the stream where the step stopped (as it leaves working memory
+and the learner).
 
 ## Errors
 
@@ -101,6 +108,7 @@ gateway can name the rule.
     learner/1,
     learner_property/2,
     learner_init/3,
+    learner_forget/2,
     learner_state/4,
     learner_choose/7,
     learner_update/3,
@@ -117,25 +125,23 @@ gateway can name the rule.
     learner_snapshot/3,
     learner_resume/3.
 
-%   Each knowledge base's engine lives in one global variable, '$relrl_engine:KB' (per KB,
-%   so one KB never sees another's), holding engine(Run, Prev, Random):
+%   Each knowledge base's engine is the `engine` part of its record (kbstate.pl), so one
+%   knowledge base never sees another's: engine(Run, Prev, Random), where
 %     Run = run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
-%               Necessities, Plan) — fixed for a run, read without copying; Plan is the
-%               state code's plan (relrl_state:state_plan/4), or relational(Plan) for a
+%               Necessities, Plan, Caps) — fixed for a run, read without copying; Plan is
+%               the state code's plan (relrl_state:state_plan/4), or relational(Plan) for a
 %               learner that reads the relational view only (the plan then only tells
-%               whether a reinforcer is sensed)
+%               whether a reinforcer is sensed); Caps the learner's capabilities
+%               (learner_property/2), checked when the run was configured
 %     Prev    prev(State, Necessity) of the last step, or none
 %     Random  the KB's random state, while the generator does not hold it (see
 %             random_owner/1: while it does, the generator's state is the KB's)
 %   Prev is replaced in place (nb_setarg/3) every step; eng(Prev, Random) is how the rest
 %   of this module sees the pair (eng/2 gives the stream as it is now).
 
-engine_key(KB, Key) :-
-    gvar_key('$relrl_engine:', KB, Key).
-
 engine(KB, Engine) :-
-    engine_key(KB, Key),
-    (   nb_current(Key, Engine0)
+    kb_get(KB, engine, Engine0),
+    (   Engine0 \== none
     ->  Engine = Engine0
     ;   existence_error(engine_configuration, KB)
     ).
@@ -163,25 +169,32 @@ set_stream(KB, Engine, Random) :-
     ),
     nb_setarg(3, Engine, Random).
 
-%   The generator holds Owner's stream (the KB that stepped last), or that of none.
+%   The generator holds Owner's stream (the KB that stepped last), or that of none: the
+%   one process-wide global of the engine (there is one generator per thread).
 random_owner(Owner) :-
     nb_current(relrl_random_owner, Owner).
 
 :- initialization(nb_setval(relrl_random_owner, none)).
 
-%!  engine_park is det.
+%!  engine_pause is det.
 %
-%   Put the stream the random generator holds (the knowledge base's that stepped last)
-%   away with its knowledge base, so that numbers drawn before the next step of any
-%   knowledge base draw from no knowledge base's stream. relrl's gateway calls it before
-%   every call that is not a control step; the engine's own predicates that need the
-%   generator do too.
+%   Something other than a control step may run now: the stream the random generator
+%   holds (the knowledge base's that stepped last) goes back to its knowledge base, so
+%   that numbers drawn before the next step of any knowledge base draw from no knowledge
+%   base's stream, and the next step checks again which facts it may read straight off
+%   working memory (relrl_state:state_touch/0: the rules may change meanwhile).
 
-engine_park :-
+engine_pause :-
+    park,
+    state_touch.
+
+%   Put the stream the generator holds away with its knowledge base.
+park :-
     (   random_owner(Owner),
         Owner \== none
-    ->  (   engine_key(Owner, Key),
-            nb_current(Key, Engine)
+    ->  (   kb_record_exists(Owner),
+            kb_get(Owner, engine, Engine),
+            Engine \== none
         ->  random_property(state(Random)),
             nb_setarg(3, Engine, Random)
         ;   true
@@ -204,7 +217,7 @@ engine_claim_random(KB) :-
 claim_random(KB, Engine) :-
     (   random_owner(KB)
     ->  true
-    ;   engine_park,
+    ;   park,
         arg(3, Engine, Random),
         set_random(state(Random)),
         nb_setval(relrl_random_owner, KB)
@@ -215,7 +228,7 @@ claim_random(KB, Engine) :-
 %   The learner KB's engine was configured with.
 
 engine_learner(KB, Learner) :-
-    run(KB, run(Learner, _, _, _, _, _, _, _, _)).
+    run(KB, run(Learner, _, _, _, _, _, _, _, _, _)).
 
 %!  engine_param(+KB, ?Name, ?Value) is nondet.
 %!  engine_param(+KB, +Name, -Value) is semidet.
@@ -223,7 +236,7 @@ engine_learner(KB, Learner) :-
 %   A parameter of KB's learner (alpha, gamma, epsilon, ...).
 
 engine_param(KB, Name, Value) :-
-    run(KB, run(_, Params, _, _, _, _, _, _, _)),
+    run(KB, run(_, Params, _, _, _, _, _, _, _, _)),
     (   atom(Name)
     ->  memberchk(Name=Value, Params)
     ;   member(Name=Value, Params)
@@ -234,7 +247,7 @@ engine_param(KB, Name, Value) :-
 %   The learner's parameters, Name=Value (what learners read in every step).
 
 engine_params(KB, Params) :-
-    run(KB, run(_, Params, _, _, _, _, _, _, _)).
+    run(KB, run(_, Params, _, _, _, _, _, _, _, _)).
 
 %!  engine_config(+KB, ?Key, ?Value) is nondet.
 %!  engine_config(+KB, +Key, -Value) is semidet.
@@ -245,7 +258,7 @@ engine_params(KB, Params) :-
 
 engine_config(KB, Key, Value) :-
     run(KB, run(Learner, Params, Features, Responses, Units, Reinforcers, Constraints,
-                Necessities, _)),
+                Necessities, _, _)),
     (   Constraints == true
     ->  HasConstraints = true
     ;   HasConstraints = false
@@ -263,7 +276,7 @@ engine_config(KB, Key, Value) :-
 %   The responses in the order engine_step/6 indexes them.
 
 engine_responses(KB, Responses) :-
-    run(KB, run(_, _, _, Responses, _, _, _, _, _)).
+    run(KB, run(_, _, _, Responses, _, _, _, _, _, _)).
 
 %!  engine_all_allowed(+KB, +Allowed:list) is semidet.
 %
@@ -273,8 +286,7 @@ engine_responses(KB, Responses) :-
 %   then. Fails when it is not, or when KB has no engine.
 
 engine_all_allowed(KB, Allowed) :-
-    engine_key(KB, Key),
-    nb_current(Key, engine(run(_, _, _, Responses, _, _, _, _, _), _, _)),
+    kb_get(KB, engine, engine(run(_, _, _, Responses, _, _, _, _, _, _), _, _)),
     Responses == Allowed.
 
 %!  engine_necessities(+KB, -Necessities:list) is det.
@@ -282,7 +294,7 @@ engine_all_allowed(KB, Allowed) :-
 %   The necessities in declaration order (the order of a step's unit outputs).
 
 engine_necessities(KB, Necessities) :-
-    run(KB, run(_, _, _, _, _, _, _, Necessities, _)).
+    run(KB, run(_, _, _, _, _, _, _, Necessities, _, _)).
 
 %!  engine_configure(+KB, +Learner, +Params:list, +Seed) is det.
 %
@@ -290,7 +302,11 @@ engine_necessities(KB, Necessities) :-
 %   Working memory, the necessity units and the learner start afresh. Seed, an integer,
 %   seeds KB's own random stream; `none` gives it a stream seeded from the clock.
 %
+%   A learner configured before in KB forgets what it kept (learner_forget/2).
+%
 %   @error domain_error(learner, Learner) if no learner of that name is registered.
+%   @error learner_hooks(Learner, Problems) if Learner lacks a hook it must have or
+%   declares (see learner_capabilities/2).
 
 engine_configure(KB, Learner, Params, Seed) :-
     must_be(atom, KB),
@@ -301,6 +317,8 @@ engine_configure(KB, Learner, Params, Seed) :-
     ;   findall(L, learner(L), Known),
         domain_error(learner(Known), Learner)
     ),
+    learner_capabilities(Learner, Caps),
+    forget_learner(KB),
     state_features(KB, Features),
     findall(R, kb_response(KB, R), Responses),
     findall(S, kb_reinforcer(KB, S), Reinforcers),
@@ -310,7 +328,7 @@ engine_configure(KB, Learner, Params, Seed) :-
     motivation_units(KB, Units0),
     motivation_compiled(KB, Units0, Units),
     state_plan(KB, Features, Reinforcers, Plan0),
-    (   learner_property(Learner, view(relational))
+    (   memberchk(view(relational), Caps)
     ->  Plan = relational(Plan0)
     ;   Plan = Plan0
     ),
@@ -319,13 +337,12 @@ engine_configure(KB, Learner, Params, Seed) :-
     ;   Constraints = none                            % no constraint rules: all allowed
     ),
     fresh_random(Seed, Random),
-    engine_key(KB, Key),
-    nb_setval(Key, engine(run(Learner, Params, Features, Responses, Units, Reinforcers,
-                              Constraints, Necessities, Plan),
-                          none, Random)),
+    kb_set(KB, engine, engine(run(Learner, Params, Features, Responses, Units, Reinforcers,
+                                  Constraints, Necessities, Plan, Caps),
+                              none, Random)),
     wm_clear(KB),
     motivation_reset(KB),
-    with_random(KB, learner_init(Learner, KB, Params)),
+    with_random(KB, hook(learner_init(Learner, KB, Params))),
     rules_forget(KB, RulesMark),
     state_forget(KB, StateMark).
 
@@ -342,7 +359,7 @@ has_constraints(KB) :-
     ).
 
 fresh_random(Seed, Random) :-
-    engine_park,
+    park,
     (   integer(Seed)
     ->  set_random(seed(Seed))
     ;   Seed == none
@@ -374,31 +391,141 @@ engine_reseed(KB, Seed) :-
 
 engine_end_episode(KB) :-
     engine(KB, Engine),
-    arg(1, Engine, run(Learner, _, _, _, _, _, _, _, _)),
+    arg(1, Engine, run(Learner, _, _, _, _, _, _, _, _, Caps)),
     nb_setarg(2, Engine, none),
     wm_clear(KB),
     motivation_reset(KB),
-    (   learner_end_episode(Learner, KB)
-    ->  true
+    (   memberchk(end_episode, Caps)
+    ->  hook(learner_end_episode(Learner, KB))
     ;   true
     ).
 
 %!  engine_forget(+KB) is det.
 %
-%   Forget KB's engine (its configuration, last step, random stream and compiled rules).
+%   Forget everything relrl keeps for KB: what its learner kept (learner_forget/2), its
+%   record (engine, working memory, units, learner, tree, kept snapshots; kbstate.pl),
+%   its random stream, its state plans and compiled rules.
 
 engine_forget(KB) :-
-    engine_key(KB, Key),
-    (   nb_current(Key, _)
-    ->  nb_delete(Key)
-    ;   true
-    ),
+    must_be(atom, KB),
+    forget_learner(KB),
     (   random_owner(KB)
     ->  nb_setval(relrl_random_owner, none)
     ;   true
     ),
+    kb_forget(KB),
     state_forget(KB),
     rules_forget(KB).
+
+%   The learner configured in KB (if any) forgets what it keeps outside the record.
+forget_learner(KB) :-
+    (   kb_record_exists(KB),
+        kb_get(KB, engine, engine(run(Learner, _, _, _, _, _, _, _, _, _), _, _))
+    ->  hook(learner_forget(Learner, KB)),
+        kb_set(KB, learner, none),
+        kb_set(KB, tree, none)
+    ;   true
+    ).
+
+%   ---- Learners' capabilities --------------------------------------------------------------
+
+%!  learner_capabilities(+Learner, -Caps:list) is det.
+%
+%   Caps are Learner's declared properties (learner_property/2), once its hooks are
+%   checked: every learner has learner_init/3, learner_forget/2, learner_update/3 and
+%   learner_explain/5, and learner_choose/7 unless it is `external`; it has the hooks of
+%   each capability it declares (capability_hooks/2), and no clause of an optional hook it
+%   does not declare (a hook the engine would never call is a mistake, not a default).
+%
+%   @error learner_hooks(Learner, Problems) listing missing(Hook) and
+%   undeclared(Capability, Hook) problems.
+
+learner_capabilities(Learner, Caps) :-
+    findall(P, learner_property(Learner, P), Caps0),
+    sort(Caps0, Caps),
+    (   memberchk(external, Caps)
+    ->  Required = [learner_init/3, learner_forget/2, learner_update/3, learner_explain/5]
+    ;   Required = [learner_init/3, learner_forget/2, learner_update/3, learner_explain/5,
+                    learner_choose/7]
+    ),
+    findall(missing(H), ( member(H, Required), \+ has_hook(Learner, H) ), Missing),
+    findall(Problem,
+            ( capability_hooks(Cap, Hooks),
+              member(H, Hooks),
+              (   memberchk(Cap, Caps)
+              ->  \+ has_hook(Learner, H),
+                  Problem = missing(H)
+              ;   has_hook(Learner, H),
+                  Problem = undeclared(Cap, H)
+              ) ),
+            Declared),
+    append(Missing, Declared, Problems),
+    (   Problems == []
+    ->  true
+    ;   throw(error(learner_hooks(Learner, Problems), _))
+    ).
+
+%!  capability_hooks(?Capability, ?Hooks:list) is nondet.
+%
+%   The optional hooks a learner has when it declares learner_property(Name, Capability).
+
+capability_hooks(state, [learner_state/4]).
+capability_hooks(size, [learner_size/3]).
+capability_hooks(policy, [learner_save/3, learner_restore/3, learner_policy_term/2]).
+capability_hooks(policy_info, [learner_policy_info/3]).
+capability_hooks(text, [learner_text/3]).
+capability_hooks(graph, [learner_graph/3]).
+capability_hooks(knowledge, [learner_knowledge/3]).
+capability_hooks(end_episode, [learner_end_episode/2]).
+capability_hooks(snapshot, [learner_snapshot/3, learner_resume/3]).
+
+%   Learner has a clause of hook Name/Arity (its first argument is the learner's name).
+has_hook(Learner, Name/Arity) :-
+    functor(Head, Name, Arity),
+    arg(1, Head, Learner),
+    \+ \+ clause(Head, _).
+
+%   Call a learner's hook, which must succeed: a hook that fails is an error naming it
+%   (an exception it raises goes on as it is).
+hook(Goal) :-
+    (   call(Goal)
+    ->  true
+    ;   functor(Goal, Name, Arity),
+        arg(1, Goal, Learner),
+        hook_failed(Learner, Name/Arity)
+    ).
+
+hook_failed(Learner, Hook) :-
+    throw(error(learner_hook_failed(Learner, Hook), _)).
+
+%   Learner has capability Cap (KB's configured run).
+capable(KB, Cap) :-
+    run(KB, run(_, _, _, _, _, _, _, _, _, Caps)),
+    memberchk(Cap, Caps).
+
+:- multifile prolog:error_message//1.
+
+prolog:error_message(learner_hooks(Learner, Problems)) -->
+    [ 'learner ~q: '-[Learner] ],
+    hook_problems(Problems).
+prolog:error_message(learner_capability(Learner, Cap)) -->
+    [ 'learner ~q has no capability ~q (learner_property/2)'-[Learner, Cap] ].
+prolog:error_message(learner_hook_failed(Learner, Hook)) -->
+    [ 'learner ~q: its hook ~q failed (a hook must succeed)'-[Learner, Hook] ].
+
+hook_problems([]) --> [].
+hook_problems([P|Ps]) -->
+    hook_problem(P),
+    (   { Ps == [] }
+    ->  []
+    ;   [ '; ' ],
+        hook_problems(Ps)
+    ).
+
+hook_problem(missing(H)) -->
+    [ 'no ~q hook'-[H] ].
+hook_problem(undeclared(Cap, H)) -->
+    [ 'has ~q but does not declare learner_property(_, ~q)'-[H, Cap] ].
 
 %!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
 %
@@ -425,7 +552,7 @@ engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
     nb_setarg(2, Engine, Next).
 
-step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
+step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan, Caps),
      Prev, Percepts, EmittedIx, Mode, Want,
      step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
      prev(State, Active)) :-
@@ -435,7 +562,7 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
     ;   wm_insert(KB, Percepts)
     ),
     view_code(KB, Plan, Code, Reinforced),
-    learner_view(Learner, KB, Code, State),
+    learner_view(Learner, Caps, KB, Code, State),
     motivation_values(KB, Units, _, Ys, Active),
     (   Reinforced == true
     ->  memberchk(reward_positive=Reward, Params)
@@ -445,16 +572,21 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan),
     (   Mode == learn,
         EmittedIx >= 0,
         Prev = prev(S0, N0)
-    ->  learner_update(Learner, KB, transition(S0, Emitted, N0, Reward, Reinforced,
-                                               State, Active, Allowed))
+    ->  (   learner_update(Learner, KB, transition(S0, Emitted, N0, Reward, Reinforced,
+                                                   State, Active, Allowed))
+        ->  true
+        ;   hook_failed(Learner, learner_update/3)
+        )
     ;   true
     ),
-    (   ( Allowed == [] ; learner_property(Learner, external) )
+    (   ( Allowed == [] ; memberchk(external, Caps) )
     ->  ActionIx = -1
-    ;   learner_choose(Learner, KB, State, Active, Allowed, Mode, Action),
-        nth0(ActionIx, Responses, Action)
-    ->  true
-    ;   existence_error(learner_choice, Learner)
+    ;   learner_choose(Learner, KB, State, Active, Allowed, Mode, Action)
+    ->  (   nth0(ActionIx, Responses, Action)
+        ->  true
+        ;   domain_error(response, Action)
+        )
+    ;   hook_failed(Learner, learner_choose/7)
     ),
     extras(Want, KB, Learner, State, Active, Extras).
 
@@ -467,9 +599,14 @@ view_code(KB, Plan, Code, Reinforced) :-
     ;   plan_code(KB, Plan, Code, Reinforced)
     ).
 
-learner_view(Learner, KB, Code, State) :-
-    (   learner_state(Learner, KB, Code, State0)
-    ->  State = State0
+%   The learner's view of the state: its learner_state/4 if it declares `state`, else
+%   the code.
+learner_view(Learner, Caps, KB, Code, State) :-
+    (   memberchk(state, Caps)
+    ->  (   learner_state(Learner, KB, Code, State0)
+        ->  State = State0
+        ;   hook_failed(Learner, learner_state/4)
+        )
     ;   State = Code
     ).
 
@@ -538,21 +675,18 @@ engine_relational_state(KB, Facts) :-
 
 engine_explain(KB, When, Explanation) :-
     must_be(oneof([last, now]), When),
-    run(KB, run(Learner, _, _, _, Units, _, _, _, Plan)),
+    run(KB, run(Learner, _, _, _, Units, _, _, _, Plan, Caps)),
     (   When == last,
         engine(KB, engine(_, prev(State, N), _))
     ->  true
     ;   view_code(KB, Plan, Code, _),
-        learner_view(Learner, KB, Code, State),
+        learner_view(Learner, Caps, KB, Code, State),
         motivation_peek(KB, Units, _, N)
     ),
     explanation(KB, Learner, State, N, Explanation).
 
 explanation(KB, Learner, State, N, explanation(Learner, State, N, Detail)) :-
-    (   learner_explain(Learner, KB, State, N, Detail0)
-    ->  Detail = Detail0
-    ;   Detail = none
-    ).
+    hook(learner_explain(Learner, KB, State, N, Detail)).
 
 %!  engine_text(+KB, -Text:string) is det.
 %
@@ -560,8 +694,8 @@ explanation(KB, Learner, State, N, explanation(Learner, State, N, Detail)) :-
 
 engine_text(KB, Text) :-
     engine_learner(KB, Learner),
-    (   learner_text(Learner, KB, Text0)
-    ->  Text = Text0
+    (   capable(KB, text)
+    ->  hook(learner_text(Learner, KB, Text))
     ;   Text = ""
     ).
 
@@ -572,8 +706,8 @@ engine_text(KB, Text) :-
 
 engine_graph(KB, Graph) :-
     engine_learner(KB, Learner),
-    (   learner_graph(Learner, KB, Graph0)
-    ->  Graph = Graph0
+    (   capable(KB, graph)
+    ->  hook(learner_graph(Learner, KB, Graph))
     ;   Graph = graph([], [])
     ).
 
@@ -583,8 +717,8 @@ engine_graph(KB, Graph) :-
 
 engine_knowledge(KB, Terms) :-
     engine_learner(KB, Learner),
-    (   learner_knowledge(Learner, KB, Terms0)
-    ->  Terms = Terms0
+    (   capable(KB, knowledge)
+    ->  hook(learner_knowledge(Learner, KB, Terms))
     ;   Terms = []
     ).
 
@@ -595,8 +729,8 @@ engine_knowledge(KB, Terms) :-
 
 engine_size(KB, size(Learner, Positions, Details)) :-
     engine_learner(KB, Learner),
-    (   learner_size(Learner, KB, size(Positions, Details))
-    ->  true
+    (   capable(KB, size)
+    ->  hook(learner_size(Learner, KB, size(Positions, Details)))
     ;   Positions = 0, Details = []
     ).
 
@@ -612,8 +746,8 @@ engine_snapshot(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
     wm_state(KB, Memory),
     motivation_outputs(KB, Units),
     eng(KB, Eng),
-    (   learner_snapshot(Learner, KB, LearnerSnap0)
-    ->  LearnerSnap = LearnerSnap0
+    (   capable(KB, snapshot)
+    ->  hook(learner_snapshot(Learner, KB, LearnerSnap))
     ;   LearnerSnap = none
     ).
 
@@ -622,34 +756,31 @@ engine_restore(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
     wm_set_state(KB, Memory),
     motivation_set_outputs(KB, Units),
     set_eng(KB, Eng),
-    (   LearnerSnap == none
-    ->  true
-    ;   learner_resume(Learner, KB, LearnerSnap)
+    (   capable(KB, snapshot)
+    ->  hook(learner_resume(Learner, KB, LearnerSnap))
+    ;   true
     ).
 
 %!  engine_keep(+KB, +Slot) is det.
 %!  engine_resume(+KB, +Slot) is det.
 %
-%   engine_snapshot/2 kept inside Prolog under the atom Slot, and restored from it (the
+%   engine_snapshot/2 kept in KB's record under the atom Slot, and restored from it (the
 %   slot is forgotten). What Python uses: the snapshot never crosses the bridge.
 
 engine_keep(KB, Slot) :-
     must_be(atom, Slot),
     engine_snapshot(KB, Snapshot),
-    slot_key(KB, Slot, Key),
-    nb_setval(Key, Snapshot).
+    kb_get(KB, kept, Kept),
+    kb_set(KB, kept, [Slot-Snapshot|Kept]).
 
 engine_resume(KB, Slot) :-
     must_be(atom, Slot),
-    slot_key(KB, Slot, Key),
-    (   nb_current(Key, Snapshot)
-    ->  nb_delete(Key),
-        engine_restore(KB, Snapshot)
+    kb_get(KB, kept, Kept0),
+    (   selectchk(Slot-Snapshot, Kept0, Kept)
+    ->  engine_restore(KB, Snapshot),
+        kb_set(KB, kept, Kept)
     ;   existence_error(engine_snapshot, Slot)
     ).
-
-slot_key(KB, Slot, Key) :-
-    atomic_list_concat(['$relrl_snap:', KB, ':', Slot], Key).
 
 %!  engine_policy_info(+KB, -Info:list) is det.
 %
@@ -661,9 +792,9 @@ slot_key(KB, Slot, Key) :-
 %   one argument.
 
 engine_policy_info(KB, Info) :-
-    run(KB, run(Learner, _, Features, Responses, _, _, _, _, _)),
-    (   learner_policy_info(Learner, KB, Info0)
-    ->  Info = Info0
+    run(KB, run(Learner, _, Features, Responses, _, _, _, _, _, Caps)),
+    (   memberchk(policy_info, Caps)
+    ->  hook(learner_policy_info(Learner, KB, Info))
     ;   Info = [features(Features), responses(Responses)]
     ).
 
@@ -677,6 +808,10 @@ engine_policy_info(KB, Info) :-
 engine_policy(KB, Header, Text) :-
     must_be(text, Header),
     engine_learner(KB, Learner),
+    (   capable(KB, policy)
+    ->  true
+    ;   throw(error(learner_capability(Learner, policy), _))
+    ),
     engine_policy_info(KB, Info),
     with_output_to(string(Text),
                    (   current_output(S),
@@ -692,7 +827,4 @@ write_policy(S, KB, Learner, Info, Header) :-
            []),
     portray_clause(S, relrl_policy(Learner, Info)),
     nl(S),
-    (   learner_save(Learner, KB, S)
-    ->  true
-    ;   true
-    ).
+    hook(learner_save(Learner, KB, S)).

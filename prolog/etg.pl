@@ -13,7 +13,7 @@
 :- use_module(engine).
 :- use_module(declarations).
 :- use_module(rules).
-:- use_module(gvar).
+:- use_module(kbstate).
 :- use_module(policy, [policy_refuse/3, policy_number/3]).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
@@ -231,20 +231,20 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   order, then its etg_test/1 goals. A state's description is its code with a bit for each
 %   extra test above the features' bits.
 
-%   What the hooks read every step, in a global variable per KB (its name made once):
-%   etg(NF, Extra, Numbers) — NF features, the extra tests Extra as a program of
+%   What the hooks read every step, the `learner` part of KB's record (kbstate.pl; the tree
+%   is its `tree` part): etg(NF, Extra, Numbers) — NF features, the extra tests Extra as a program of
 %   relrl_rules (their bits above the features'; `none` without extra tests), and Numbers =
 %   numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or `params` when
 %   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
 
-config_key(KB, Key) :-
-    gvar_key('$relrl_etg:', KB, Key).
-
 config(KB, Config) :-
-    config_key(KB, Key),
-    nb_getval(Key, Config).
+    kb_get(KB, learner, Config).
 
 relrl_engine:learner(etg).
+relrl_engine:learner_property(etg, Cap) :-
+    member(Cap, [state, size, text, graph, policy]).
+
+relrl_engine:learner_forget(etg, _KB).         % all in the record (and rules.pl's program)
 
 relrl_engine:learner_init(etg, KB, Params) :-
     engine_config(KB, features, Features),
@@ -260,8 +260,7 @@ relrl_engine:learner_init(etg, KB, Params) :-
     ->  Numbers = numbers(Alpha, Gamma, Epsilon, Qinit, Threshold)
     ;   Numbers = params
     ),
-    config_key(KB, Key),
-    nb_setval(Key, etg(NF, ExtraTests, Numbers)),
+    kb_set(KB, learner, etg(NF, ExtraTests, Numbers)),
     append(Features, Extra, Tests),
     etg_init(KB, Tests).
 

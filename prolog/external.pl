@@ -11,5 +11,6 @@ state, the necessity, the reward and the allowed responses; Python chooses.
 relrl_engine:learner(external).
 relrl_engine:learner_property(external, external).
 relrl_engine:learner_init(external, _KB, _Params).
+relrl_engine:learner_forget(external, _KB).
 relrl_engine:learner_update(external, _KB, _Transition).
 relrl_engine:learner_explain(external, _KB, _State, _N, external).

@@ -8,9 +8,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(guard).
-:- use_module(engine, [engine_park/0, engine_forget/1]).
-:- use_module(state, [state_touch/0]).
-:- use_module(memory, [wm_clear/1]).
+:- use_module(engine, [engine_forget/1]).
 
 /** <module> Knowledge bases: their life cycle and loading
 
@@ -20,43 +18,65 @@ gw_drop_kb/1 forgets all of it. gw_load/3 consults a domain file into one and co
 every error and warning with its file and line instead of printing them.
 */
 
-:- dynamic kb_counter/1, kb_module_/1.
-kb_counter(0).
+:- dynamic kb_module_/2.             % Module, N: a knowledge base, relrl_kb_N
 
 %!  kb_module(?Module) is nondet.
 %
 %   Module is a knowledge base made by gw_new_kb/1 and not dropped.
 
 kb_module(Module) :-
-    kb_module_(Module).
+    kb_module_(Module, _).
 
 %!  gw_new_kb(-Module) is det.
 %
-%   Module is a fresh, empty knowledge-base module that sees relrl's predicates.
+%   Module is a fresh, empty knowledge-base module, relrl_kb_N with N the least number no
+%   knowledge base has now, that sees relrl's predicates. (A dropped knowledge base's name
+%   is given again: its module was destroyed, and the files loaded into the new one are
+%   recorded under the same names, so that SWI-Prolog's records of loaded files do not
+%   grow with every knowledge base a long-lived process makes.)
 
 gw_new_kb(Module) :-
-    retract(kb_counter(N0)),
-    N is N0 + 1,
-    assertz(kb_counter(N)),
+    free_number(1, N),
     format(atom(Module), "relrl_kb_~d", [N]),
-    assertz(kb_module_(Module)),
-    set_module(Module:class(user)),
+    assertz(kb_module_(Module, N)),
+    set_module(Module:class(temporary)),   % destroyed when dropped (gw_drop_kb/1)
     add_import_module(Module, relrl, start),
     set_prolog_flag(Module:unknown, error).
 
+free_number(N0, N) :-
+    (   kb_module_(_, N0)
+    ->  N1 is N0 + 1,
+        free_number(N1, N)
+    ;   N = N0
+    ).
+
 %!  gw_drop_kb(+Module) is det.
 %
-%   Forget the clauses, working memory and engine state of a knowledge-base module.
+%   Forget everything relrl keeps for a knowledge base (relrl_engine:engine_forget/1: its
+%   record, its learner's own clauses, its plans), unload the domain files consulted into
+%   it and destroy the module itself, as library(modules) destroys a temporary module: a
+%   process that makes and drops knowledge bases all day keeps no trace of them. Module
+%   files a domain loaded (use_module(library(lists))) stay loaded: the rest of the
+%   process uses them too; only their record of being loaded into Module goes.
 
 gw_drop_kb(Module) :-
     must_be(atom, Module),
-    wm_clear(Module),
     engine_forget(Module),
-    retractall(kb_module_(Module)),
-    forall(( current_predicate(Module:Name/Arity),
-             functor(Head, Name, Arity),
-             \+ predicate_property(Module:Head, imported_from(_)) ),
-           abolish(Module:Name/Arity)).
+    (   retract(kb_module_(Module, _))
+    ->  forall(( source_file_property(File, load_context(Module, _, _)),
+                 \+ source_file_property(File, module(_)) ),
+               unload_file(File)),
+        retractall(system:'$load_context_module'(_, Module, _)),
+        '$destroy_module'(Module),
+        garbage_collect_clauses,
+        garbage_collect_atoms
+    ;   true
+    ).
+
+%   The clause and atom garbage collections run at once: what the knowledge base's
+%   clauses and compiled programs held is freed now, not once some 10,000 atoms more
+%   (the atom collector's margin) have been made, which a process stepping one knowledge
+%   base after another may take thousands of them to reach.
 
 %!  gw_load(+File, +Module, -Problems:list) is det.
 %
@@ -69,8 +89,6 @@ gw_drop_kb(Module) :-
 
 gw_load(File, Module, Problems) :-
     must_be(atom, Module),
-    engine_park,                        % a directive may draw random numbers
-    state_touch,                        % or redefine a rule
     (   exists_file(File)
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),

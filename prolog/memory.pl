@@ -18,6 +18,7 @@
 :- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(kbstate).
 
 /** <module> Working memory with age counters
 
@@ -38,38 +39,16 @@ argument of every predicate names it. This module is the only one that stores pe
 :- use_module(library(pairs)).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
-%   The memory of knowledge base KB is one term, wm(Clock, Span, Pairs, Elements, Now), in a
-%   global variable (nb_setval/2) named after KB: Clock counts insertions, Span is the expiry
+%   The memory of knowledge base KB is one term, wm(Clock, Span, Pairs, Elements, Now), the
+%   `memory` part of KB's record (kbstate.pl): Clock counts insertions, Span is the expiry
 %   age (or `default` until the domain's memory_span/1 is read), Pairs are Element-Stamp
 %   pairs, newest first; Elements are the same elements alone and Now those of the latest
 %   insertion (age 0), both in the same order: the perception predicates look elements up
 %   many times a step, and memberchk/2 over plain terms takes half the time of a look-up
-%   over pairs. A global term instead of asserted clauses keeps the robot's control step
-%   free of assert/retract churn.
-
-key(KB, Key) :-
-    (   key_(KB, Key0)
-    ->  Key = Key0
-    ;   atom_concat('$relrl_wm:', KB, Key),
-        nb_setval(Key, wm(0, default, [], [], [])),
-        assertz(key_(KB, Key))
-    ).
-
-:- dynamic key_/2.                  % KB, the name of its global variable (made once)
-
-%   The variable exists from the moment its name is made (key/2), so reading it is one
-%   nb_getval/2: the perception predicates read memory many times a step. Readers take the
-%   term and then unify it with the wm/5 they want (State = wm(...)): a wm/5 pattern given
-%   to nb_getval/2 or get/2 would first be built on the global stack, every read.
-get(KB, State) :-
-    (   key_(KB, Key)
-    ->  nb_getval(Key, State)
-    ;   State = wm(0, default, [], [], [])
-    ).
-
-put(KB, State) :-
-    key(KB, Key),
-    nb_setval(Key, State).
+%   over pairs. A term in the record instead of asserted clauses keeps the robot's control
+%   step free of assert/retract churn. Readers take the term and then unify it with the
+%   wm/5 they want (State = wm(...)): a wm/5 pattern given to kb_get/3 would first be built
+%   on the global stack, every read.
 
 %!  wm_span(+KB, -Span) is det.
 %
@@ -78,7 +57,7 @@ put(KB, State) :-
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, Span0, _, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -102,16 +81,16 @@ domain_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, Elements, Now),
-    put(KB, wm(Clock, Span, Pairs, Elements, Now)).
+    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
 %!  wm_clock(+KB, -Clock) is det.
 %
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, _, _, _).
 
 %!  wm_insert(+KB, +Elements:list) is det.
@@ -130,7 +109,7 @@ wm_insert(KB, New) :-
     ->  instantiation_error(E)
     ;   true
     ),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock0, Span0, Old, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -138,18 +117,17 @@ wm_insert(KB, New) :-
     ),
     Clock is Clock0 + 1,
     Oldest is Clock - Span,
-    duplicate_term(New, Fresh),
-    stamp(Fresh, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
-    keep_old(Old, Fresh, Oldest, KeptPairs, KeptElements),
-    key(KB, Key),
-    nb_linkval(Key, wm(Clock, Span, Pairs, Elements, Now)).
+    stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
+    keep_old(Old, New, Oldest, KeptPairs, KeptElements),
+    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
-%   The new memory is linked into the global variable, not copied as nb_setval/2 would
-%   (half an insertion's time). That is safe because nothing in it can be undone by
-%   backtracking: the new elements are a copy made here, the kept ones were stored by
-%   earlier insertions, and every list cell and pair is made by stamp/7 and keep_old/5
-%   below, which bind only variables younger than any choice point (if-then-else commits
-%   before it binds). nb_linkval/2 freezes the global stack, so the cells outlive the call.
+%   The new memory is copied into the record (kb_set/3), never linked (nb_linkval/2 or
+%   nb_linkarg/3): a linked term is only as safe as every binding that built it, and a
+%   signal handler that stores a term on the global stack in the middle of an insertion
+%   (an alarm re-arming itself did) freezes the stack, so that the list cells bound after
+%   it are trailed; the gateway's discarded frame, or any backtracking past the call, then
+%   undid them and left the stored memory with an unbound tail
+%   (tests/prolog/test_memory.plt, tests/relrl/test_memory_signals.py).
 
 %   The new elements stamped, in front of PairsTail, and alone (Now), in front of Tail.
 stamp([], _, PairsTail, PairsTail, [], Tail, Tail).
@@ -177,7 +155,7 @@ keep_old([P|Ps], New, Oldest, Pairs, Elements) :-
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, _, _),
     member(Element-Stamp, Pairs),
     Age is Clock - Stamp.
@@ -188,8 +166,7 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    key_(KB, Key),                      % none: no memory yet
-    nb_getval(Key, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     element_in(Element, Elements).
 
@@ -198,8 +175,7 @@ wm_has(KB, Element) :-
 %   once(wm_has(KB, Element)).
 
 wm_has_chk(KB, Element) :-
-    key_(KB, Key),
-    nb_getval(Key, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     memberchk(Element, Elements).
 
@@ -208,7 +184,7 @@ wm_has_chk(KB, Element) :-
 %   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
 
 wm_now(KB, Element) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, _, Now),
     element_in(Element, Now).
 
@@ -225,7 +201,7 @@ element_in(Element, Elements) :-
 %   (at(S, Place)) in KB's memory.
 
 wm_has_stimulus(KB, S) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, _, Elements, _),
     member(E, Elements),
     compound(E),
@@ -249,7 +225,7 @@ sense_name(at).
 %   pass over it (the state code's).
 
 wm_stamped(KB, Clock, Pairs) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, _, Pairs, _, _).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
@@ -270,16 +246,16 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, Span, _, _, _),
-    put(KB, wm(0, Span, [], [], [])).
+    kb_set(KB, memory, wm(0, Span, [], [], [])).
 
 %!  wm_size(+KB, -Size:nonneg) is det.
 %
 %   Size is the number of elements in KB's memory.
 
 wm_size(KB, Size) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(_, _, Pairs, _, _),
     length(Pairs, Size).
 
@@ -293,7 +269,7 @@ wm_size(KB, Size) :-
 %   @error domain_error(working_memory_state, State) if State is not such a term.
 
 wm_state(KB, wm(Clock, Span, Pairs)) :-
-    get(KB, State),
+    kb_get(KB, memory, State),
     State = wm(Clock, Span, Pairs, _, _).
 
 wm_set_state(KB, State) :-
@@ -301,7 +277,7 @@ wm_set_state(KB, State) :-
     (   State = wm(Clock, Span, Pairs), integer(Clock), is_list(Pairs),
         maplist(stamped, Pairs, Elements)
     ->  findall(E, ( member(E-S, Pairs), S =:= Clock ), Now),
-        put(KB, wm(Clock, Span, Pairs, Elements, Now))
+        kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now))
     ;   domain_error(working_memory_state, State)
     ).
 

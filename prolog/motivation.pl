@@ -16,7 +16,7 @@
 :- use_module(library(apply)).
 :- use_module(declarations).
 :- use_module(rules).
-:- use_module(gvar).
+:- use_module(kbstate).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Consequence control: necessity units and the mediator
@@ -39,22 +39,14 @@ W: a satisfying stimulus (the caregiver's attention, a frontal face) lowers the 
 paper's weights are declared as satisfiers with their printed magnitudes.
 */
 
-%   The units' outputs of KB live in a global variable, a list of Necessity-Y pairs in
-%   declaration order (no assert/retract in the robot's control step).
-
-outputs_key(KB, Key) :-
-    gvar_key('$relrl_units:', KB, Key).
+%   The units' outputs of KB are the `units` part of its record (kbstate.pl), a list of
+%   Necessity-Y pairs in declaration order (no assert/retract in the robot's control step).
 
 get_outputs(KB, Outputs) :-
-    outputs_key(KB, Key),
-    (   nb_current(Key, Outputs0)
-    ->  Outputs = Outputs0
-    ;   Outputs = []
-    ).
+    kb_get(KB, units, Outputs).
 
 put_outputs(KB, Outputs) :-
-    outputs_key(KB, Key),
-    nb_setval(Key, Outputs).
+    kb_set(KB, units, Outputs).
 
 %!  unit_output(+U, +Delta, -Y) is det.
 %
@@ -161,13 +153,9 @@ motivation_step(KB, Units, Outputs, Active) :-
 %   control step's one pass over the units.
 
 motivation_values(KB, Units, Outputs, Ys, Active) :-
-    outputs_key(KB, Key),
-    (   nb_current(Key, Previous)
-    ->  true
-    ;   Previous = []
-    ),
+    get_outputs(KB, Previous),
     unit_values(Units, KB, Previous, Outputs, Ys),
-    nb_setval(Key, Outputs),
+    put_outputs(KB, Outputs),
     mediate(Units, Outputs, Active).
 
 %!  motivation_peek(+KB, +Units, -Outputs, -Active) is det.

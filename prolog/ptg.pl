@@ -16,7 +16,8 @@
 :- use_module(library(pairs)).
 :- use_module(library(random)).
 :- use_module(tg).
-:- use_module(tg_tree, [tg_data/2, tg_get_tree/2]).
+:- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1]).
+:- use_module(kbstate, [kb_forget/1]).
 :- use_module(tg_classes, [tg_class_member/3]).
 
 /** <module> ptg: P-learning beside TG's Q-tree
@@ -266,7 +267,18 @@ policy_term(Term) :-
 
 relrl_engine:learner(ptg).
 
-relrl_engine:learner_property(ptg, view(relational)).
+relrl_engine:learner_property(ptg, Cap) :-
+    member(Cap, [view(relational), state, size, text, graph, policy, policy_info]).
+
+%   The Q-tree is tg's under KB; the P-tree is a tree of its own, under its own key: its
+%   record (kbstate.pl) and compiled clauses go with it, and the options' global.
+relrl_engine:learner_forget(ptg, KB) :-
+    tg_forget(KB),
+    ptg_key(KB, PK),
+    tg_forget(PK),
+    kb_forget(PK),
+    params_key(KB, K),
+    nb_delete(K).
 
 relrl_engine:learner_init(ptg, KB, Params) :-
     ptg_init(KB, Params).

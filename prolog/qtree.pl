@@ -22,6 +22,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
+:- use_module(kbstate).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> Relational Q-trees
@@ -41,8 +42,8 @@ on (to update the previous step's example).
 A node is test(Index, Goal, Yes, No) or leaf(Rep, Entries); Rep is `none` until the first
 example arrives. Id 0 is the root.
 
-A tree is one term in a global variable (named after the tree), qtree(Tests, Next, Nodes,
-Memo): Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument
+A tree is one term, the `tree` part of the record (kbstate.pl) of the knowledge base the
+tree is named after, qtree(Tests, Next, Nodes, Memo): Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument
 Id+1 holds node Id (`free` beyond the last). Memo remembers where the last two states sorted
 went (see qtree_sort/3). The control step reads nodes in place (arg/3, no
 copy: sorting a state down the tree is a few argument look-ups) and replaces a leaf in place
@@ -51,22 +52,9 @@ What this module gives to callers that may bind variables (qtree_node/3, qtree_t
 goals of qtree_path/3) is a copy (copy_term/2 shares ground parts).
 */
 
-%   The name of Tree's global variable (made once per tree).
-tree_key(Tree, Key) :-
-    (   tree_key_(Tree, Key0)
-    ->  Key = Key0
-    ;   must_be(atom, Tree),
-        atom_concat('$relrl_qtree:', Tree, Key),
-        nb_setval(Key, none),
-        assertz(tree_key_(Tree, Key))
-    ).
-
-:- dynamic tree_key_/2.
-
 %   Tree's term; fails when Tree was never made (or was cleared).
 tree(Tree, T) :-
-    tree_key_(Tree, Key),
-    nb_getval(Key, T0),
+    kb_get(Tree, tree, T0),
     T0 = qtree(_, _, _, _),
     T = T0.
 
@@ -148,17 +136,14 @@ qtree_restore_(Tree, Tests, Nodes, Next) :-
                nb_setarg(I, Term, Node)
            ;   domain_error(qtree_node_id, Id)
            )),
-    tree_key(Tree, Key),
-    nb_setval(Key, qtree(Tests, Next, Term, none)).
+    kb_set(Tree, tree, qtree(Tests, Next, Term, none)).
 
 %!  qtree_clear(+Tree) is det.
 %
 %   Forget Tree.
 
 qtree_clear(Tree) :-
-    must_be(atom, Tree),
-    tree_key(Tree, Key),
-    nb_setval(Key, none).
+    kb_set(Tree, tree, none).
 
 %!  qtree_tests(+Tree, -Tests:list) is det.
 
@@ -290,23 +275,9 @@ qtree_set_leaf(Tree, Id, Rep, Entries) :-
         T = qtree(_, Next, Nodes, _),
         integer(Id), Id >= 0, Id < Next,
         node(Nodes, Id, leaf(_, _))
-    ->  (   ground(Rep-Entries)
-        ->  link_node(T, Id, leaf(Rep, Entries))
-        ;   set_node(T, Id, leaf(Rep, Entries))
-        )
+    ->  set_node(T, Id, leaf(Rep, Entries))
     ;   existence_error(qtree_leaf, Tree-Id)
     ).
-
-%   A ground node linked into the tree, not copied (the control step replaces a leaf every
-%   time unit: copying its entries doubled what the replacement leaves to the garbage
-%   collector). Safe for a ground term: nothing in it can be undone by backtracking, and
-%   nb_linkarg/3 freezes the global stack, so it outlives the call. The tree never changes
-%   a node in place (a node is always replaced whole), so sharing parts of it with the
-%   caller's terms is harmless.
-link_node(T, Id, Node) :-
-    arg(3, T, Nodes),
-    I is Id + 1,
-    nb_linkarg(I, Nodes, Node).
 
 %!  qtree_grow(+Tree, +Parent, +Branch, +Rep, +Entries, -Id) is det.
 %

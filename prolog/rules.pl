@@ -73,20 +73,22 @@ rules_error(KB, GoalBits, running(I), E) :-
 %   directly (no call/1 of a goal term at run time, a fifth less time); program_mask/3 runs
 %   it, with rules_mask/4's results and errors. A program lasts until rules_forget/1 (the
 %   engine forgets a KB's programs when it is configured again and when it is dropped).
-
-:- dynamic program_/5.              % Id, KB, Running, Mask0, Mask (Id: unique)
+%
+%   The clause is KB's own, '$relrl_program'(Id, Running, Mask0, Mask): its goals are
+%   KB's, and it goes with KB's module when the knowledge base is dropped (a clause of
+%   another module may not name a knowledge base's module, which is destroyed then).
 
 rules_program(KB, GoalBits, program(Id, KB, GoalBits)) :-
     must_be(atom, KB),
     must_be(list, GoalBits),
     flag(relrl_rules_program, Id, Id + 1),
-    program_body(GoalBits, KB, Running, 1, Mask0, Mask, Body),
-    assertz((program_(Id, KB, Running, Mask0, Mask) :- Body)).
+    program_body(GoalBits, Running, 1, Mask0, Mask, Body),
+    assertz(KB:('$relrl_program'(Id, Running, Mask0, Mask) :- Body)).
 
-program_body([], _, _, _, Mask0, Mask, Mask = Mask0).
-program_body([Goal-Bit|Gs], KB, Running, I, Mask0, Mask,
+program_body([], _, _, Mask0, Mask, Mask = Mask0).
+program_body([Goal-Bit|Gs], Running, I, Mask0, Mask,
              ( nb_setarg(1, Running, I),
-               (   KB:Goal
+               (   Goal
                ->  Mask1 is Mask0 \/ Bit
                ;   Mask1 = Mask0
                ),
@@ -94,11 +96,11 @@ program_body([Goal-Bit|Gs], KB, Running, I, Mask0, Mask,
     must_be(callable, Goal),
     must_be(integer, Bit),
     I1 is I + 1,
-    program_body(Gs, KB, Running, I1, Mask1, Mask, Rest).
+    program_body(Gs, Running, I1, Mask1, Mask, Rest).
 
 program_mask(program(Id, KB, GoalBits), Mask0, Mask) :-
     Running = running(0),
-    catch(program_(Id, _, Running, Mask0, Mask), E,
+    catch(KB:'$relrl_program'(Id, Running, Mask0, Mask), E,
           rules_error(KB, GoalBits, Running, E)).
 
 %!  rules_mark(-Mark) is det.
@@ -112,11 +114,14 @@ rules_mark(Mark) :-
     flag(relrl_rules_program, Mark, Mark).
 
 rules_forget(KB) :-
-    retractall(program_(_, KB, _, _, _)).
+    rules_forget(KB, inf).
 
 rules_forget(KB, Mark) :-
-    forall(( clause(program_(Id, KB, _, _, _), _, Ref), Id < Mark ),
-           erase(Ref)).
+    (   current_predicate(KB:'$relrl_program'/4)
+    ->  forall(( clause(KB:'$relrl_program'(Id, _, _, _), _, Ref), Id < Mark ),
+               erase(Ref))
+    ;   true
+    ).
 
 %!  rule_solution(+KB, +Goal) is nondet.
 %

@@ -110,10 +110,9 @@ tg_init(Key, KB, Params) :-
     tg_new_stats(Qinit, 0, K, 0, Keep, L),
     tg_empty_leaves(16, Leaves0),
     setarg(1, Leaves0, L),
-    atom_concat('$tg:', Key, DK),
     Half is max(0, round(Half0)),
-    nb_setval(DK, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                       novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
+    tg_put_data(Key, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
+                          novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
     tg_put_tree(Key, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(Key),
     tg_compile_leaf(Key, Root),
@@ -683,7 +682,11 @@ tg_candidates(KB, LeafId, Texts) :-
 
 relrl_engine:learner(tg).
 
-relrl_engine:learner_property(tg, view(relational)).
+relrl_engine:learner_property(tg, Cap) :-
+    member(Cap, [view(relational), state, size, text, graph, policy, policy_info]).
+
+relrl_engine:learner_forget(tg, KB) :-
+    tg_forget(KB).
 
 relrl_engine:learner_init(tg, KB, Params) :-
     tg_init(KB, Params).

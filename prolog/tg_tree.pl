@@ -2,6 +2,8 @@
           [ tg_data/2,            % +KB, -Data
             tg_get_tree/2,        % +KB, -Tree
             tg_put_tree/2,        % +KB, +Tree
+            tg_put_data/2,        % +KB, +Data
+            tg_forget/1,          % +KB
             tg_leaf/3,            % +KB, +LeafId, -Stats
             tg_new_stats/6,       % +Q, +N, +K, +Clock, +Keep, -Stats
             tg_empty_leaves/2,    % +Capacity, -Leaves
@@ -17,6 +19,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(tg_bias).
+:- use_module(kbstate).
 
 /** <module> The TG learner's state and its compiled tree
 
@@ -33,13 +36,13 @@ explains, draws, saves and restores them.
 
 % ---- the learner's state -------------------------------------------------------------------
 
-%   Two global variables per knowledge base:
+%   Two parts of the knowledge base's record (kbstate.pl):
 %
-%   '$tg_tree:KB'  tree(Root, NextId, Bias, Responses), read (copied) only when the
+%   tree           tree(Root, NextId, Bias, Responses), read (copied) only when the
 %                  tree changes, is explained, drawn or saved. Root is a leaf(Id, PathLits,
 %                  Vars, Cands) or node(Id, Lits, New, Yes, No) term; variables are shared
 %                  along the path, as in the tree.
-%   '$tg:KB'       tg(Params, Leaves, Cache, Version, Clock, Index), read in place on every
+%   learner        tg(Params, Leaves, Cache, Version, Clock, Index), read in place on every
 %                  step:
 %                  Leaves = leaves(L1, ..., Lk), Li = l(Q, N, M, S, SS, C, Last, Base,
 %                  Ring) for leaf i (or `free`): the Q estimate and the examples counted in
@@ -69,19 +72,26 @@ explains, draws, saves and restores them.
 %   @error existence_error(tg_learner, KB) when KB has no tg learner.
 
 tg_data(KB, D) :-
-    atom_concat('$tg:', KB, K),
-    (   nb_current(K, D0)
+    kb_get(KB, learner, D0),
+    (   D0 = tg(_, _, _, _, _, _)
     ->  D = D0
     ;   existence_error(tg_learner, KB)
     ).
+
+%!  tg_put_data(+KB, +Data) is det.
+%
+%   Data becomes KB's tg/6 term (a copy; change it afterwards with nb_setarg/3 only).
+
+tg_put_data(KB, D) :-
+    kb_set(KB, learner, D).
 
 %!  tg_get_tree(+KB, -Tree) is det.
 %
 %   Tree is a copy of KB's tree/4 term (above).
 
 tg_get_tree(KB, Tree) :-
-    atom_concat('$tg_tree:', KB, K),
-    (   nb_current(K, Tree0)
+    kb_get(KB, tree, Tree0),
+    (   Tree0 = tree(_, _, _, _)
     ->  copy_term(Tree0, Tree)
     ;   existence_error(tg_learner, KB)
     ).
@@ -91,8 +101,7 @@ tg_get_tree(KB, Tree) :-
 %   Tree becomes KB's tree/4 term.
 
 tg_put_tree(KB, Tree) :-
-    atom_concat('$tg_tree:', KB, K),
-    nb_setval(K, Tree).
+    kb_set(KB, tree, Tree).
 
 %!  tg_leaf(+KB, +LeafId, -Stats) is det.
 %
@@ -192,6 +201,14 @@ tg_forget_leaf(KB, Id) :-
 
 tg_forget_leaves(KB) :-
     retractall(tg_cands_(KB, _, _, _, _, _)).
+
+%!  tg_forget(+KB) is det.
+%
+%   Remove KB's compiled tree and leaves (the learner forgets KB).
+
+tg_forget(KB) :-
+    retractall(tg_sort_(KB, _, _, _, _)),
+    tg_forget_leaves(KB).
 
 hits_body([], [], true).
 hits_body([hit(I, G)|Gs], Hits, (( G -> Hits = [I|Hits1] ; Hits = Hits1 ), Body)) :-

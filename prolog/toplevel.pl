@@ -7,8 +7,7 @@
 :- use_module(library(apply)).
 :- use_module(guard).
 :- use_module(kb_load, [kb_module/1]).
-:- use_module(engine, [engine_park/0]).
-:- use_module(state, [state_touch/0]).
+:- use_module(engine, [engine_pause/0]).
 
 /** <module> A user's query, one answer at a time: the toplevel of relrl shell and of Python
 
@@ -99,8 +98,7 @@ toplevel_error(E, E).
 %   While an answer is sought, a guarded call runs (halt/0,1 is cancelled, Ctrl-C and the
 %   time limit stop it); between answers, none does and what the goal wrote is flushed.
 resume :-
-    engine_park,                        % a step may have run between two answers
-    state_touch,                        % a query may redefine or trace a rule
+    engine_pause,                       % a step may have run between two answers
     nb_setval(relrl_active, true).
 
 pause(Halt) :-

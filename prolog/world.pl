@@ -22,6 +22,7 @@
 :- use_module(declarations).
 :- use_module(rules).
 :- use_module(engine).
+:- use_module(kbstate).
 
 /** <module> Worlds written in Prolog
 
@@ -435,15 +436,14 @@ expand([A|As], KB, Goal, S, Seen0, Seen, N0, N, Next0, Next, Found) :-
 world_for_task(KB, Task) :-
     must_be(atom, KB),
     must_be(callable, Task),
-    atom_concat('$relrl_world_task:', KB, Key),
-    nb_setval(Key, Task).
+    kb_set(KB, task, Task).
 
 :- multifile relrl_tg_bias:extra_rmode/2, relrl_tg_bias:own_rmodes/1.
 
 relrl_tg_bias:extra_rmode(KB, Mode) :-
     atom(KB),
-    atom_concat('$relrl_world_task:', KB, Key),
-    nb_current(Key, Task),
+    kb_get(KB, task, Task),
+    Task \== none,
     declared(KB, task_rmode(T, Mode)),
     subsumes_term(T, Task).
 

@@ -8,7 +8,7 @@
 :- use_module(library(pairs)).
 :- use_module(declarations).
 :- use_module(rules).
-:- use_module(engine, [engine_park/0]).
+:- use_module(engine, [engine_pause/0]).
 :- use_module(check, [body_goal/2, clause_location/3]).
 :- use_module(tg_bias, [bias_problem/2]).
 :- use_module(world).
@@ -142,7 +142,7 @@ undefined(KB, Goal, Name/Arity) :-
 %   Episodes of random legal actions, 3 per task, seeded; then optimal_steps/3 against the
 %   search. Each problem is reported once (the first episode that shows it).
 run_problem(KB, P) :-
-    engine_park,
+    engine_pause,
     set_random(seed(0)),
     sizes(KB, Sizes),
     Sizes = [Smallest|_],

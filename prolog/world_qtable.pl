@@ -8,6 +8,7 @@
 :- use_module(library(random)).
 :- use_module(library(aggregate)).
 :- use_module(engine).
+:- use_module(kbstate).
 :- use_module(declarations).
 
 /** <module> qtable: Q-learning over ground relational states (the baseline of worlds)
@@ -34,9 +35,10 @@ table's size.
 
 :- dynamic q_/5.                  % Hash, KB, Key, Q, Visits  (Key = k(State, N, Action))
 
+%   The parameters are the `learner` part of KB's record (kbstate.pl).
 params(KB, P) :-
-    atom_concat('$qtable:', KB, K),
-    (   nb_current(K, P0)
+    kb_get(KB, learner, P0),
+    (   P0 = p(_, _, _, _, _)
     ->  P = P0
     ;   existence_error(qtable, KB)
     ).
@@ -46,8 +48,7 @@ init(KB, Params) :-
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init],
             [Alpha, Gamma, Epsilon, Tau, Qinit]),
     retractall(q_(_, KB, _, _, _)),
-    atom_concat('$qtable:', KB, K),
-    nb_setval(K, p(Alpha, Gamma, Epsilon, Tau, Qinit)).
+    kb_set(KB, learner, p(Alpha, Gamma, Epsilon, Tau, Qinit)).
 
 param(Params, Name, Value) :-
     (   memberchk(Name=V, Params)
@@ -160,7 +161,11 @@ check_term(T) :-
 
 relrl_engine:learner(qtable).
 
-relrl_engine:learner_property(qtable, view(relational)).
+relrl_engine:learner_property(qtable, Cap) :-
+    member(Cap, [view(relational), state, size, policy, policy_info]).
+
+relrl_engine:learner_forget(qtable, KB) :-
+    retractall(q_(_, KB, _, _, _)).
 
 relrl_engine:learner_init(qtable, KB, Params) :-
     init(KB, Params).

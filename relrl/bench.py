@@ -65,12 +65,12 @@ def stepbench() -> ModuleType:
 
 def measure_call_cost(n: int = 2000) -> float:
     """Seconds per gateway call with one binding (``relrl_state:state_code``-sized work)."""
-    from relrl.engine import GOALS
+    from relrl.bridge.calls import prolog
     from relrl.kb import KnowledgeBase
     from relrl.terms import Var
 
     with KnowledgeBase() as kb:
-        goal = GOALS["wm_clock"]
+        goal = ":".join(prolog().goal("wm_clock"))
         kb.call(goal, kb.module, Var())
         t0 = time.perf_counter()
         for _ in range(n):

@@ -1,10 +1,10 @@
 """The one typed front over relrl's Prolog engine.
 
-Every goal of relrl's Prolog that Python calls is named here, in :data:`GOALS`, and nowhere
-else (``prolog/gateway.pl``'s ``python_api/1`` lists the same set; the gateway refuses any
-other goal of relrl's modules). Results come back decoded: :meth:`Engine.step` returns a
-:class:`StepResult` dataclass, not a term to unpack by position, and a goal that fails where
-it must succeed raises :class:`EngineError` naming it.
+Every goal of relrl's Prolog that Python calls is called by its short name, as
+``prolog/gateway.pl``'s ``python_api/2`` declares it (the one list, asked when Prolog
+starts; the gateway refuses any other goal of relrl's modules). Results come back decoded:
+:meth:`Engine.step` returns a :class:`StepResult` dataclass, not a term to unpack by
+position, and a goal that fails where it must succeed raises :class:`EngineError` naming it.
 
 One :class:`Engine` serves one knowledge base. The control loop (:mod:`relrl.loop`) and the
 learners (:mod:`relrl.learners`) use it; so can a researcher embedding relrl:
@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from relrl.bridge.calls import prolog
 from relrl.bridge.marshal import Cached
 from relrl.errors import PolicyError, PrologError, QueryTimeout, RelrlError
 from relrl.terms import Term, Var
@@ -38,7 +39,7 @@ from relrl.terms import Term, Var
 if TYPE_CHECKING:
     from relrl.kb import KnowledgeBase
 
-__all__ = ["ALL_ALLOWED", "GOALS", "MODES", "WANTS", "Engine", "EngineError", "StepResult",
+__all__ = ["ALL_ALLOWED", "MODES", "WANTS", "Engine", "EngineError", "StepResult",
            "mask_indices", "POLICY_BYTES_PER_POSITION", "POLICY_SECONDS_PER_MB"]
 
 #: seconds a policy load may take per megabyte of the file, on top of the knowledge base's
@@ -48,61 +49,6 @@ POLICY_SECONDS_PER_MB = 2.0
 #: what a position of learned knowledge (a node, an entry, a rule) takes in a policy file,
 #: at most, for the time a save may take (measured: 35 to 60 bytes).
 POLICY_BYTES_PER_POSITION = 100
-
-#: Every goal of relrl's Prolog that Python calls: short name -> "module:predicate".
-GOALS: dict[str, str] = {
-    # the control step and the learner (prolog/engine.pl)
-    "configure": "relrl_engine:engine_configure",
-    "step": "relrl_engine:engine_step",
-    "end_episode": "relrl_engine:engine_end_episode",
-    "explain": "relrl_engine:engine_explain",
-    "text": "relrl_engine:engine_text",
-    "graph": "relrl_engine:engine_graph",
-    "knowledge": "relrl_engine:engine_knowledge",
-    "size": "relrl_engine:engine_size",
-    "policy": "relrl_engine:engine_policy",
-    "keep": "relrl_engine:engine_keep",
-    "resume": "relrl_engine:engine_resume",
-    "reseed": "relrl_engine:engine_reseed",
-    "responses": "relrl_engine:engine_responses",
-    "necessities": "relrl_engine:engine_necessities",
-    "learner": "relrl_engine:engine_learner",
-    "relational_state": "relrl_engine:engine_relational_state",
-    # policies, read as data (prolog/policy.pl)
-    "policy_learner": "relrl_policy:policy_learner",
-    "policy_load": "relrl_policy:policy_load",
-    "policy_max_number": "relrl_policy:policy_max_number",
-    # working memory (prolog/memory.pl)
-    "wm_insert": "relrl_memory:wm_insert",
-    "wm_elements": "relrl_memory:wm_elements",
-    "wm_clear": "relrl_memory:wm_clear",
-    "wm_clock": "relrl_memory:wm_clock",
-    "wm_set_span": "relrl_memory:wm_set_span",
-    # the state code (prolog/state.pl) and the constraint rules (prolog/responses.pl)
-    "state_code": "relrl_state:state_code",
-    "state_terms": "relrl_state:state_terms",
-    "state_decode": "relrl_state:state_decode",
-    "state_encode": "relrl_state:state_encode",
-    "state_features": "relrl_state:state_features",
-    "allowed_responses": "relrl_responses:allowed_responses",
-    # declarations and checks (prolog/declarations.pl, prolog/check.pl, prolog/gateway.pl)
-    "necessity_inputs": "relrl_declarations:necessity_inputs",
-    "check_domain": "relrl_check:check_domain",
-    "rule_listing": "relrl_check:rule_listing",
-    "bias_listing": "relrl_check:bias_listing",
-    # percepts against a world's vocabulary (prolog/percepts.pl)
-    "world_problems": "relrl_percepts:world_problems",
-    "unread_percepts": "relrl_percepts:unread_percepts",
-    # worlds written in Prolog (prolog/world.pl, prolog/world_check.pl)
-    "world_episodes": "relrl_world:world_episodes",
-    "world_info": "relrl_world:world_info",
-    "world_task": "relrl_world:world_task",
-    "world_verify": "relrl_world:world_verify",
-    "world_for_task": "relrl_world:world_for_task",
-    "world_check": "relrl_world_check:world_problems",
-    "findall": "relrl_gateway:gw_findall",
-    "parse": "relrl_gateway:gw_parse",
-}
 
 #: The allowed mask of a step at which every response is allowed (a domain without
 #: constraint rules): the engine does not build a mask of as many bits every step.
@@ -153,17 +99,25 @@ def mask_indices(mask: int) -> list[int]:
 
 
 def call(kb: KnowledgeBase, goal: str, *arguments: Term, timeout: float | None = None) -> list:
-    """Call the engine goal named ``goal`` (a key of :data:`GOALS`) once.
+    """Call the goal of relrl's Prolog that ``python_api/2`` names ``goal`` once.
 
     Returns the values of its :class:`~relrl.terms.Var` arguments.
 
     Raises:
         EngineError: the goal failed.
     """
-    out = kb.call(GOALS[goal], *arguments, timeout=timeout)
+    out = call_semidet(kb, goal, *arguments, timeout=timeout)
     if out is None:
-        raise EngineError(f"{GOALS[goal]}/{len(arguments)} failed in {kb.module}")
+        module, name = prolog().goal(goal)
+        raise EngineError(f"{module}:{name}/{len(arguments)} failed in {kb.module}")
     return out
+
+
+def call_semidet(kb: KnowledgeBase, goal: str, *arguments: Term,
+                 timeout: float | None = None) -> list | None:
+    """:func:`call` for a goal that may fail: None when it does."""
+    module, name = prolog().goal(goal)
+    return kb.call(f"{module}:{name}", *arguments, timeout=timeout)
 
 
 def one(kb: KnowledgeBase, goal: str, *arguments: Term) -> Term:
@@ -225,7 +179,7 @@ class Engine:
         want = list(want) if want else []
         raw = self.kb.step(percepts, emitted, mode, want)
         if raw is None:
-            raise EngineError(f"{GOALS['step']}/6 failed in {self.module}")
+            raise EngineError(f"relrl_engine:engine_step/6 failed in {self.module}")
         code, necessity, ys, reward, reinforced, mask, action, extras = raw
         memory = memory_size = explanation = None
         if extras:

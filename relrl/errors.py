@@ -19,6 +19,8 @@ __all__ = [
     "USER_ERRORS",  # noqa: F822 (module __getattr__: imports head and perception lazily)
     "RelrlError",
     "UserError",
+    "JobFailed",
+    "JobCrashed",
     "PrologError",
     "PrologLoadError",
     "QueryTimeout",
@@ -36,6 +38,16 @@ class RelrlError(Exception):
 
 class UserError(RelrlError):
     """An error the user can fix: printed as one line, exit status 2."""
+
+
+class JobFailed(UserError):
+    """An experiment job's relrl error (or a lost worker), raised inside the engine that runs
+    the jobs to stop the run (:mod:`relrl.experiments.runner`)."""
+
+
+class JobCrashed(RuntimeError):
+    """An experiment job raised something that is not a relrl error: a bug; carries the
+    traceback."""
 
 
 class PrologError(RelrlError):

@@ -75,7 +75,8 @@ class KnowledgeBase:
         self.timeout = timeout
         self.files: list[Path] = []
         self.warnings: list[Problem] = []
-        out = self._prolog.run((":", "relrl_gateway", ("gw_new_kb", Var())), timeout, (0,))
+        module, name = self._prolog.goal("new_kb")
+        out = self._prolog.run((":", module, (name, Var())), timeout, (0,))
         self.module: str = out[0]  # type: ignore[index]
         self._closed = False
         for path in domains:
@@ -94,8 +95,9 @@ class KnowledgeBase:
         """
         p = Path(path)
         try:
-            out = self._prolog.run((":", "relrl_gateway", ("gw_load", str(p), self.module,
-                                                           Var())), self.timeout, (2,))
+            module, name = self._prolog.goal("load")
+            out = self._prolog.run((":", module, (name, str(p), self.module, Var())),
+                                   self.timeout, (2,))
         except Aborted as exc:
             raise PrologLoadError(display_path(str(p)), None,
                                   "abort/0 called while loading") from exc
@@ -178,7 +180,8 @@ class KnowledgeBase:
 
     # -- the knowledge layer ---------------------------------------------------------------
 
-    # Each method below is one goal of the knowledge layer, named in relrl.engine.GOALS.
+    # Each method below is one goal of the knowledge layer, called by its name in
+    # prolog/gateway.pl's python_api/2.
 
     def insert(self, elements: Iterable[Term]) -> None:
         """One insertion of ``elements`` into working memory (they get age 0)."""
@@ -232,8 +235,8 @@ class KnowledgeBase:
         """Forget this knowledge base's clauses and memory. Safe to call twice."""
         if not self._closed:
             self._closed = True
-            self._prolog.run((":", "relrl_gateway", ("gw_drop_kb", self.module)),
-                             self.timeout)
+            module, name = self._prolog.goal("drop_kb")
+            self._prolog.run((":", module, (name, self.module)), self.timeout)
 
     def __enter__(self) -> KnowledgeBase:
         return self

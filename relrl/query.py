@@ -93,7 +93,8 @@ class OpenQuery:
             raise ValueError(f"mode {mode!r}: use 'write' or 'print'")
         if self.closed:
             return None
-        prolog().run((":", "relrl_gateway", ("gw_answer_again", mode)), self.timeout)
+        module, name = prolog().goal("answer_again")
+        prolog().run((":", module, (name, mode)), self.timeout)
         return self.next()
 
     def close(self) -> None:

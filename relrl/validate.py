@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from relrl.bridge.calls import display_path as _display_path
+from relrl.engine import call as engine_call
+from relrl.engine import one
 from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase
 from relrl.terms import Term, Var, format_term
@@ -18,7 +20,7 @@ def validate(kb: KnowledgeBase) -> list[str]:
     declarations and bad necessity unit parameters (prolog/check.pl). Load warnings such as
     singleton variables come from :meth:`KnowledgeBase.load` with ``strict=False``.
     """
-    out = kb.call("relrl_check:check_domain", kb.module, Var())
+    out = engine_call(kb, "check_domain", kb.module, Var())
     lines = []
     for _, path, line, message in out[0]:  # type: ignore[index]
         where = f"{_display_path(path)}:{line}" if path else "domain"
@@ -50,8 +52,6 @@ def world_warnings(kb: KnowledgeBase, world: str) -> list[str]:
     ``world`` names a vocabulary of :data:`perception.vocabulary.WORLDS` (``sis``,
     ``episodes``, ...).
     """
-    from relrl.engine import one
-
     lines = []
     for _, path, line, message in one(kb, "world_problems", kb.module,
                                       vocabulary_terms(world)):
@@ -64,7 +64,7 @@ def bias_warnings(kb: KnowledgeBase) -> list[str]:
     """One line per warning about the tg learner's language bias: a ``#Type`` whose
     constants grow with the world (one per response's argument, or more than 10), which
     makes every leaf's candidate tests grow with it (prolog/tg_bias.pl)."""
-    _, _, _, warnings = kb.call("relrl_check:bias_listing", kb.module,
+    _, _, _, warnings = engine_call(kb, "bias_listing", kb.module,
                                 Var())[0]  # type: ignore[index]
     return [f"{_display_path(path)}:{line}: warning: {message}" if path else
             f"domain: warning: {message}" for (_, path, line, message) in warnings]
@@ -72,8 +72,6 @@ def bias_warnings(kb: KnowledgeBase) -> list[str]:
 
 def unread_percepts(kb: KnowledgeBase, percepts: list[Term]) -> list[Term]:
     """The ``percepts`` no stimulus, fact or rule of the domain perceives."""
-    from relrl.engine import one
-
     return one(kb, "unread_percepts", kb.module, list(percepts))
 
 
@@ -82,7 +80,7 @@ def describe(kb: KnowledgeBase) -> str:
     lines = ["stimuli and facts (x, 2^x):"]
     for x, feature in enumerate(kb.features()):
         lines.append(f"  {x:3d} {1 << x:>12d}  {format_term(feature)}")
-    reinforcers = kb.call("relrl_gateway:gw_findall", kb.module,
+    reinforcers = engine_call(kb, "findall", kb.module,
                           ("stimulus_property", Var("S"), "reinforcer"), Var())[0]  # type: ignore
     if reinforcers:
         lines.append("reinforcers: " + ", ".join(format_term(r[1]) for r in reinforcers))
@@ -90,14 +88,14 @@ def describe(kb: KnowledgeBase) -> str:
     lines += [f"  {format_term(r)}" for r in kb.declarations("response")]
     lines.append("necessities:")
     for n in kb.declarations("necessity"):
-        params = kb.call("relrl_gateway:gw_findall", kb.module,
+        params = engine_call(kb, "findall", kb.module,
                          ("unit", n, Var("P"), Var("V")), Var())[0]  # type: ignore[index]
         text = ", ".join(f"{p[2]}={format_term(p[3])}" for p in params)
         lines.append(f"  {format_term(n)}: {text}")
-        inputs = kb.call("relrl_declarations:necessity_inputs", kb.module, n, Var())[0]  # type: ignore
+        inputs = engine_call(kb, "necessity_inputs", kb.module, n, Var())[0]  # type: ignore
         for _, goal, weight in inputs:
             lines.append(f"      input {format_term(goal)}  weight {weight:+g}")
-    rules = kb.call("relrl_check:rule_listing", kb.module, Var())[0]  # type: ignore[index]
+    rules = engine_call(kb, "rule_listing", kb.module, Var())[0]  # type: ignore[index]
     lines.append("rules:")
     lines += [f"  {r}" for r in rules] or ["  (none)"]
     lines += _bias_lines(kb)
@@ -106,7 +104,7 @@ def describe(kb: KnowledgeBase) -> str:
 
 def _bias_lines(kb: KnowledgeBase) -> list[str]:
     """The relational view and what the tg learner's language bias generates at the root."""
-    _, relations, refinements, _ = kb.call("relrl_check:bias_listing", kb.module,
+    _, relations, refinements, _ = engine_call(kb, "bias_listing", kb.module,
                                            Var())[0]  # type: ignore[index]
     if not relations and not refinements:
         return []

@@ -65,7 +65,27 @@ class Prolog:
         self._gw_run = lib.predicate(b"gw_run", 2, b"relrl_gateway")
         self._true = lib.predicate(b"true", 0, b"system")
         self._kernel: Any = None         # the compiled step, loaded with the first step
+        self._api: dict[str, tuple[str, str]] | None = None   # python_api/2, asked once
         self._wants: dict[Any, int] = {}  # records of the steps' lists of extras
+
+    # -- the API -------------------------------------------------------------------------
+
+    def goal(self, name: str) -> tuple[str, str]:
+        """``(module, predicate)`` of the goal of relrl's Prolog that Python calls ``name``:
+        ``prolog/gateway.pl``'s ``python_api/2``, the one list of them, asked once.
+
+        Raises:
+            RelrlError: relrl's Prolog declares no goal of that name.
+        """
+        if self._api is None:
+            out = self.run((":", "relrl_gateway", ("gw_api", Var())), 0, (0,))
+            self._api = {str(n): (str(m), str(p))
+                         for (_, n, (_, m, (_, p, _))) in out[0]}  # type: ignore[index]
+        try:
+            return self._api[name]
+        except KeyError:
+            raise RelrlError(f"relrl's Prolog declares no goal {name!r} for Python "
+                             "(python_api/2 in prolog/gateway.pl)") from None
 
     # -- a goal, once ----------------------------------------------------------------------
 
@@ -135,7 +155,8 @@ class Prolog:
         ex = self.lib.exception(0)
         if not ex:
             self.lib.clear_exception()
-            out = self.run((":", "relrl_gateway", ("gw_take_abort", Var())), 0, (0,))
+            module, name = self.goal("take_abort")
+            out = self.run((":", module, (name, Var())), 0, (0,))
             where = out[0] if out else "goal"
             if isinstance(where, tuple) and where[0] == ":":
                 raise Aborted(str(where[1]), where[2] or None)

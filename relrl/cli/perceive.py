@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     from perception.errors import PerceptionError
     from perception.facts import format_fact
     from perception.pipeline import Perceiver, annotate
-    from perception.vocab import PLACES
+    from perception.vocabulary import PLACES
     from relrl.outdir import check_out_file, write_atomic
 
     if (args.image is None) == (args.camera is None):

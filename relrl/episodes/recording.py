@@ -45,10 +45,7 @@ from relrl.monitor.view import head_view, metrics_view, overlay_of, view_of
 from relrl.outdir import open_stream, write_atomic, write_json_atomic
 from relrl.tensorboard import EVENT_FILE, ScalarLog
 
-__all__ = ["RECORDED", "RECORDING", "SessionTap", "write_manifest"]
-
-#: the files a recorded session writes besides the summary's (``--record``).
-RECORDED = ("session.json", "episode.toml", "domain.pl", "session.mcap")
+__all__ = ["RECORDING", "SessionTap", "write_manifest"]
 
 #: what a traced or shown step asks the engine for, in the step's one gateway call.
 WANTS = ("memory", "explain")

@@ -22,6 +22,7 @@ from typing import Any
 
 from head.tomlfile import MAX_NESTING, read_limited, too_deep
 from perception.vocabulary import OBJECT_PLACES, PLACES
+from relrl.episodes.outputs import policy_save_problem
 from relrl.errors import UserError
 
 __all__ = [
@@ -291,8 +292,6 @@ class _Checker:
             self.fail(where, f"policy_save must be a file name inside --out (a relative path "
                              f"without '..'), not {value!r}")
             return None
-        from relrl.episodes.session import policy_save_problem  # the session's own files
-
         if problem := policy_save_problem(str(parts)):
             self.fail(where, problem)
             return None

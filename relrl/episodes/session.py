@@ -26,27 +26,22 @@ import threading
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import Any, TextIO
 
 import numpy as np
 
+from relrl.episodes.outputs import RECORDED, RUN_FILES, policy_save_problem
 from relrl.episodes.provenance import provenance, session_manifest
-from relrl.episodes.recording import RECORDED, SessionTap, write_manifest
+from relrl.episodes.recording import SessionTap, write_manifest
 from relrl.episodes.script import Episode
 from relrl.outdir import check_inside, deferred_signals, write_json_atomic
 from relrl.progress import progress
-from relrl.tensorboard import EVENT_FILE
 from relrl.terms import format_term
 
-__all__ = ["RUN_FILES", "STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial",
-           "policy_save_problem", "run_episode", "run_outputs"]
+__all__ = ["STOP_SIGNALS", "RunOptions", "StopRequest", "keep_partial", "run_episode",
+           "run_outputs"]
 
-#: the files and folders (``name/``) a session writes into its output folder.
-RUN_FILES = ("trace.jsonl", EVENT_FILE, "summary.json", "timing.json", "run.log",
-             "rewards.png", "cgi.png", "table1.png") + RECORDED
-#: the longest file name most file systems take, in bytes (the folder is asked at the run).
-NAME_MAX = 255
 
 
 #: signals that stop a run after the current time unit (SIGHUP: the terminal was closed).
@@ -136,26 +131,6 @@ class RunOptions:
     record_rate: float = 10.0
     record_quality: int = 85
     timeout: float = 10.0
-
-
-def policy_save_problem(name: str) -> str | None:
-    """Why ``name`` (a path inside the output folder) cannot be an episode's ``policy_save``:
-    a NUL, a part longer than a file name can be, or a file or folder of the run itself
-    (``summary.json``, ``session.json``, ``session.mcap``, relrl's ``.relrl-run.*``); None
-    when it can."""
-    if "\0" in name:
-        return f"policy_save {name!r} holds a NUL character; no file name can"
-    parts = PurePosixPath(name).parts
-    for part in parts:
-        if len(part.encode("utf-8", "surrogateescape")) > NAME_MAX:
-            return (f"policy_save: the name {part[:40]}... is {len(part.encode())} bytes; a "
-                    f"file name has at most {NAME_MAX}")
-    if not parts:
-        return None
-    if {parts[0], f"{parts[0]}/"} & set(RUN_FILES) or parts[0].startswith(".relrl-run"):
-        return (f"policy_save {name!r} is a file of the run itself; choose another name (e.g. "
-                "policy.pl)")
-    return None
 
 
 def run_outputs(episode: Episode, record: bool = False) -> list[str]:

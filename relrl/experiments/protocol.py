@@ -52,6 +52,7 @@ class Session:
         from relrl.learners import make_learner
         from relrl.loop import Agent, Interaction
         from relrl.sim.metrics import GazeMetrics
+        from relrl.sim.sis import SharedAttentionEnv
         from relrl.sim.world import World
 
         self.t_start = time.perf_counter()
@@ -67,8 +68,8 @@ class Session:
         try:
             self.learner = make_learner(learner, **dict(learner_params))
             self.agent = Agent(self.kb, self.learner, seed=seed)
-            env = self.world.env(caregiver, caregiver_params, max_steps=None,
-                                 record_trace=False)
+            env = SharedAttentionEnv(caregiver, caregiver_params, world=self.world,
+                                     max_steps=None, record_trace=False)
             self.metrics = GazeMetrics(env.caregiver.params.contact_hold)
             self.reward = 0.0
             self.learning = Interaction(env, self.agent, on_step=self._on_learning_step)

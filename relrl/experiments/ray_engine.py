@@ -16,7 +16,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from relrl.errors import ConfigError
+from relrl.errors import ConfigError, JobCrashed, JobFailed
 
 __all__ = ["run_ray"]
 
@@ -93,7 +93,6 @@ def run_ray(fn: Callable[..., dict[str, Any]], arglist: list[tuple], outcome: An
         from ray.util.queue import Empty, Queue
     except ImportError:
         raise ConfigError("--engine ray needs Ray: pip install 'relrl[ray]'") from None
-    from relrl.experiments.runner import JobCrashed, _JobFailed
 
     started = _connect(ray, address, workers)
     queue = None
@@ -124,14 +123,14 @@ def run_ray(fn: Callable[..., dict[str, Any]], arglist: list[tuple], outcome: An
                     status = ray.get(ref)
                 except ray.exceptions.RayError as exc:
                     first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-                    raise _JobFailed(f"the Ray task running {label(arglist[index])} ended "
+                    raise JobFailed(f"the Ray task running {label(arglist[index])} ended "
                                      f"without a result ({type(exc).__name__}: {first}); a "
                                      "domain that calls halt/0 or crashes Prolog ends its "
                                      "worker: check it with relrl check") from None
                 if status[0] == "done":
                     outcome.results[index] = status[1]
                 elif status[0] == "error":
-                    raise _JobFailed(status[2])
+                    raise JobFailed(status[2])
                 else:
                     raise JobCrashed(f"job {label(arglist[index])} failed with {status[1]} "
                                      f"(a bug in relrl; the task's traceback follows)\n"

@@ -38,9 +38,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
-from relrl.errors import ConfigError, UserError
+from relrl.errors import ConfigError, JobCrashed, JobFailed, UserError
+from relrl.experiments.ray_engine import run_ray
 
-__all__ = ["ENGINES", "STOP_SIGNALS", "CommandSignals", "JobCrashed", "Outcome", "ProgressBar",
+__all__ = ["ENGINES", "STOP_SIGNALS", "CommandSignals", "Outcome", "ProgressBar",
            "Stopped", "WorkerLost", "command_signals", "raise_kept", "run_jobs"]
 
 #: a job function: ``fn(*args, report=callable) -> dict``.
@@ -49,10 +50,6 @@ JobFn = Callable[..., dict[str, Any]]
 
 class WorkerLost(UserError):
     """A worker process ended without finishing its job (``halt/0`` in a domain, a crash)."""
-
-
-class JobCrashed(RuntimeError):
-    """A job raised something that is not a relrl error: a bug; carries the traceback."""
 
 
 @dataclass
@@ -109,10 +106,6 @@ def raise_kept(error: str, out: Any) -> None:
     """Raise the one line of a job's failure, saying where the finished jobs were kept."""
     raise UserError(f"{error} (the run stopped; what finished is in {out}/results.json, "
                     "marked partial)")
-
-
-class _JobFailed(UserError):
-    """A job's relrl error (or a lost worker), raised inside an engine to stop the run."""
 
 
 class _Stop(Exception):
@@ -258,7 +251,7 @@ def run_jobs(fn: JobFn, arglist: list[tuple], *, workers: int = 1, engine: str =
                       label=label, stopped=stopped)
             except _Stop as stop:
                 outcome.interrupted = stop.name
-            except _JobFailed as failed:
+            except JobFailed as failed:
                 outcome.error = str(failed)
             if stopped.is_set() and outcome.interrupted is None:
                 outcome.interrupted = getattr(stopped, "signal_name", "SIGINT")
@@ -379,7 +372,7 @@ def _run_local(fn: JobFn, arglist: list[tuple], outcome: Outcome,
                     open_conns.discard(w)
                     if w in busy:
                         procs[w].join(2.0)
-                        raise _JobFailed(str(WorkerLost(
+                        raise JobFailed(str(WorkerLost(
                             f"the worker running {label(arglist[busy[w]])} ended without a "
                             f"result (exit status {procs[w].exitcode}): a domain that calls "
                             "halt/0 or crashes Prolog ends its worker; check it with relrl "
@@ -392,7 +385,7 @@ def _run_local(fn: JobFn, arglist: list[tuple], outcome: Outcome,
                     outcome.results[index] = msg[2]
                     give(w)
                 elif kind == "error":
-                    raise _JobFailed(msg[3])
+                    raise JobFailed(msg[3])
                 else:
                     raise JobCrashed(f"job {label(arglist[index])} failed with {msg[2]} "
                                      f"(a bug in relrl; the worker's traceback follows)\n"
@@ -406,12 +399,6 @@ def _run_local(fn: JobFn, arglist: list[tuple], outcome: Outcome,
         _stop_processes(procs)
 
 
-def _run_ray(*args: Any, **kwargs: Any) -> None:
-    from relrl.experiments.ray_engine import run_ray
-
-    run_ray(*args, **kwargs)
-
-
 #: engine name -> runner ``(fn, arglist, outcome, event, workers=, address=, label=,
 #: stopped=)`` that fills ``outcome.results`` and calls ``event`` for every event.
-ENGINES: dict[str, Callable[..., None]] = {"local": _run_local, "ray": _run_ray}
+ENGINES: dict[str, Callable[..., None]] = {"local": _run_local, "ray": run_ray}

@@ -34,6 +34,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from relrl.sim.world import World
+
 __all__ = ["ScalingConfig", "held_out_places", "run_scaling_job"]
 
 
@@ -70,10 +72,8 @@ class ScalingConfig:
     transfer_from: int = 5           #: with transfer "sizes": the world learned in
     holdout: float = 0.4             #: share of places (or kinds) held out for transfer
 
-    def world_of(self, size: int) -> Any:
+    def world_of(self, size: int) -> World:
         """The world of one size."""
-        from relrl.sim.world import World
-
         return World(**{**self.world, "places": size})
 
     def jobs(self) -> list[tuple[str, int, int, str]]:

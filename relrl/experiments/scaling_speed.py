@@ -32,6 +32,7 @@ def step_cost_by_size(learner: str = "tg", sizes: tuple[int, ...] = (5, 129), *,
     from relrl.kb import KnowledgeBase
     from relrl.learners import make_learner
     from relrl.loop import Agent, Interaction
+    from relrl.sim.sis import SharedAttentionEnv
     from relrl.sim.world import World
 
     if not sizes:
@@ -45,8 +46,8 @@ def step_cost_by_size(learner: str = "tg", sizes: tuple[int, ...] = (5, 129), *,
                 run = {"size": size, "kb": kb, "agent": 0.0, "env": 0.0, "steps": 0}
                 runs.append(run)
                 agent = Agent(kb, make_learner(learner), seed=seed)
-                interaction = Interaction(world.env(max_steps=None, record_trace=False),
-                                          agent)
+                interaction = Interaction(
+                    SharedAttentionEnv(world=world, max_steps=None, record_trace=False), agent)
                 interaction.reset(seed=seed)
                 interaction.run(warmup, keep=False)
                 run.update(interaction=interaction, agent_obj=agent)

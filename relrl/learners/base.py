@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import numpy as np
 
 from relrl.errors import ConfigError
+from relrl.reward import PAPER_REWARD
 from relrl.terms import Term
 
 if TYPE_CHECKING:
@@ -24,8 +25,10 @@ if TYPE_CHECKING:
 
 __all__ = ["Learner", "StepOut", "register", "make_learner", "LEARNERS", "COMMON_DEFAULTS"]
 
-#: Parameters every learner takes: the reward for a perceived reinforcer and otherwise.
-COMMON_DEFAULTS: dict[str, float] = {"reward_positive": 10.0, "reward_negative": -1.0}
+#: Parameters every learner takes: the reward for a perceived reinforcer and otherwise (the
+#: task's reward, :data:`relrl.reward.PAPER_REWARD`).
+COMMON_DEFAULTS: dict[str, float] = {"reward_positive": PAPER_REWARD.attention,
+                                     "reward_negative": PAPER_REWARD.other}
 
 
 @dataclass

@@ -8,12 +8,13 @@ See ``docs/simulator.md`` and ``docs/benchmark.md``. Quick start::
     obs, info = env.reset(seed=1)
     obs, reward, terminated, truncated, info = env.step(("look", "centre"))
     print(info["percepts"], env.metrics()["cgi"])
-    big = World(places=17, colours=3, scene=True).env()
+    big = SharedAttentionEnv(world=World(places=17, colours=3, scene=True))
 """
 
 from __future__ import annotations
 
 from relrl.envs import register_envs
+from relrl.reward import PAPER_REWARD, Reward
 from relrl.sim.caregiver import (
     EVALUATION_SEQUENCE,
     Caregiver,
@@ -37,7 +38,6 @@ from relrl.sim.metrics import (
     summarize,
 )
 from relrl.sim.places import PLACES, TOY_PLACES, Layout, layout, place_names
-from relrl.sim.reward import PAPER_REWARD, Reward
 from relrl.sim.sis import ENV_ID, ENV_ID_V1, RESPONSES, SharedAttentionEnv
 from relrl.sim.world import World
 

@@ -26,6 +26,11 @@ from typing import Any
 
 import numpy as np
 
+from relrl.sim.caregiver import make_caregiver
+from relrl.sim.errors import SimError
+from relrl.sim.sis import SharedAttentionEnv
+from relrl.sim.world import World
+
 __all__ = ["Evaluation", "evaluate", "evaluation_env", "evaluation_seeds"]
 
 #: a policy: ``(observation, info) -> action`` (an index, a ``look(P)`` term or its text).
@@ -88,12 +93,14 @@ class Evaluation:
                 "eye_contacts_mean": self.eye_contacts_mean}
 
 
-def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
+def evaluate(policy: Policy, *, world: World | Mapping[str, Any] | None = None,
+             caregiver: str = "paper",
              caregiver_params: Mapping[str, Any] | None = None, runs: int = 20,
              steps: int = 500, seed: int = 0, sequence: Sequence[str] | None = None,
              which: tuple[int, int] | None = None,
              on_run: Callable[[int, int], None] | None = None,
-             env: Any = None, observation: int = 0, by_place: bool = False) -> Evaluation:
+             env: SharedAttentionEnv | None = None, observation: int = 0,
+             by_place: bool = False) -> Evaluation:
     """Evaluate a policy by the paper's protocol.
 
     Args:
@@ -120,8 +127,6 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
         An :class:`Evaluation` with one metrics dict per run.
     """
     if not isinstance(runs, int) or runs < 1 or not isinstance(steps, int) or steps < 1:
-        from relrl.sim.errors import SimError
-
         raise SimError(f"runs={runs!r}, steps={steps!r}: use whole numbers >= 1")
     if env is None:
         env = evaluation_env(world=world, caregiver=caregiver,
@@ -148,15 +153,12 @@ def evaluate(policy: Policy, *, world: Any = None, caregiver: str = "paper",
     return result
 
 
-def evaluation_env(*, world: Any = None, caregiver: str = "paper",
-                   caregiver_params: Mapping[str, Any] | None = None, steps: int = 500,
-                   sequence: Sequence[str] | None = None, observation: int = 0) -> Any:
+def evaluation_env(*, world: World | Mapping[str, Any] | None = None,
+                   caregiver: str = "paper", caregiver_params: Mapping[str, Any] | None = None,
+                   steps: int = 500, sequence: Sequence[str] | None = None,
+                   observation: int = 0) -> SharedAttentionEnv:
     """The simulator in evaluation mode: targets from ``sequence`` (default: the world's
     balanced sequence), ``steps`` time units per episode, no stored trace."""
-    from relrl.sim.caregiver import make_caregiver
-    from relrl.sim.sis import SharedAttentionEnv
-    from relrl.sim.world import World
-
     if isinstance(world, Mapping):
         world = World(**world)
     world = world or World()

@@ -28,7 +28,7 @@ Action: ``Discrete(P + 1)``, action ``i`` is ``look(places[i])`` (``RESPONSES`` 
 paper's world). ``step`` also takes the response term ``("look", "left")`` or its text
 ``"look(left)"``.
 
-Reward: :mod:`relrl.sim.reward` (+10 in a time unit with ``hear(attention)``, else -1).
+Reward: :mod:`relrl.reward` (+10 in a time unit with ``hear(attention)``, else -1).
 Episodes never terminate; they are truncated after ``max_steps`` time units (``None``:
 never; stepping on after truncation is allowed). At truncation ``info`` also holds the
 episode's metrics: ``cgi``, ``cgi_literal``, ``eye_contacts``, ``opportunities``, ``shifts``,
@@ -47,12 +47,12 @@ from gymnasium import spaces
 
 from perception.vocabulary import SIS_POSES
 from relrl.interfaces import Environment
+from relrl.reward import PAPER_REWARD
 from relrl.sim.caregiver import Caregiver, CaregiverParams, make_caregiver
 from relrl.sim.errors import InvalidResponse, SimError, did_you_mean
 from relrl.sim.metrics import GazeMetrics, StepRecord
 from relrl.sim.places import CENTRE, PLACES, layout
 from relrl.sim.render import render_rgb, render_text
-from relrl.sim.reward import PAPER_REWARD
 from relrl.sim.world import World
 
 __all__ = ["ENV_ID", "ENV_ID_V1", "OBSERVATION_FIELDS", "POSES", "RESET_OPTIONS", "RESPONSES",

@@ -10,7 +10,7 @@ caregiver (reliability, latency, timeouts) stays in
 The world builds the rest, so nothing is copied by hand::
 
     world = World(places=9, colours=3, scene=True)
-    env = world.env(caregiver_params={"reliability": 0.8})     # the simulator
+    env = SharedAttentionEnv(world=world, caregiver_params={"reliability": 0.8})
     path = world.write_domain("runs/worlds")                     # its Prolog domain
 
 ``World()`` is the paper's world: :meth:`World.domain_text` then declares the same stimuli,
@@ -27,6 +27,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from perception.vocabulary import Vocabulary, sis_vocabulary
+from relrl.outdir import write_atomic
+from relrl.sim.caregiver import CaregiverParams, preset_params
+from relrl.sim.domain import domain_text
 from relrl.sim.errors import SimError, did_you_mean
 from relrl.sim.places import MAX_PLACES, Layout, layout
 
@@ -122,47 +126,33 @@ class World:
     # ---- building the simulator and the domain ---------------------------------------------
 
     def caregiver_params(self, overrides: Mapping[str, Any] | None = None,
-                         preset: str = "paper") -> Any:
+                         preset: str = "paper") -> CaregiverParams:
         """The caregiver's parameters in this world: a registered preset with this world's
         places, colours, kinds and toys per trial, then ``overrides`` (reliability, ...)."""
-        from relrl.sim.caregiver import preset_params
-
         base = preset_params(preset).replace(
             places=self.layout.toy_places, placement=None, toy_colours=self.colour_names,
             toy_kinds=self.kind_names, n_toys=self.toys)
         return base.replace(**dict(overrides or {}))
 
-    def env(self, caregiver: str = "paper", caregiver_params: Mapping[str, Any] | None = None,
-            **kwargs: Any) -> Any:
-        """A :class:`~relrl.sim.sis.SharedAttentionEnv` of this world (keywords as its)."""
-        from relrl.sim.sis import SharedAttentionEnv
-
-        return SharedAttentionEnv(caregiver, caregiver_params, world=self, **kwargs)
-
     def domain_text(self) -> str:
         """This world's domain file (see :mod:`relrl.sim.domain`)."""
-        from relrl.sim.domain import domain_text
-
         return domain_text(self)
 
-    def write_domain(self, folder: str | Path) -> Path:
-        """Write this world's domain to ``folder/NAME.pl`` (unchanged files are left alone;
-        a new one appears whole, through a rename). Returns the path."""
-        from relrl.outdir import write_atomic
-
-        path = Path(folder) / f"{self.name}.pl"
+    def write_domain(self, folder: str | Path, stem: str | None = None) -> Path:
+        """Write this world's domain to ``folder/STEM.pl``, ``STEM`` this world's
+        :attr:`name` by default (unchanged files are left alone; a new one appears whole,
+        through a rename). Returns the path."""
+        path = Path(folder) / f"{stem or self.name}.pl"
         text = self.domain_text()
         if path.is_file() and not path.is_symlink() and path.read_text() == text:
             return path
         return write_atomic(path, text)
 
-    def vocabulary(self) -> Any:
+    def vocabulary(self) -> Vocabulary:
         """The percepts this world produces, as a
         :class:`perception.vocabulary.Vocabulary` (what ``relrl check --world`` compares a
         domain with): the simulator's for these places, plus ``kind(toy, K)`` and
         ``in_view(P, C, K)`` where the world has them."""
-        from perception.vocabulary import Vocabulary, sis_vocabulary
-
         places = self.layout.places
         base = sis_vocabulary(places, name=self.name,
                               description=f"the simulator, {self.places} toy places")

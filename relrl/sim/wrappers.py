@@ -1,36 +1,24 @@
 """Gymnasium wrappers for outside agents.
 
-:class:`EpisodeScalars` writes every finished episode's return, length and gaze metrics (the
-CGI and the rest that ``info`` holds at truncation) as TensorBoard scalars, whatever agent
-library steps the environment (Stable-Baselines3, a loop of your own).
-
 :class:`RelationalObservation` replaces the observation vector by the *relational view* of the
-time unit: the ground facts a relational learner reads (the ``relation/1`` templates of the
-generated domains and ``examples/domains/sis.pl``; docs/tg.md), as a sorted tuple of Prolog
-text, e.g. ``("gaze(face,left)", "head_at(centre)", "sees(face)")``. The tuple is hashable,
-so a tabular agent can key a table on it; a first-order agent can parse it.
+time unit: the ground facts a relational learner reads, as a sorted tuple of Prolog text, e.g.
+``("gaze(face,left)", "head_at(centre)", "sees(face)")``. The tuple is hashable, so a tabular
+agent can key a table on it; a first-order agent can parse it.
 
-============================  ==========================================================
-percept of the time unit      relational fact
-============================  ==========================================================
-``see(X)``                    ``sees(X)``
-``pose(face, frontal)``       ``gaze(face,centre)`` (the caregiver looks at the robot)
-``pose(face, P)``             ``gaze(face,P)``
-``at(P)``                     ``head_at(P)``
-``at(toy, P)``                ``toy_at(toy,P)`` (focus-only worlds)
-``colour(toy, C)``            ``colour(toy,C)`` (focus-only worlds)
-``kind(toy, K)``              ``kind(toy,K)`` (focus-only worlds)
-``in_view(P, C, K)``          ``toy_at(toy(P),P)``, ``colour(toy(P),C)``, ``kind(toy(P),K)``
-                              (whole-scene worlds; ``none`` values give no fact)
-``hear(W)``                   ``heard(W)``
-============================  ==========================================================
-
-A test holds this table to the Prolog definitions of the generated domains.
+The view is the world's domain's (:class:`RelationalView`): the world's generated domain
+(:mod:`relrl.sim.domain`) is loaded into a knowledge base, each time unit's percepts go into
+its working memory, and the facts are the ground solutions of its ``relation/1`` templates
+(docs/tg.md) -- what the tg learner reads, from the one definition of it. For the paper's
+world: ``see(X)`` gives ``sees(X)``, ``pose(face, P)`` ``gaze(face,P)`` (``centre`` for
+``frontal``: the caregiver looks at the robot), ``at(P)`` ``head_at(P)``, ``at(toy, P)``
+``toy_at(toy,P)``, ``colour(toy, C)`` ``colour(toy,C)``, ``hear(W)`` ``heard(W)``; whole-scene
+worlds see each toy in view as ``toy(P)``.
 """
 
 from __future__ import annotations
 
 import string
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -38,9 +26,12 @@ from typing import Any
 import gymnasium as gym
 from gymnasium import spaces
 
-from relrl.terms import Term
+from relrl.engine import one
+from relrl.kb import KnowledgeBase
+from relrl.sim.world import World
+from relrl.terms import Term, format_term
 
-__all__ = ["EpisodeScalars", "RelationalObservation", "relational_facts"]
+__all__ = ["EpisodeScalars", "RelationalObservation", "RelationalView"]
 
 #: what ``info`` holds at an episode's end that :class:`EpisodeScalars` writes.
 EPISODE_METRICS = ("cgi", "cgi_literal", "eye_contacts", "opportunities", "shifts",
@@ -49,33 +40,37 @@ EPISODE_METRICS = ("cgi", "cgi_literal", "eye_contacts", "opportunities", "shift
 _CHARSET = string.ascii_lowercase + string.digits + "_(),"
 
 
-def relational_facts(percepts: Sequence[Term], scene: bool = False) -> tuple[str, ...]:
-    """The relational view of one time unit's percepts, sorted (see the module table)."""
-    facts: set[str] = set()
-    add = facts.add
-    for p in percepts:
-        head = p[0]
-        if head == "see":
-            add(f"sees({p[1]})")
-        elif head == "pose":
-            add(f"gaze({p[1]},{'centre' if p[2] == 'frontal' else p[2]})")
-        elif head == "at":
-            if len(p) == 2:
-                add(f"head_at({p[1]})")
-            elif not scene:
-                add(f"toy_at({p[1]},{p[2]})")
-        elif head in ("colour", "kind") and not scene:
-            add(f"{head}({p[1]},{p[2]})")
-        elif head == "in_view":
-            place, colour, kind = p[1], p[2], p[3]
-            add(f"toy_at(toy({place}),{place})")
-            if colour != "none":
-                add(f"colour(toy({place}),{colour})")
-            if kind != "none":
-                add(f"kind(toy({place}),{kind})")
-        elif head == "hear":
-            add(f"heard({p[1]})")
-    return tuple(sorted(facts))
+class RelationalView:
+    """The relational view of a world's time units, from its domain's ``relation/1``.
+
+    Holds a knowledge base of the world's domain until :meth:`close` (also a context
+    manager).
+
+    Example:
+        >>> with RelationalView(World()) as view:
+        ...     view([("see", "face"), ("pose", "face", "frontal"), ("at", "centre")])
+        ('gaze(face,centre)', 'head_at(centre)', 'sees(face)')
+    """
+
+    def __init__(self, world: World) -> None:
+        with tempfile.TemporaryDirectory(prefix="relrl-view-") as folder:
+            self.kb = KnowledgeBase(world.write_domain(folder))
+
+    def __call__(self, percepts: Sequence[Term]) -> tuple[str, ...]:
+        """The relational view of one time unit's percepts, sorted (their text)."""
+        self.kb.insert(percepts)
+        return tuple(sorted(format_term(f)
+                            for f in one(self.kb, "relational_state", self.kb.module)))
+
+    def close(self) -> None:
+        """Drop the knowledge base. Safe to call twice."""
+        self.kb.close()
+
+    def __enter__(self) -> RelationalView:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 class RelationalObservation(gym.ObservationWrapper, gym.utils.RecordConstructorArgs):
@@ -95,27 +90,32 @@ class RelationalObservation(gym.ObservationWrapper, gym.utils.RecordConstructorA
     def __init__(self, env: gym.Env) -> None:
         gym.utils.RecordConstructorArgs.__init__(self)
         gym.ObservationWrapper.__init__(self, env)
-        self._scene = bool(getattr(env.unwrapped, "world", None) and env.unwrapped.world.scene)
+        self.view = RelationalView(env.unwrapped.world)
         self.observation_space = spaces.Sequence(spaces.Text(max_length=64, charset=_CHARSET))
         self._last: tuple[str, ...] = ()
 
     def reset(self, **kwargs: Any) -> tuple[tuple[str, ...], dict[str, Any]]:
         """Reset the wrapped environment; the observation is the relational view."""
         obs, info = self.env.reset(**kwargs)
-        self._last = relational_facts(info["percepts"], self._scene)
+        self._last = self.view(info["percepts"])
         info["relational"] = self._last
         return self._last, info
 
     def step(self, action: Any) -> tuple[tuple[str, ...], float, bool, bool, dict[str, Any]]:
         """Step the wrapped environment; the observation is the relational view."""
         obs, reward, terminated, truncated, info = self.env.step(action)
-        self._last = relational_facts(info["percepts"], self._scene)
+        self._last = self.view(info["percepts"])
         info["relational"] = self._last
         return self._last, reward, terminated, truncated, info
 
     def observation(self, observation: Any) -> tuple[str, ...]:
         """The relational view of the last time unit (computed from its percepts)."""
         return self._last
+
+    def close(self) -> None:
+        """Close the wrapped environment and drop the view's knowledge base."""
+        self.view.close()
+        super().close()
 
 
 class EpisodeScalars(gym.Wrapper, gym.utils.RecordConstructorArgs):

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from relrl.bridge.calls import display_path as _display_path
-from relrl.engine import Engine, call, one
+from relrl.engine import Engine, call, call_semidet, one
 from relrl.errors import ConfigError, PrologError
 from relrl.kb import KnowledgeBase
 from relrl.terms import Term, Var, format_term
@@ -179,7 +179,7 @@ class World:
                                   f"{_display_path(str(self.path))}: "
                                   f"{', '.join(self.task_names())})")
             spec = terms[0]
-        out = self.kb.call("relrl_world:world_task", self.kb.module, spec, Var())
+        out = call_semidet(self.kb, "world_task", self.kb.module, spec, Var())
         if out is None:
             raise ConfigError(f"--task {text!r}: no such task in "
                               f"{_display_path(str(self.path))} (tasks: "

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from relrl.errors import ConfigError
-from relrl.experiments.runner import JobCrashed, run_jobs
+from relrl.errors import ConfigError, JobCrashed
+from relrl.experiments.runner import run_jobs
 from tests.experiments import jobs
 
 

@@ -72,9 +72,12 @@ def test_a_transfer_job_never_sees_a_toy_at_the_held_out_places() -> None:
     assert tr["unseen"] == list(held_out_places(layout(9).toy_places, 0.4))
     assert set(tr["trained"]).isdisjoint(tr["unseen"]) and 0 <= tr["cgi_unseen"] <= 1
     world = cfg.world_of(9)
-    env = world.env(caregiver_params={"placement": {p: 1.0 for p in tr["trained"]}},
-                    max_steps=None)
+    from relrl.sim import SharedAttentionEnv
     from relrl.sim.policies import GazeFollower, rollout
+
+    placement = {p: 1.0 for p in tr["trained"]}
+    env = SharedAttentionEnv(world=world, caregiver_params={"placement": placement},
+                             max_steps=None)
 
     trace = rollout(env, GazeFollower(), 3000, seed=0)
     assert {p for rec in trace for p, _ in rec.toys}.isdisjoint(tr["unseen"])

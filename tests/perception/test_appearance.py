@@ -126,7 +126,7 @@ def test_the_hand_covers_part_of_the_fruit() -> None:
 
 def test_faces_survive_the_camera() -> None:
     from perception.pipeline import Perceiver
-    from perception.vocab import POSES
+    from perception.vocabulary import POSES
 
     var = Variation()
     rng = np.random.default_rng(5)

@@ -9,7 +9,7 @@ import pytest
 
 from perception.cascade import Cascade, group, parse_cascade
 from perception.render import SceneView, render
-from perception.vocab import POSES
+from perception.vocabulary import POSES
 
 _DIR = Path(cv2.data.haarcascades)
 _FILES = ("haarcascade_frontalface_alt2.xml", "haarcascade_profileface.xml")

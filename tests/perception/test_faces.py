@@ -7,7 +7,7 @@ import pytest
 from perception.bench import lfw_figures
 from perception.faces import FaceTracker, detect_face
 from perception.render import SceneView, render
-from perception.vocab import POSES
+from perception.vocabulary import POSES
 
 
 def test_astronaut_face_is_found_frontal(astronaut_bgr):

@@ -12,7 +12,9 @@ import pytest
 import perception.vocabulary as percepts
 from perception.vocabulary import (
     ANY,
+    COLOURS,
     GAZE_POSE,
+    HUES,
     OBJECT_PLACES,
     PLACES,
     POSES,
@@ -30,21 +32,20 @@ def test_every_package_uses_the_one_definition() -> None:
     import relrl.episodes.world
     import relrl.sim.places
     import relrl.sim.sis
-    import relrl.vocabulary
 
     assert head.DIRECTIONS is PLACES
     assert perception.PLACES is PLACES and perception.POSES is POSES
+    assert perception.COLOURS is COLOURS and perception.HUES is HUES and tuple(HUES) == COLOURS
     assert relrl.sim.places.PLACES is PLACES and relrl.sim.places.TOY_PLACES is OBJECT_PLACES
     assert relrl.sim.sis.POSES is SIS_POSES
     assert relrl.episodes.script.PLACES is PLACES
     assert relrl.episodes.script.OBJECT_PLACES is OBJECT_PLACES
     assert relrl.episodes.world.GAZE_POSE is GAZE_POSE
-    assert relrl.vocabulary.PLACES is PLACES and relrl.vocabulary.world is world
     assert set(GAZE_POSE) == set(PLACES) and set(GAZE_POSE.values()) == set(POSES)
 
 
 @pytest.mark.parametrize("module", ["head", "perception", "perception.vocabulary",
-                                    "head.errors", "perception.errors", "perception.vocab"])
+                                    "head.errors", "perception.errors"])
 def test_lower_layers_stand_alone(module: str) -> None:
     code = (f"import sys, {module}; print(sorted({{m.split('.')[0] for m in sys.modules}} & "
             "{'relrl', 'gymnasium', 'cv2', 'pyswip', 'numpy'}))")
@@ -54,7 +55,7 @@ def test_lower_layers_stand_alone(module: str) -> None:
 
 
 def test_import_relrl_imports_no_gymnasium() -> None:
-    code = "import sys, relrl, relrl.errors, relrl.vocabulary; print('gymnasium' in sys.modules)"
+    code = "import sys, relrl, relrl.errors; print('gymnasium' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          cwd=ROOT, check=True).stdout
     assert out.strip() == "False"

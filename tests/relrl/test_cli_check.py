@@ -30,7 +30,7 @@ def test_check_sis_is_valid(capsys) -> None:
 def test_a_bias_that_grows_with_the_world_warns(tmp_path, capsys) -> None:
     """A #place constant per place (as the SIS's bias once had) is valid but warned about,
     with file and line, also with -q."""
-    text = SIS.read_text().replace("rmode(head_at(#face_place)).",
+    text = SIS.read_text().replace("rmode(head_at(#(face_place))).",
                                    "rmode(head_at(#place)).")
     text += "".join(f"rconst(place, {p}).\n" for p in
                     ("centre", "left", "left_down", "down", "right_down", "right"))

@@ -9,8 +9,16 @@ from pathlib import Path
 
 import pytest
 
-from relrl.engine import GOALS, Engine, StepResult
-from relrl.errors import PolicyError, PrologError, PrologLoadError, QueryTimeout, RuleError
+from relrl.bridge.calls import prolog
+from relrl.engine import Engine, StepResult
+from relrl.errors import (
+    PolicyError,
+    PrologError,
+    PrologLoadError,
+    QueryTimeout,
+    RelrlError,
+    RuleError,
+)
 from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from relrl.loop import Agent, Interaction
@@ -231,12 +239,21 @@ def test_preserved_leaves_learning_as_it_was() -> None:
 
 # -- 3. one typed front ---------------------------------------------------------------------
 
-def test_goal_table_is_the_gateway_api() -> None:
-    api = set(re.findall(r"^python_api\((\w+:\w+)/\d+\)\.", GATEWAY.read_text(), re.M))
-    transport = {"relrl_gateway:gw_new_kb", "relrl_gateway:gw_drop_kb",
-                 "relrl_gateway:gw_load", "relrl_gateway:gw_answer_again",
-                 "relrl_gateway:gw_take_abort"}
-    assert set(GOALS.values()) == api - transport
+def test_python_calls_only_the_declared_api_and_all_of_it() -> None:
+    """Python names its goals of relrl's Prolog by python_api/2's short names, asked at
+    start: every name it uses is declared, and every declared name is used."""
+    declared = {str(t[1]) for t in prolog().run(
+        (":", "relrl_gateway", ("gw_api", Var())), 0, (0,))[0]}  # type: ignore[index]
+    calls = re.compile(r'(?:\b(?:call|one|call_semidet|engine_call)\(\s*[\w.]+,\s*|\.goal\()'
+                       r'"(\w+)"')
+    used = {m.group(1) for path in (ROOT / "relrl").rglob("*.py")
+            for m in calls.finditer(path.read_text())}
+    assert used <= declared, used - declared
+    assert declared - used == {"api"}, declared - used
+    for name in declared:
+        prolog().goal(name)
+    with pytest.raises(RelrlError, match="no goal 'nope'"):
+        prolog().goal("nope")
 
 
 def test_private_predicates_are_refused() -> None:

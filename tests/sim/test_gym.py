@@ -13,9 +13,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from relrl.kb import KnowledgeBase
-from relrl.sim import ENV_ID, ENV_ID_V1, GazeMetrics, World
+from relrl.sim import ENV_ID, ENV_ID_V1, GazeMetrics, SharedAttentionEnv, World
 from relrl.sim.policies import GazeFollower, RandomPolicy
-from relrl.sim.wrappers import RelationalObservation, relational_facts
+from relrl.sim.wrappers import RelationalObservation, RelationalView
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -52,7 +52,7 @@ def test_v0_observation_is_unchanged_by_v1() -> None:
 
 def test_v1_observation_encodes_the_scene() -> None:
     world = World(places=9, colours=3, kinds=2, scene=True, field=50)
-    env = world.env(observation=1, max_steps=None)
+    env = SharedAttentionEnv(world=world, observation=1, max_steps=None)
     rp = RandomPolicy(2, env.places)
     _, info = env.reset(seed=2)
     names = [f for f, _ in env.observation_fields]
@@ -75,21 +75,25 @@ def test_v1_observation_encodes_the_scene() -> None:
 @pytest.mark.parametrize("world", [World(places=9, kinds=2),
                                    World(places=9, colours=3, kinds=2, scene=True)])
 def test_the_wrapper_gives_what_the_domains_relations_give(world: World, tmp_path: Path) -> None:
-    """The relational view computed in Python equals the generated domain's relation/1."""
+    """The wrapper's view is the generated domain's relation/1, asked of a knowledge base of
+    its own, time unit by time unit, and every fact it gives is ground text of a template."""
     kb = KnowledgeBase(world.write_domain(tmp_path))
+    env = RelationalObservation(SharedAttentionEnv(world=world, observation=1, max_steps=None))
     try:
-        env = RelationalObservation(world.env(observation=1, max_steps=None))
         follower, rp = GazeFollower(), RandomPolicy(3, env.unwrapped.places)
         obs, info = env.reset(seed=3)
+        seen = set()
         for t in range(400):
             kb.insert(info["percepts"])
             solutions, _ = kb.query("findall(T, (relation(T), call(T)), L0), sort(L0, L)")
             printed = next(p for name, _, p in solutions[0] if name == "L")
-            prolog = sorted(_split(printed))
-            assert list(obs) == prolog == sorted(info["relational"])
+            assert list(obs) == sorted(_split(printed)) == list(info["relational"])
+            seen.update(f.split("(")[0] for f in obs)
             policy = follower if t % 3 else rp
             obs, _, _, _, info = env.step(policy(info["percepts"]))
+        assert {"sees", "gaze", "head_at", "toy_at", "colour", "kind"} <= seen
     finally:
+        env.close()
         kb.close()
 
 
@@ -107,14 +111,17 @@ def _split(printed: str) -> list[str]:
     return out
 
 
-def test_relational_facts_by_hand() -> None:
-    assert relational_facts([("see", "face"), ("pose", "face", "frontal"), ("at", "centre"),
-                             ("hear", "attention")]) == (
-        "gaze(face,centre)", "head_at(centre)", "heard(attention)", "sees(face)")
-    assert relational_facts([("see", "toy"), ("at", "toy", "left"), ("colour", "toy", "red"),
-                             ("in_view", "left", "red", "none"), ("at", "left")],
-                            scene=True) == (
-        "colour(toy(left),red)", "head_at(left)", "sees(toy)", "toy_at(toy(left),left)")
+def test_the_relational_view_by_hand() -> None:
+    with RelationalView(World()) as view:
+        assert view([("see", "face"), ("pose", "face", "frontal"), ("at", "centre"),
+                     ("hear", "attention")]) == (
+            "gaze(face,centre)", "head_at(centre)", "heard(attention)", "sees(face)")
+        assert view([("see", "environment"), ("at", "down")]) == (
+            "head_at(down)", "sees(environment)")
+    with RelationalView(World(scene=True)) as view:
+        assert view([("see", "toy"), ("at", "toy", "left"), ("colour", "toy", "red"),
+                     ("in_view", "left", "red", "none"), ("at", "left")]) == (
+            "colour(toy(left),red)", "head_at(left)", "sees(toy)", "toy_at(toy(left),left)")
 
 
 def test_the_tabular_example_learns_and_reports_the_protocols_cgi() -> None:

@@ -53,8 +53,11 @@ def test_a_farming_policy_earns_less_than_gaze_following(during_gaze: bool,
 
 def test_farming_loses_in_large_worlds_and_with_an_unreliable_caregiver() -> None:
     for world, params in [(World(places=17), {}), (World(), {"reliability": 0.5})]:
-        farm = mean_reward(world.env(caregiver_params=params, max_steps=None), Farmer())
-        follow = mean_reward(world.env(caregiver_params=params, max_steps=None), GazeFollower())
+        def env(world: World = world, params: dict = params) -> SharedAttentionEnv:
+            return SharedAttentionEnv(world=world, caregiver_params=params, max_steps=None)
+
+        farm = mean_reward(env(), Farmer())
+        follow = mean_reward(env(), GazeFollower())
         assert farm < follow
 
 
