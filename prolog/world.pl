@@ -449,8 +449,8 @@ relrl_tg_bias:extra_rmode(KB, Mode) :-
 
 relrl_tg_bias:own_rmodes(KB) :-
     atom(KB),
-    atom_concat('$relrl_world_task:', KB, Key),
-    nb_current(Key, Task),
+    kb_get(KB, task, Task),
+    Task \== none,
     declared(KB, task_own_bias(T)),
     subsumes_term(T, Task),
     !.
