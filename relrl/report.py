@@ -300,8 +300,9 @@ def _sis_curves(run: Run) -> str:
 def _exp2_table1(run: Run) -> str:
     r = run.results
     paper = r.get("paper", {}).get("table1", {})
-    keys = sorted(r["summary"])
-    if not all((r["summary"][k].get("table1") or {}).get("all_executions") for k in keys):
+    keys = sorted(k for k in r["summary"]
+                  if (r["summary"][k].get("table1") or {}).get("all_executions"))
+    if not keys:   # (only the readings of the time unit with naming executions have one)
         raise UserError(f"{run.path / 'results.json'}: no Table 1 in this run (symbolic "
                         "perception, or no naming executions)")
     outcomes = list(paper) or sorted({o for k in keys
@@ -330,6 +331,23 @@ def _exp2_fig6(run: Run) -> str:
             row.append(_pm(pt["cgi_mean"], pt["cgi_sd_over_seeds"]) if pt else "—")
         rows.append(row)
     return table(["learning units"] + [f"CGI {k}" for k in keys], rows)
+
+
+@view("exp2", "confusions")
+def _exp2_confusions(run: Run) -> str:
+    """What the robot would have said of each fruit shown, before hearing its name (% of the
+    presentations of that fruit; ``nothing``: no confident name yet), per learner."""
+    rows = []
+    for k in sorted(run.results["summary"]):
+        confusion = run.results["summary"][k].get("confusion") or {}
+        for shown, said in sorted(confusion.items()):
+            total = sum(said.values())
+            ranked = sorted(said.items(), key=lambda kv: (-kv[1], kv[0]))
+            rows.append([k, shown, ", ".join(f"{name} {100 * n / total:.1f} %"
+                                             for name, n in ranked)])
+    if not rows:
+        raise UserError(f"{run.path / 'results.json'}: no confusions in this run")
+    return table(["learner / time unit", "fruit shown", "what the robot would have said"], rows)
 
 
 @view("exp2", "short")

@@ -138,3 +138,19 @@ def test_a_symbolic_experiment2_run_has_no_table1_and_says_so(tmp_path: Path) ->
     assert "| tg/interaction | 1.00 | — |" in short
     with pytest.raises(UserError, match="no Table 1"):
         render(load_run(tmp_path), "table1", "exp2")
+
+
+def test_experiment2_views_of_a_run_with_table1_for_one_reading_only(tmp_path: Path) -> None:
+    """Table 1 is run for one reading of the time unit: its view shows that reading's
+    columns; the confusions view ranks what the robot would have said, in % of the fruit."""
+    t1 = {"all_executions": {"success": [80.0, 3.0], "unknown": [6.0, 1.0]}}
+    summary = {"etg/interaction": {"fig6": [], "table1": t1,
+                                   "confusion": {"apple": {"apple": 9, "nothing": 1}}},
+               "etg/step": {"fig6": [], "table1": None}}
+    (tmp_path / "results.json").write_text(json.dumps({"experiment": "exp2",
+                                                       "summary": summary}))
+    table1 = render(load_run(tmp_path), "table1", "exp2")
+    assert "| measure (%) | paper | etg/interaction |" in table1
+    assert "| success | — | 80.00 ± 3.00 |" in table1
+    confusions = render(load_run(tmp_path), "confusions", "exp2")
+    assert "| etg/interaction | apple | apple 90.0 %, nothing 10.0 % |" in confusions
