@@ -439,16 +439,21 @@ def _worlds_summary(run: Run) -> str:
 
 @view("worlds", "short")
 def _worlds_short(run: Run) -> str:
-    """Each task and learner: optimality on the training sizes and on the largest test size."""
+    """One row per world and task, one column per learner: the fraction of optimal on the
+    training sizes (worst seed) and on the largest test size, with no learning."""
     r = run.results
     train, test = r["config"]["train_sizes"], r["config"]["test_sizes"]
-    rows = [[f"{Path(x['world']).stem}: {x['task']}", x["learner"],
-             f"{x['train_optimality']:.3f} ({x['train_optimality_min']:.3f})",
-             _f(x["test"][str(max(test))]["optimality"], 3), _f(x["memory_positions"], 0)]
-            for x in r["summary"]]
-    return table(["world: task", "learner",
-                  f"of optimal, {min(train)}–{max(train)} blocks (worst seed)",
-                  f"{max(test)} blocks, no learning", "memory (positions)"], rows)
+    learners = list(dict.fromkeys(x["learner"] for x in r["summary"]))
+    cells: dict[str, dict[str, str]] = {}
+    for x in r["summary"]:
+        row = cells.setdefault(f"{Path(x['world']).stem}: {x['task']}", {})
+        row[x["learner"]] = (f"{x['train_optimality']:.3f} ({x['train_optimality_min']:.3f})"
+                             f" → {_f(x['test'][str(max(test))]['optimality'], 3)}")
+    rows = [[task] + [row.get(learner, "—") for learner in learners]
+            for task, row in cells.items()]
+    return (f"Fraction of optimal on {min(train)}–{max(train)} blocks (worst seed) → on "
+            f"{max(test)} blocks with no learning, mean of {len(r['seeds'])} seeds.\n\n"
+            + table(["world: task", *learners], rows))
 
 
 @view("worlds", "cost")
