@@ -13,8 +13,8 @@ from __future__ import annotations
 from typing import Any
 
 from relrl.errors import ConfigError
-from relrl.learners.tg import TGLearner
-from relrl.terms import Term, format_term
+from relrl.learners.tg import TGLearner, explanation
+from relrl.terms import Term
 
 __all__ = ["PTGLearner"]
 
@@ -49,14 +49,5 @@ class PTGLearner(TGLearner):
         P-tree's tests from the root to its leaf with the bindings that made them true;
         ``path`` and ``leaf``: the best response's."""
         _, choices = detail
-        ranked, paths = [], {}
-        for _, action, p, q, leaf, path in choices:
-            response = format_term(action)
-            ranked.append({"response": response, "p": p, "q": q, "leaf": leaf})
-            paths[response] = [{"test": str(text), "holds": outcome == "true",
-                                "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
-                               for (_, _, text, outcome, bindings) in path]
-        best = ranked[0]["response"] if ranked else None
-        return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
-                "path": paths.get(best, []) if best else [],
-                "leaf": ranked[0]["leaf"] if ranked else None}
+        return explanation(state, [({"p": p, "q": q, "leaf": leaf}, action, path)
+                                   for _, action, p, q, leaf, path in choices])

@@ -16,7 +16,7 @@ from relrl.errors import ConfigError
 from relrl.learners.base import Learner, register
 from relrl.terms import Term, format_term
 
-__all__ = ["TGLearner"]
+__all__ = ["TGLearner", "explanation"]
 
 
 @register
@@ -76,14 +76,23 @@ class TGLearner(Learner):
         first-order tests from the root to its leaf, with the bindings that made them
         true; ``path`` and ``leaf``: the best response's."""
         _, choices = detail
-        ranked, paths = [], {}
-        for _, action, q, leaf, path in choices:
-            response = format_term(action)
-            ranked.append({"response": response, "q": q, "leaf": leaf})
-            paths[response] = [{"test": str(text), "holds": outcome == "true",
-                                "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
-                               for (_, _, text, outcome, bindings) in path]
-        best = ranked[0]["response"] if ranked else None
-        return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
-                "path": paths.get(best, []) if best else [],
-                "leaf": ranked[0]["leaf"] if ranked else None}
+        return explanation(state, [({"q": q, "leaf": leaf}, action, path)
+                                   for _, action, q, leaf, path in choices])
+
+
+def explanation(state: Term, choices: list[tuple[dict[str, Any], Term, Term]]
+                ) -> dict[str, Any]:
+    """A tree learner's explanation as :meth:`explain` returns it, from its Prolog side's
+    choices, best first: each is (the response's figures, the response, its path of tests,
+    each ``test(_, _, Text, Outcome, Bindings)``)."""
+    ranked, paths = [], {}
+    for figures, action, path in choices:
+        response = format_term(action)
+        ranked.append({"response": response, **figures})
+        paths[response] = [{"test": str(text), "holds": outcome == "true",
+                            "bindings": {str(b[1]): format_term(b[2]) for b in bindings}}
+                           for (_, _, text, outcome, bindings) in path]
+    best = ranked[0]["response"] if ranked else None
+    return {"state": [format_term(f) for f in state], "ranked": ranked, "paths": paths,
+            "path": paths.get(best, []) if best else [],
+            "leaf": ranked[0]["leaf"] if ranked else None}
