@@ -32,6 +32,7 @@ import re
 import secrets
 import socket
 import threading
+from abc import ABC, abstractmethod
 from pathlib import Path
 from typing import Any
 
@@ -400,8 +401,9 @@ def listen(host: str, port: int, what: str = "the monitor",
     return sock
 
 
-class Endpoint:
+class Endpoint(ABC):
     """Where a monitor serves: the address, whether it is loopback, the token it requires.
+    A server (the live monitor's, the replay's) says how it starts, runs and stops.
 
     Args:
         address: ``HOST:PORT`` (see :func:`parse_address`).
@@ -432,17 +434,17 @@ class Endpoint:
         return {"127.0.0.1", "localhost", "::1", self.host}
 
     @property
+    @abstractmethod
     def running(self) -> bool:
         """Whether it serves (between ``start()`` and ``close()``)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def start(self) -> Endpoint:
         """Start serving; returns itself."""
-        raise NotImplementedError
 
+    @abstractmethod
     def close(self) -> None:
         """Stop serving (safe twice)."""
-        raise NotImplementedError
 
     def __enter__(self) -> Any:
         return self if self.running else self.start()
