@@ -6,7 +6,9 @@ import argparse
 import json
 import math
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from relrl.cli.recorded import add_config_option, apply_record, finish_record
 from relrl.outdir import add_out_options
@@ -369,8 +371,6 @@ def run(args: argparse.Namespace) -> int:
             pass  # no real stderr (embedded): no stack dumps, nothing else changes
     from relrl.experiments import main as sis_main
     from relrl.experiments.report import OUTPUTS, summary_table
-    from relrl.experiments.runner import command_signals
-    from relrl.outdir import OutDir
 
     if args.name == "scaling":
         return _run_scaling(args)
@@ -380,34 +380,41 @@ def run(args: argparse.Namespace) -> int:
 
     config = build_config(args)
     print(f"setting: {config.setting()}")
-    with command_signals() as signals, \
-            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                         default="runs/exp1", outputs=OUTPUTS) as out:
-        results, files = sis_main.run_sis(config, out.path, workers=args.workers,
-                                          engine=args.engine, address=args.address)
-        out.status = "partial" if results.get("partial") else "complete"
+    results, files, out, signum = _claimed_run(args, "runs/exp1", OUTPUTS, sis_main.run_sis,
+                                               config)
     print(summary_table(results["summary"]))
     if any(c["held"] is not None for c in results.get("claims", {}).values()):
         print("\nthe paper's claims (docs/experiment1.md):")
         print(claims_table(results["claims"]))
-    return _finish(results, files, out.path, signals.signum)
+    return _finish(results, files, out, signum)
+
+
+def _claimed_run(args: argparse.Namespace, default: str, outputs: Any,
+                 run: Callable[..., tuple[dict, list]], config: Any
+                 ) -> tuple[dict, list, Path, int | None]:
+    """Run an experiment into the --out folder it claims (marked partial or complete),
+    with Ctrl-C, SIGTERM and SIGHUP ending it gracefully: its results, the files written,
+    the folder and the signal that stopped it, if one did."""
+    from relrl.experiments.runner import command_signals
+    from relrl.outdir import OutDir
+
+    with command_signals() as signals, \
+            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                         default=default, outputs=outputs) as out:
+        results, files = run(config, out.path, workers=args.workers, engine=args.engine,
+                             address=args.address)
+        out.status = "partial" if results.get("partial") else "complete"
+    return results, files, out.path, signals.signum
 
 
 def _run_scaling(args: argparse.Namespace) -> int:
-    from relrl.experiments.runner import command_signals
     from relrl.experiments.scaling_report import OUTPUTS, run_scaling, scaling_table
-    from relrl.outdir import OutDir
 
-    config = build_scaling_config(args)
-    with command_signals() as signals, \
-            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                         default="runs/scaling", outputs=OUTPUTS) as out:
-        results, files = run_scaling(config, out.path, workers=args.workers,
-                                     engine=args.engine, address=args.address)
-        out.status = "partial" if results.get("partial") else "complete"
-    timing = json.loads((out.path / "timing.json").read_text())
+    results, files, out, signum = _claimed_run(args, "runs/scaling", OUTPUTS, run_scaling,
+                                               build_scaling_config(args))
+    timing = json.loads((out / "timing.json").read_text())
     print(scaling_table(results, timing))
-    return _finish(results, files, out.path, signals.signum)
+    return _finish(results, files, out, signum)
 
 
 def build_worlds_config(args: argparse.Namespace):
@@ -470,19 +477,12 @@ def build_worlds_config(args: argparse.Namespace):
 
 
 def _run_worlds(args: argparse.Namespace) -> int:
-    from relrl.experiments.runner import command_signals
-    from relrl.outdir import OutDir
     from relrl.worlds.experiment import OUTPUTS, run_worlds, worlds_table
 
-    config = build_worlds_config(args)
-    with command_signals() as signals, \
-            OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                         default="runs/worlds", outputs=OUTPUTS) as out:
-        results, files = run_worlds(config, out.path, workers=args.workers,
-                                    engine=args.engine, address=args.address)
-        out.status = "partial" if results.get("partial") else "complete"
+    results, files, out, signum = _claimed_run(args, "runs/worlds", OUTPUTS, run_worlds,
+                                               build_worlds_config(args))
     print(worlds_table(results))
-    return _finish(results, files, out.path, signals.signum)
+    return _finish(results, files, out, signum)
 
 
 def _finish(results: dict, files: list, out: Path, signum: int | None) -> int:
