@@ -116,8 +116,7 @@ def call(kb: KnowledgeBase, goal: str, *arguments: Term, timeout: float | None =
 def call_semidet(kb: KnowledgeBase, goal: str, *arguments: Term,
                  timeout: float | None = None) -> list | None:
     """:func:`call` for a goal that may fail: None when it does."""
-    module, name = prolog().goal(goal)
-    return kb.call(f"{module}:{name}", *arguments, timeout=timeout)
+    return prolog().api(goal, *arguments, timeout=kb.timeout if timeout is None else timeout)
 
 
 def one(kb: KnowledgeBase, goal: str, *arguments: Term) -> Term:

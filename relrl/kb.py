@@ -75,8 +75,7 @@ class KnowledgeBase:
         self.timeout = timeout
         self.files: list[Path] = []
         self.warnings: list[Problem] = []
-        module, name = self._prolog.goal("new_kb")
-        out = self._prolog.run((":", module, (name, Var())), timeout, (0,))
+        out = self._prolog.api("new_kb", Var(), timeout=timeout)
         self.module: str = out[0]  # type: ignore[index]
         self._closed = False
         for path in domains:
@@ -95,9 +94,7 @@ class KnowledgeBase:
         """
         p = Path(path)
         try:
-            module, name = self._prolog.goal("load")
-            out = self._prolog.run((":", module, (name, str(p), self.module, Var())),
-                                   self.timeout, (2,))
+            out = self._prolog.api("load", str(p), self.module, Var(), timeout=self.timeout)
         except Aborted as exc:
             raise PrologLoadError(display_path(str(p)), None,
                                   "abort/0 called while loading") from exc
@@ -235,8 +232,7 @@ class KnowledgeBase:
         """Forget this knowledge base's clauses and memory. Safe to call twice."""
         if not self._closed:
             self._closed = True
-            module, name = self._prolog.goal("drop_kb")
-            self._prolog.run((":", module, (name, self.module)), self.timeout)
+            self._prolog.api("drop_kb", self.module, timeout=self.timeout)
 
     def __enter__(self) -> KnowledgeBase:
         return self

@@ -93,8 +93,7 @@ class OpenQuery:
             raise ValueError(f"mode {mode!r}: use 'write' or 'print'")
         if self.closed:
             return None
-        module, name = prolog().goal("answer_again")
-        prolog().run((":", module, (name, mode)), self.timeout)
+        prolog().api("answer_again", mode, timeout=self.timeout)
         return self.next()
 
     def close(self) -> None:

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import re
 import threading
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from ctypes import byref, c_size_t
 from pathlib import Path
 from typing import Any, NoReturn
@@ -87,6 +88,14 @@ class Prolog:
             raise RelrlError(f"relrl's Prolog declares no goal {name!r} for Python "
                              "(python_api/2 in prolog/gateway.pl)") from None
 
+    def api(self, name: str, *arguments: Term, timeout: float = 0.0) -> list | None:
+        """Run the goal ``python_api/2`` names ``name`` with ``arguments`` once (see
+        :meth:`run`): the values of its :class:`~relrl.terms.Var` arguments, in order, or
+        None when it fails."""
+        module, predicate = self.goal(name)
+        return self.run((":", module, (predicate, *arguments)), timeout,
+                        [i for i, a in enumerate(arguments) if isinstance(a, Var)])
+
     # -- a goal, once ----------------------------------------------------------------------
 
     def run(self, goal: Term, timeout: float, outputs: Sequence[int] = ()) -> list | None:
@@ -96,46 +105,54 @@ class Prolog:
         Raises:
             QueryTimeout, RuleError, PrologError, ...: see :func:`check_result`.
         """
-        self._check_thread()
         lib, marshal = self.lib, self.marshal
-        lib.keep_c_stack_guard()
-        mark = c_size_t()
-        lib.mark_string_buffers(byref(mark))
-        fid = lib.open_foreign_frame()
-        try:
-            a0 = lib.new_term_refs(2)
-            marshal.put(a0, goal, {})
-            if not self._call(self._gw_run, a0, timeout):
-                self._raise_exception()
-            result = marshal.get(a0 + 1)
-            if result == "false":
-                return None
-            check_result(result, timeout)
-            if not outputs:
-                return []
-            inner, arg = lib.new_term_ref(), lib.new_term_ref()
-            lib.put_term(inner, a0)
-            if isinstance(goal, tuple) and goal[0] == ":" and len(goal) == 3:
-                lib.get_arg_sz(2, a0, inner)
-            values = []
-            for i in outputs:
-                lib.get_arg_sz(i + 1, inner, arg)
-                values.append(marshal.get(arg))
-            return values
-        finally:
-            lib.discard_foreign_frame(fid)
-            lib.release_string_buffers_from_mark(mark.value)
-            self._flush()
+        with self._crossing():
+            lib.keep_c_stack_guard()
+            fid = lib.open_foreign_frame()
+            try:
+                a0 = lib.new_term_refs(2)
+                marshal.put(a0, goal, {})
+                if not self._timed(timeout, lib.call_predicate, None, L.Q_FLAGS,
+                                   self._gw_run, a0):
+                    self._raise_exception()
+                result = marshal.get(a0 + 1)
+                if result == "false":
+                    return None
+                check_result(result, timeout)
+                inner, arg = lib.new_term_ref(), lib.new_term_ref()
+                lib.put_term(inner, a0)
+                if isinstance(goal, tuple) and goal[0] == ":" and len(goal) == 3:
+                    lib.get_arg_sz(2, a0, inner)
+                values = []
+                for i in outputs:
+                    lib.get_arg_sz(i + 1, inner, arg)
+                    values.append(marshal.get(arg))
+                return values
+            finally:
+                lib.discard_foreign_frame(fid)
 
-    def _call(self, predicate: int, args: int, timeout: float) -> bool:
-        """Call ``predicate`` with its arguments at ``args`` under the time limit."""
+    def _timed(self, timeout: float, call: Any, *args: Any) -> Any:
+        """``call(*args)``, a foreign call that runs Prolog, under the time limit."""
         self.calls += 1
         watchdog = self.watchdog
         watchdog.arm(timeout)
         try:
-            return bool(self.lib.call_predicate(None, L.Q_FLAGS, predicate, args))
+            return call(*args)
         finally:
             self._flush_pending |= watchdog.disarm()
+
+    @contextmanager
+    def _crossing(self) -> Iterator[None]:
+        """Within the block: calls from this thread only; the string buffers pushed are
+        popped after it, and a signal raised as its last call returned is taken."""
+        self._check_thread()
+        mark = c_size_t()
+        self.lib.mark_string_buffers(byref(mark))
+        try:
+            yield
+        finally:
+            self.lib.release_string_buffers_from_mark(mark.value)
+            self._flush()
 
     def _flush(self) -> None:
         """Let Prolog take a signal raised as the last call returned, outside any call
@@ -155,8 +172,7 @@ class Prolog:
         ex = self.lib.exception(0)
         if not ex:
             self.lib.clear_exception()
-            module, name = self.goal("take_abort")
-            out = self.run((":", module, (name, Var())), 0, (0,))
+            out = self.api("take_abort", Var())
             where = out[0] if out else "goal"
             if isinstance(where, tuple) and where[0] == ":":
                 raise Aborted(str(where[1]), where[2] or None)
@@ -187,16 +203,15 @@ class Prolog:
         io[k.EMITTED] = emitted
         io[k.FRAME] = 0
         mark = None
-        self.calls += 1
-        watchdog = self.watchdog
-        watchdog.arm(timeout)
         try:
-            try:
-                status = k.step(io, fo)
-            finally:
-                self._flush_pending |= watchdog.disarm()
+            status = self._timed(timeout, k.step, io, fo)
             v = io.tolist()
-            if status == k.DONE and (necessity := marshal.held(v[k.NECESSITY])):
+            if status == k.DONE:
+                necessity = marshal.held(v[k.NECESSITY])
+                if necessity is None:             # not held (Engine holds the necessities)
+                    mark = c_size_t()
+                    self.lib.mark_string_buffers(byref(mark))
+                    necessity = marshal.atom_name(v[k.NECESSITY])
                 values = fo[:k.FIRST_OUTPUT + v[k.OUTPUTS]].tolist()
                 return (v[k.CODE], necessity, values[k.FIRST_OUTPUT:], values[k.REWARD],
                         v[k.REINFORCED] == self._true_atom, v[k.MASK], v[k.ACTION], None)
@@ -204,11 +219,6 @@ class Prolog:
             self.lib.mark_string_buffers(byref(mark))
             if status == k.RAISED:
                 self._raise_exception()
-            if status == k.DONE:                  # a necessity not held (Engine holds them)
-                values = fo[:k.FIRST_OUTPUT + v[k.OUTPUTS]].tolist()
-                return (v[k.CODE], marshal.atom_name(v[k.NECESSITY]),
-                        values[k.FIRST_OUTPUT:], values[k.REWARD],
-                        v[k.REINFORCED] == self._true_atom, v[k.MASK], v[k.ACTION], None)
             return self._step_rest(v[k.ARGS], timeout)
         finally:
             if io[k.FRAME]:            # read from io: Ctrl-C may come as the kernel returns
@@ -290,17 +300,8 @@ class Query:
         if self._qid is None:
             return None
         prolog, lib = self._prolog, self._lib
-        prolog._check_thread()
-        mark = c_size_t()
-        lib.mark_string_buffers(byref(mark))
-        try:
-            prolog.calls += 1
-            prolog.watchdog.arm(timeout)
-            try:
-                more = lib.next_solution(self._qid)
-            finally:
-                prolog._flush_pending |= prolog.watchdog.disarm()
-            if more:
+        with prolog._crossing():
+            if prolog._timed(timeout, lib.next_solution, self._qid):
                 return prolog.marshal.get(self._answer)
             ex = lib.exception(self._qid)
             detail = prolog.marshal.get(ex) if ex else None
@@ -310,9 +311,6 @@ class Query:
             if detail is not None:
                 raise PrologError(f"query failed: {detail!r}", detail)
             return None
-        finally:
-            lib.release_string_buffers_from_mark(mark.value)
-            prolog._flush()
 
     def close(self) -> None:
         """Discard the query and its remaining solutions. Safe to call twice."""
