@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any
 from relrl.bridge.calls import prolog
 from relrl.bridge.marshal import Cached
 from relrl.errors import PolicyError, PrologError, QueryTimeout, RelrlError
+from relrl.outdir import write_atomic
 from relrl.terms import Term, Var
 
 if TYPE_CHECKING:
@@ -246,8 +247,6 @@ class Engine:
     def save(self, path: str | Path, header: str) -> Path:
         """Write the learned knowledge as a readable policy file (:mod:`relrl.outdir`: atomic,
         never through a link; the text as :meth:`policy_text` makes it)."""
-        from relrl.outdir import write_atomic
-
         return write_atomic(path, self.policy_text(header))
 
     def load_policy(self, path: str | Path) -> None:
