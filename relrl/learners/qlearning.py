@@ -10,7 +10,8 @@ import numpy as np
 
 from relrl.engine import Engine
 from relrl.errors import PolicyError
-from relrl.learners.base import Learner, StepOut, register
+from relrl.learners.base import DOMAINS, Learner, LearnerSpec, Parameter, StepOut
+from relrl.learners.registry import register
 from relrl.outdir import write_atomic
 from relrl.terms import Term, format_term
 
@@ -26,12 +27,16 @@ class QLearner(Learner):
     declaration order. Choice is epsilon-greedy over the allowed responses, ties broken at
     random; without exploration (evaluation) greedy.
 
-    Parameters: alpha, gamma, epsilon, q_init.
+    Parameters: alpha, gamma, epsilon, q_init. It chooses in Python (through the engine's
+    ``external`` learner), so its parameters are declared here, not in Prolog.
     """
 
     name = "qlearning"
-    engine_name = "external"
-    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0}
+    python_spec = LearnerSpec(
+        name="qlearning", engine="external",
+        parameters=(Parameter("alpha", 0.2, "unit"), Parameter("gamma", 0.9, "unit"),
+                    Parameter("epsilon", 0.05, "unit"), Parameter("q_init", 30.0)),
+        serves={DOMAINS: {}})
 
     def attach(self, engine: Engine, seed: int | None) -> None:
         """Start learning with ``engine`` (an empty table)."""

@@ -92,7 +92,8 @@ def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, se
 def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = None
                ) -> dict[str, Any]:
     """The world's optimal_steps/3 against a breadth-first search (seeded, per size)."""
-    from relrl.worlds.world import World, make_world_learner
+    from relrl.learners import make_world_learner
+    from relrl.worlds.world import World
 
     rows = []
     with World(world) as w:
