@@ -25,13 +25,14 @@ Beside its hooks, a learner declares what a user chooses it by:
 A learner that declares learner_property(Name, external) is the engine's side of learners
 that choose in Python; they declare their parameters in Python and it declares none.
 learner_catalogue/1 is what Python asks when it starts: its registry of learners is built
-from it alone.
+from it alone, in the order the files below are loaded (the order experiments list them
+in).
 */
 
 %!  learner_catalogue(-Learners:list) is det.
 %
 %   Learners is learner(Name, Properties, Parameters, Serves) for every registered
-%   learner (relrl_engine:learner/1), by name: Properties its learner_property/2
+%   learner (relrl_engine:learner/1), in the order they were loaded: Properties its learner_property/2
 %   declarations (sorted), Parameters its parameter(Param, Default, Kind) in the order
 %   declared, Serves its serves(Family, Overrides).
 %
@@ -41,7 +42,7 @@ from it alone.
 
 learner_catalogue(Learners) :-
     findall(Name, relrl_engine:learner(Name), Names0),
-    sort(Names0, Names),
+    list_to_set(Names0, Names),
     forall(( ( relrl_engine:learner_parameter(Other, _, _, _)
              ; relrl_engine:learner_serves(Other, _, _) ),
              \+ memberchk(Other, Names) ),
@@ -152,8 +153,8 @@ declaration_error(Name, Problem) :-
 prolog:error_message(learner_declaration(Name, Problem)) -->
     [ 'learner ~q: ~w'-[Name, Problem] ].
 
-:- use_module(etg).
 :- use_module(contingency).
+:- use_module(etg).
 :- use_module(external).
 :- use_module(tg).
 :- use_module(ptg).

@@ -1,6 +1,6 @@
 """Learners, looked up by name in the registry relrl's Prolog declares
 (:mod:`relrl.learners.registry`): ``contingency``, ``etg``, ``qlearning`` and ``tg`` learn
-the domains; ``tg``, ``ptg`` and ``qtable`` learn worlds.
+the domains; ``tg``, ``ptg`` and ``qtable`` learn worlds (in prolog/learners.pl's order).
 
 Example:
     >>> from relrl.learners import learners, make_learner

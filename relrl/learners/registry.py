@@ -14,6 +14,8 @@ Example:
     >>> from relrl.learners import learners, make_learner, make_world_learner
     >>> learners("domains")
     ('contingency', 'etg', 'qlearning', 'tg')
+    >>> learners("worlds")
+    ('tg', 'ptg', 'qtable')
     >>> make_world_learner("tg").params["q_init"]
     0.0
 """
@@ -73,19 +75,20 @@ def build_registry(entries: list[Term], classes: Mapping[str, type[Learner]]
                    ) -> dict[str, tuple[LearnerSpec, type[Learner]]]:
     """The registry from Prolog's catalogue ``entries`` and the Python ``classes``: every
     learner of Prolog but the external ones, made by its class or :class:`PrologLearner`,
-    and every class with a ``python_spec`` whose engine is an external learner of Prolog;
-    by name.
+    and in an external one's place the classes with a ``python_spec`` choosing through it
+    (by name); in the catalogue's order.
 
     Raises:
         RelrlError: a class names a learner Prolog does not declare, or a Python learner's
             engine is not an external learner of Prolog.
     """
     found: dict[str, tuple[LearnerSpec, type[Learner]]] = {}
-    external = set()
     for _, name, properties, parameters, serves in entries:
         props = tuple(format_term(p) for p in properties)
         if "external" in props:
-            external.add(str(name))
+            for python_name, cls in sorted(classes.items()):
+                if cls.python_spec is not None and cls.python_spec.engine == name:
+                    found[python_name] = (cls.python_spec, cls)
             continue
         spec = LearnerSpec(name=str(name), engine=str(name),
                            parameters=tuple(_parameter(p) for p in parameters),
@@ -104,17 +107,14 @@ def build_registry(entries: list[Term], classes: Mapping[str, type[Learner]]
         if spec is None:
             raise RelrlError(f"{cls.__qualname__} is the Python side of learner {name!r}, "
                              "which relrl's Prolog does not declare (prolog/learners.pl)")
-        if spec.engine not in external:
-            raise RelrlError(f"learner {name!r} chooses through Prolog learner "
-                             f"{spec.engine!r}, which is not an external learner of relrl's "
-                             "Prolog")
-        found[name] = (spec, cls)
+        raise RelrlError(f"learner {name!r} chooses through Prolog learner {spec.engine!r}, "
+                         "which is not an external learner of relrl's Prolog")
     for spec, _ in found.values():
         for family in spec.serves:
             if family not in FAMILIES:
                 raise RelrlError(f"learner {spec.name!r} serves {family!r}, not a family of "
                                  f"tasks ({', '.join(FAMILIES)})")
-    return dict(sorted(found.items()))
+    return found
 
 
 def _parameter(term: Term) -> Parameter:
@@ -133,7 +133,7 @@ def registry() -> dict[str, tuple[LearnerSpec, type[Learner]]]:
 
 def learners(family: str | None = None) -> tuple[str, ...]:
     """The names of the learners serving ``family`` (``domains`` or ``worlds``; None:
-    every learner), sorted."""
+    every learner), in the registry's order (prolog/learners.pl's)."""
     return tuple(name for name, (spec, _) in registry().items()
                  if family is None or family in spec.serves)
 

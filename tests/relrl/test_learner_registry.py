@@ -84,7 +84,7 @@ def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> 
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     assert out["domains"] == ["contingency", "etg", "qlearning", "tg", "toy"]
-    assert out["worlds"] == ["ptg", "qtable", "tg", "toy"]
+    assert out["worlds"] == ["tg", "ptg", "qtable", "toy"]
     assert out["class"] == "PrologLearner"
     assert out["params"] == {**COMMON_DEFAULTS, "bias": 0.5, "rounds": 3.0}
     assert out["world_params"] == {**COMMON_DEFAULTS, "bias": 0.25, "rounds": 7.0}
@@ -167,7 +167,7 @@ def test_a_python_class_for_a_learner_prolog_does_not_declare_is_an_error() -> N
 
 def test_families_and_world_defaults() -> None:
     assert learners(DOMAINS) == ("contingency", "etg", "qlearning", "tg")
-    assert learners(WORLDS) == ("ptg", "qtable", "tg")
+    assert learners(WORLDS) == ("tg", "ptg", "qtable")
     tg = make_world_learner("tg")
     assert (tg.params["q_init"], tg.params["novelty_bonus"], tg.params["stale_bonus"]) == (
         0.0, 0.0, 0.0)
