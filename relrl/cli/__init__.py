@@ -2,7 +2,8 @@
 
 Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EXAMPLE``,
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
-pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
+pyserial, matplotlib) inside ``run`` so ``relrl --help`` stays fast; Prolog is asked once,
+for the learner registry the options' help and defaults name (about 0.1 s).
 
 Errors a user can cause (:data:`relrl.errors.USER_ERRORS`: relrl's ``UserError`` and the error
 bases of the ``head`` and ``perception`` packages) print one line and exit 2 (an error that
