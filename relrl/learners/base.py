@@ -34,9 +34,14 @@ DOMAINS = "domains"
 WORLDS = "worlds"
 FAMILIES = (DOMAINS, WORLDS)
 
-#: What the kinds of parameter values (``relrl_engine:learner_parameter/4``) allow, as text.
-_KIND_TEXT = {"unit": "in [0, 1]", "open_unit": "in (0, 1)", "nonneg": ">= 0",
-              "flag": "0 or 1", "number": "a number"}
+#: The kinds of parameter values (``relrl_engine:learner_parameter/4``): what each allows
+#: (``whole``: a whole number >= the parameter's ``least``), and that as text.
+_KINDS = {"unit": (lambda v: 0.0 <= v <= 1.0, "in [0, 1]"),
+          "open_unit": (lambda v: 0.0 < v < 1.0, "in (0, 1)"),
+          "nonneg": (lambda v: v >= 0, ">= 0"),
+          "whole": (lambda v: v == int(v), "a whole number"),
+          "flag": (lambda v: v in (0.0, 1.0), "0 or 1"),
+          "number": (lambda v: True, "a number")}
 
 
 @dataclass(frozen=True)
@@ -49,14 +54,13 @@ class Parameter:
     kind: str = "number"
     least: int = 0
 
+    def __post_init__(self) -> None:
+        if self.kind not in _KINDS:
+            raise ValueError(f"parameter {self.name}: unknown kind {self.kind!r}")
+
     def holds(self, value: float) -> bool:
         """Whether ``value`` (a finite number) is a value of this parameter's kind."""
-        return {"unit": lambda v: 0.0 <= v <= 1.0,
-                "open_unit": lambda v: 0.0 < v < 1.0,
-                "nonneg": lambda v: v >= 0,
-                "whole": lambda v: v >= self.least and v == int(v),
-                "flag": lambda v: v in (0.0, 1.0),
-                "number": lambda v: True}[self.kind](value)
+        return _KINDS[self.kind][0](value) and (self.kind != "whole" or value >= self.least)
 
     def value(self, learner: str, value: object) -> float:
         """``value`` as this parameter of ``learner`` takes it (a float).
@@ -73,8 +77,8 @@ class Parameter:
             raise ConfigError(f"parameter {self.name} of learner {learner!r} must be a "
                               f"finite number, not {value!r}")
         if not self.holds(number):
-            allowed = (f"a whole number >= {self.least}" if self.kind == "whole"
-                       else _KIND_TEXT[self.kind])
+            allowed = _KINDS[self.kind][1] + (f" >= {self.least}" if self.kind == "whole"
+                                              else "")
             raise ConfigError(f"{self.name} must be {allowed}, not {number}")
         return number
 
