@@ -136,6 +136,15 @@ class Learner(abc.ABC):
     and families from the declarations (``relrl_engine:learner_parameter/4``,
     ``learner_serves/3``); one that chooses in Python (through the engine's ``external``
     learner) declares them as its class's ``python_spec``.
+
+    Args:
+        spec: the learner's name, Prolog learner, parameters and families.
+        family: the family of tasks it learns (``domains`` or ``worlds``), whose defaults
+            it takes.
+        **params: parameters over those defaults.
+
+    Raises:
+        ConfigError: an unknown parameter, or a value not of its parameter's kind.
     """
 
     #: the learner a subclass is the Python side of (an instance's: its spec's name)

@@ -33,7 +33,7 @@ class QLearner(Learner):
 
     name = "qlearning"
     python_spec = LearnerSpec(
-        name="qlearning", engine="external",
+        name=name, engine="external",
         parameters=(Parameter("alpha", 0.2, "unit"), Parameter("gamma", 0.9, "unit"),
                     Parameter("epsilon", 0.05, "unit"), Parameter("q_init", 30.0)),
         serves={DOMAINS: {}})
