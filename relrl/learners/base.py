@@ -24,6 +24,7 @@ from relrl.terms import Term
 
 if TYPE_CHECKING:
     from relrl.engine import Engine
+    from relrl.kb import KnowledgeBase
 
 __all__ = ["COMMON", "COMMON_DEFAULTS", "DOMAINS", "FAMILIES", "Learner", "LearnerSpec",
            "Parameter", "StepOut", "WORLDS"]
@@ -171,7 +172,7 @@ class Learner(abc.ABC):
         self.rng = np.random.default_rng(0)
 
     @property
-    def kb(self) -> Any:
+    def kb(self) -> KnowledgeBase | None:
         """The knowledge base the learner is attached to (None before :meth:`attach`)."""
         return self.engine.kb if self.engine is not None else None
 

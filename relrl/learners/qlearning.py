@@ -150,7 +150,7 @@ class QLearner(Learner):
         engine = self._engine()
         mine = [format_term(r) for r in self.responses]
         necessities = [*engine.necessities, "none"]
-        states = 1 << len(self.kb.features())
+        states = 1 << len(engine.kb.features())
         arrays = _read_table(path, max_rows=states * len(necessities), width=len(mine))
         q, codes, names = arrays["q"], arrays["codes"], arrays["necessities"]
         responses = [str(r) for r in arrays["responses"]]
@@ -173,7 +173,7 @@ class QLearner(Learner):
                                   f"under {necessity}")
             rows[key] = i
         values = np.asarray(q, dtype=float)
-        bound = float(one(self.kb, "policy_max_number"))
+        bound = float(one(engine.kb, "policy_max_number"))
         bad = np.flatnonzero(~(np.abs(values) <= bound).all(axis=1))
         if len(bad):
             i = int(bad[0])
