@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from relrl.engine import Engine
+from relrl.engine import Engine, one
 from relrl.errors import PolicyError
 from relrl.learners.base import DOMAINS, Learner, LearnerSpec, Parameter, StepOut
 from relrl.learners.registry import register
@@ -144,8 +144,6 @@ class QLearner(Learner):
             PolicyError: not a relrl Q-table of this domain (names the file and what is
                 wrong).
         """
-        from relrl.engine import one
-
         path = Path(path)
         engine = self._engine()
         mine = [format_term(r) for r in self.responses]
