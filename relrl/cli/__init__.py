@@ -92,8 +92,13 @@ def _add_verbosity(parser: argparse.ArgumentParser, default: object) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``relrl`` command line; returns the exit status."""
     from relrl import log
+    from relrl.errors import USER_ERRORS
 
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except USER_ERRORS as exc:  # the learners' declarations the options name (registry)
+        print(f"relrl: {exc}", file=sys.stderr)
+        return 2
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(argv)
     verbose, quiet = getattr(args, "verbose", 0), getattr(args, "quiet", 0)
@@ -102,8 +107,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
-    from relrl.errors import USER_ERRORS
-
     try:
         return int(args._run(args) or 0)
     except USER_ERRORS as exc:

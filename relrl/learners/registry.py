@@ -27,7 +27,7 @@ from collections.abc import Mapping
 from typing import Any, TypeVar
 
 from relrl.bridge.calls import prolog
-from relrl.errors import ConfigError, RelrlError
+from relrl.errors import ConfigError, PrologError, RelrlError
 from relrl.learners.base import DOMAINS, FAMILIES, WORLDS, Learner, LearnerSpec, Parameter
 from relrl.terms import Term, Var, format_term
 
@@ -63,9 +63,21 @@ class PrologLearner(Learner):
 
 def catalogue() -> list[Term]:
     """Prolog's answer: ``learner(Name, Properties, Parameters, Serves)`` for every learner
-    (``relrl_learners:learner_catalogue/1``)."""
+    (``relrl_learners:learner_catalogue/1``).
+
+    Raises:
+        ConfigError: a learner's declarations are wrong (names the learner and what).
+    """
     module, name = prolog().goal("learners")
-    out = prolog().run((":", module, (name, Var())), _TIMEOUT, (0,))
+    try:
+        out = prolog().run((":", module, (name, Var())), _TIMEOUT, (0,))
+    except PrologError as exc:
+        formal = exc.term[1] if isinstance(exc.term, tuple) and exc.term[0] == "error" \
+            else exc.term
+        if isinstance(formal, tuple) and formal[0] == "learner_declaration":
+            raise ConfigError(f"{exc.message} (the learners' declarations, "
+                              "prolog/learners.pl)") from None
+        raise
     if out is None:
         raise RelrlError(f"{module}:{name}/1 failed")
     return list(out[0])

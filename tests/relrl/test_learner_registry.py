@@ -67,16 +67,18 @@ print(json.dumps(out))
 """
 
 
-def _with_learner(tmp_path: Path, source: str) -> subprocess.CompletedProcess:
-    """Run SCRIPT against a copy of relrl's Prolog whose learners.pl loads ``source`` too."""
+def _with_learner(tmp_path: Path, source: str, *command: str) -> subprocess.CompletedProcess:
+    """Run SCRIPT (or ``command``) against a copy of relrl's Prolog whose learners.pl loads
+    ``source`` too."""
     copy = tmp_path / "prolog"
     shutil.copytree(prolog_dir(), copy)
     (copy / "toy_learner.pl").write_text(source)
     learners_pl = copy / "learners.pl"
     learners_pl.write_text(learners_pl.read_text() + ":- use_module(toy_learner).\n")
     env = {**os.environ, "RELRL_PROLOG_DIR": str(copy)}
-    return subprocess.run([sys.executable, "-c", SCRIPT, str(ROOT / "tests/data/tiny.pl")],
-                          capture_output=True, text=True, env=env, cwd=ROOT, timeout=120)
+    argv = command or ("-c", SCRIPT, str(ROOT / "tests/data/tiny.pl"))
+    return subprocess.run([sys.executable, *argv], capture_output=True, text=True, env=env,
+                          cwd=ROOT, timeout=120)
 
 
 def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> None:
@@ -109,6 +111,15 @@ def test_a_learner_with_bad_declarations_is_an_error(tmp_path: Path, change: tup
     proc = _with_learner(tmp_path, TOY.replace(*change))
     assert proc.returncode != 0
     assert message in proc.stderr
+
+
+def test_bad_declarations_are_one_line_and_exit_2_at_the_command_line(tmp_path: Path
+                                                                       ) -> None:
+    proc = _with_learner(tmp_path, TOY.replace("bias, 0.25, unit", "bias, 1.5, unit"),
+                         "-m", "relrl", "learn", "--help")
+    assert proc.returncode == 2
+    assert proc.stderr == ("relrl: learner toy: parameter bias: 1.5 is not a value of kind "
+                           "unit (the learners' declarations, prolog/learners.pl)\n")
 
 
 def _declared_in_source() -> tuple[set[str], set[str], dict[str, dict[str, float]]]:
