@@ -76,4 +76,13 @@ test(a_missing_parameter_stops_a_learner,
     selectchk(alpha=_, Params, Fewer),
     relrl_engine:engine_configure(KB, tg, Fewer, 0).
 
+test(only_learners_of_worlds_run_episodes,
+     [ setup(kb_with('examples/worlds/blocks.pl', KB)),
+       cleanup(relrl_gateway:gw_drop_kb(KB)),
+       error(domain_error(world_learner, contingency))
+     ]) :-
+    defaults(contingency, domains, Params),
+    relrl_engine:engine_configure(KB, contingency, Params, 0),
+    relrl_world:world_episodes(KB, episodes(stack, [3], 1, learn, []), _).
+
 :- end_tests(learner_declarations).
