@@ -245,6 +245,22 @@ relrl_engine:learner(contingency).
 relrl_engine:learner_property(contingency, Cap) :-
     member(Cap, [size, text, knowledge, policy, snapshot]).
 
+%   Parameters (learners.pl; their reading of section 4.1 in docs/engine.md, "Contingency"):
+%   default_fitness (the slice of a response with no matching rule), influence (how much a
+%   consequence moves a rule's fitness), min_fitness and max_fitness (0 < min_fitness =<
+%   default_fitness =< max_fitness), default_always (1: every response keeps the default
+%   slice, its rules' fitness added to it), extinction (how much of the influence rate a
+%   response followed by no reinforcer loses), satiation (1: a reinforcer that comes when no
+%   necessity is active lowers the rule). The defaults are the fixed task's.
+relrl_engine:learner_parameter(contingency, default_fitness, 1.0, number).
+relrl_engine:learner_parameter(contingency, influence, 0.5, number).
+relrl_engine:learner_parameter(contingency, min_fitness, 0.05, number).
+relrl_engine:learner_parameter(contingency, max_fitness, 10.0, number).
+relrl_engine:learner_parameter(contingency, default_always, 0.0, flag).
+relrl_engine:learner_parameter(contingency, extinction, 1.0, unit).
+relrl_engine:learner_parameter(contingency, satiation, 0.0, flag).
+relrl_engine:learner_serves(contingency, domains, []).
+
 relrl_engine:learner_forget(contingency, KB) :-
     retractall(learned_(KB, _, _, _, _)),
     retractall(authored_(KB, _, _, _, _)),

@@ -59,6 +59,8 @@ touches its own file and one line of learners.pl.
   | learner(Name)                                   | registers Name                         |
   | learner_property(Name, external)                | Python chooses (Q-learning over numpy) |
   | learner_property(Name, view(relational))        | reads the relational view only: no state code is computed for it (a step reports code 0) |
+  | learner_parameter(Name, Param, Default, Kind)   | a parameter, its default and the values it takes (learners.pl) |
+  | learner_serves(Name, Family, Overrides)         | learns tasks of Family (`domains`, `worlds`), with these defaults there (learners.pl) |
   | learner_init(Name, KB, Params)                  | start afresh                           |
   | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
   | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
@@ -107,6 +109,8 @@ gateway can name the rule.
 :- multifile
     learner/1,
     learner_property/2,
+    learner_parameter/4,
+    learner_serves/3,
     learner_init/3,
     learner_forget/2,
     learner_state/4,

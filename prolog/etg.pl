@@ -244,6 +244,16 @@ relrl_engine:learner(etg).
 relrl_engine:learner_property(etg, Cap) :-
     member(Cap, [state, size, text, graph, policy]).
 
+%   Parameters (learners.pl): alpha, gamma, epsilon (Eq. 4 and epsilon-greedy choice), q_init
+%   (Q of an action a leaf has no entry for), split_threshold (temporal-difference error
+%   above which a leaf is split between two states it cannot tell apart).
+relrl_engine:learner_parameter(etg, alpha, 0.2, unit).
+relrl_engine:learner_parameter(etg, gamma, 0.9, unit).
+relrl_engine:learner_parameter(etg, epsilon, 0.05, unit).
+relrl_engine:learner_parameter(etg, q_init, 30.0, number).
+relrl_engine:learner_parameter(etg, split_threshold, 0.1, number).
+relrl_engine:learner_serves(etg, domains, []).
+
 relrl_engine:learner_forget(etg, _KB).         % all in the record (and rules.pl's program)
 
 relrl_engine:learner_init(etg, KB, Params) :-

@@ -119,6 +119,7 @@ python_api(wm_insert, relrl_memory:wm_insert/2).
 python_api(wm_elements, relrl_memory:wm_elements/2).
 python_api(wm_clear, relrl_memory:wm_clear/1).
 python_api(wm_clock, relrl_memory:wm_clock/2).
+python_api(learners, relrl_learners:learner_catalogue/1).
 python_api(state_code, relrl_state:state_code/2).
 python_api(state_terms, relrl_state:state_terms/2).
 python_api(state_decode, relrl_state:state_decode/3).

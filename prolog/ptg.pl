@@ -270,6 +270,18 @@ relrl_engine:learner(ptg).
 relrl_engine:learner_property(ptg, Cap) :-
     member(Cap, [view(relational), state, size, text, graph, policy, policy_info]).
 
+%   Parameters (learners.pl): tg's (the Q-tree's, and the P-tree's splits), then p_margin (a
+%   response is labelled optimal when its Q is within this of the best response's), p_alpha
+%   (a P-leaf's estimate moves at rate max(1/n, p_alpha)) and p_pairs (pairs of P-examples
+%   inserted per learning step). A learner of worlds, with tg's defaults there.
+relrl_engine:learner_parameter(ptg, Param, Default, Kind) :-
+    relrl_engine:learner_parameter(tg, Param, Default, Kind).
+relrl_engine:learner_parameter(ptg, p_margin, 0.0, nonneg).
+relrl_engine:learner_parameter(ptg, p_alpha, 0.02, unit).
+relrl_engine:learner_parameter(ptg, p_pairs, 1.0, whole(1)).
+relrl_engine:learner_serves(ptg, worlds, Overrides) :-
+    relrl_engine:learner_serves(tg, worlds, Overrides).
+
 %   The Q-tree is tg's under KB; the P-tree is a tree of its own, under its own key: its
 %   record (kbstate.pl) and compiled clauses go with it, and the options' global.
 relrl_engine:learner_forget(ptg, KB) :-

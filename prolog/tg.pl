@@ -685,6 +685,26 @@ relrl_engine:learner(tg).
 relrl_engine:learner_property(tg, Cap) :-
     member(Cap, [view(relational), state, size, text, graph, policy, policy_info]).
 
+%   Parameters (learners.pl; what each does: docs/tg.md; the defaults were chosen by
+%   measurement on Experiment 1's task). In worlds, whose rewards are of size 1, Q starts
+%   at 0 and both exploration bonuses are off: the novelty bonus's candidate tests for every
+%   action of every choice made a learning step 17 times slower on 10-block states, and the
+%   goal tasks were learned as well without it (docs/worlds.md).
+relrl_engine:learner_parameter(tg, alpha, 0.2, unit).
+relrl_engine:learner_parameter(tg, gamma, 0.9, unit).
+relrl_engine:learner_parameter(tg, epsilon, 0.05, unit).
+relrl_engine:learner_parameter(tg, temperature, 1.0, nonneg).
+relrl_engine:learner_parameter(tg, q_init, 30.0, number).
+relrl_engine:learner_parameter(tg, significance, 0.001, open_unit).
+relrl_engine:learner_parameter(tg, min_examples, 5.0, whole(3)).
+relrl_engine:learner_parameter(tg, stale_bonus, 1.0, nonneg).
+relrl_engine:learner_parameter(tg, half_life, 1000.0, nonneg).
+relrl_engine:learner_parameter(tg, novelty_bonus, 20.0, nonneg).
+relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
+relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
+relrl_engine:learner_serves(tg, domains, []).
+relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0]).
+
 relrl_engine:learner_forget(tg, KB) :-
     tg_forget(KB).
 

@@ -263,6 +263,9 @@ contract(KB, Goal, Format, Args) :-
 %   Episodes are ep(Size, Goal, Steps, Return, Reached, Optimal, Trace): Steps actions
 %   taken, Return the sum of rewards, Reached true/false, Optimal an integer or `none`,
 %   Trace [] or a list of step(State, Action, Reward) ending with end(State).
+%
+%   @error domain_error(world_learner, Learner) if KB's learner is not a learner of worlds
+%   (learner_serves(Learner, worlds, _), learners.pl).
 
 world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(list(positive_integer), Sizes),
@@ -271,8 +274,8 @@ world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(list, Options),
     Sizes = [_|_],
     engine_learner(KB, Learner),
-    (   learner_property(Learner, view(relational))
-    ->  true
+    (   relrl_engine:learner_serves(Learner, worlds, _)   % learners.pl: reads the
+    ->  true                                              % relational view too
     ;   domain_error(world_learner, Learner)
     ),
     option_(updates(Updates), Options, episode),
@@ -289,9 +292,6 @@ option_(Opt, Options, Default) :-
     ->  true
     ;   arg(1, Opt, Default)
     ).
-
-learner_property(Learner, Property) :-
-    relrl_engine:learner_property(Learner, Property).
 
 episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)) :-
     Run = run(KB, _, _, _, Limit, _),

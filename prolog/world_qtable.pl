@@ -164,6 +164,16 @@ relrl_engine:learner(qtable).
 relrl_engine:learner_property(qtable, Cap) :-
     member(Cap, [view(relational), state, size, policy, policy_info]).
 
+%   Parameters (learners.pl): alpha, gamma, epsilon (with temperature 0: epsilon-greedy),
+%   temperature (> 0: Boltzmann), q_init. The baseline of worlds; the domains' tabular
+%   baseline is qlearning over the state code.
+relrl_engine:learner_parameter(qtable, alpha, 0.5, unit).
+relrl_engine:learner_parameter(qtable, gamma, 0.9, unit).
+relrl_engine:learner_parameter(qtable, epsilon, 0.1, unit).
+relrl_engine:learner_parameter(qtable, temperature, 0.0, nonneg).
+relrl_engine:learner_parameter(qtable, q_init, 0.0, number).
+relrl_engine:learner_serves(qtable, worlds, []).
+
 relrl_engine:learner_forget(qtable, KB) :-
     retractall(q_(_, KB, _, _, _)).
 

@@ -127,6 +127,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     import platform
 
     from relrl import __version__
+    from relrl.learners import DOMAINS, learners
     from relrl.machine import machine_info
     from relrl.sim.policies import bench_step_rate
 
@@ -139,7 +140,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     # moves both sides of each ratio together.
     out["learners"] = {}
     calls: list[float] = []
-    for name in ("etg", "contingency", "qlearning", "tg"):
+    for name in learners(DOMAINS):
         before = measure_call_cost(5000) * 1e6
         figures = bench_engine(name, steps)
         after = measure_call_cost(5000) * 1e6

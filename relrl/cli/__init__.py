@@ -2,7 +2,8 @@
 
 Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EXAMPLE``,
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
-pyserial, matplotlib, Prolog) inside ``run`` so ``relrl --help`` stays fast.
+pyserial, matplotlib) inside ``run`` so ``relrl --help`` stays fast; Prolog is asked once,
+for the learner registry the options' help and defaults name (about 0.1 s).
 
 Errors a user can cause (:data:`relrl.errors.USER_ERRORS`: relrl's ``UserError`` and the error
 bases of the ``head`` and ``perception`` packages) print one line and exit 2 (an error that
@@ -91,8 +92,13 @@ def _add_verbosity(parser: argparse.ArgumentParser, default: object) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``relrl`` command line; returns the exit status."""
     from relrl import log
+    from relrl.errors import USER_ERRORS
 
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except USER_ERRORS as exc:  # the learners' declarations the options name (registry)
+        print(f"relrl: {exc}", file=sys.stderr)
+        return 2
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(argv)
     verbose, quiet = getattr(args, "verbose", 0), getattr(args, "quiet", 0)
@@ -101,8 +107,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not getattr(args, "_run", None):
         parser.print_help()
         return 2
-    from relrl.errors import USER_ERRORS
-
     try:
         return int(args._run(args) or 0)
     except USER_ERRORS as exc:

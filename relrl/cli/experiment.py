@@ -102,7 +102,7 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the subcommands and options of ``relrl experiment``."""
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS, learners
 
     sub = parser.add_subparsers(dest="name", metavar="EXPERIMENT", required=True,
                                 parser_class=type(parser))
@@ -117,7 +117,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                 "  relrl experiment sis --config runs/exp1/results.json --out "
                                 "runs/exp1-again",
                          formatter_class=argparse.RawDescriptionHelpFormatter)
-    _common(sis, default_learners=",".join(LEARNERS), default_seeds="0")
+    _common(sis, default_learners=",".join(learners(DOMAINS)), default_seeds="0")
     from relrl.experiments.sis import PRESETS
 
     sis.add_argument("--preset", default=None, choices=sorted(PRESETS),
@@ -145,7 +145,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                "  relrl experiment scaling --learners tg --sizes 5 --transfer "
                                "sizes --transfer-sizes 9,33,129 --out runs/transfer",
                         formatter_class=argparse.RawDescriptionHelpFormatter)
-    _common(sc, default_learners=",".join(LEARNERS), default_seeds="0,1,2")
+    _common(sc, default_learners=",".join(learners(DOMAINS)), default_seeds="0,1,2")
     sc.add_argument("--sizes", default="5,9,17,33", help="world sizes P (default 5,9,17,33)")
     sc.add_argument("--world", default="", metavar="NAME=VALUE,...",
                     help="the worlds' other fields: colours, kinds, toys, scene, field "
@@ -173,13 +173,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_worlds(sub) -> None:
-    from relrl.worlds import WORLD_LEARNERS
+    from relrl.learners import WORLDS, learners
 
+    world_learners = ",".join(learners(WORLDS))
     w = sub.add_parser("worlds", help="tasks of worlds written in Prolog (blocks world)",
                        description="Learning curves, evaluation on other sizes with no "
                                    "further learning, memory and step cost of the learners "
-                                   "of worlds (tg, ptg, qtable) on tasks of worlds written in "
-                                   "Prolog; the worlds' stated optimum checked by search.",
+                                   f"of worlds ({world_learners.replace(',', ', ')}) on tasks "
+                                   "of worlds written in Prolog; the worlds' stated optimum "
+                                   "checked by search.",
                        epilog="examples:\n"
                               "  relrl experiment worlds --quick --out runs/worlds-quick\n"
                               "  relrl experiment worlds --tasks stack,unstack,on --seeds "
@@ -189,8 +191,8 @@ def _add_worlds(sub) -> None:
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
     w.add_argument("--tasks", default="stack,unstack,on",
                    help="tasks of each world (default stack,unstack,on)")
-    w.add_argument("--learners", default=",".join(WORLD_LEARNERS),
-                   help=f"learners (default {','.join(WORLD_LEARNERS)})")
+    w.add_argument("--learners", default=world_learners,
+                   help=f"learners (default {world_learners})")
     w.add_argument("--seeds", default=None, help="comma-separated seeds (default 0,1,2)")
     w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
     w.add_argument("--test-sizes", default="6,8,10",
@@ -225,11 +227,12 @@ def _ints(text: str, what: str) -> list[int]:
     return values
 
 
-def _check_common(args: argparse.Namespace, config, learners_known) -> None:
+def _check_common(args: argparse.Namespace, config) -> None:
     """Validate and copy the options both experiments share into ``config``."""
     from relrl.errors import ConfigError
-    from relrl.learners import make_learner
+    from relrl.learners import DOMAINS, learners, make_learner
 
+    learners_known = learners(DOMAINS)
     learners = [x.strip() for x in args.learners.split(",") if x.strip()]
     for name in learners:
         if name not in learners_known:
@@ -267,7 +270,6 @@ def build_config(args: argparse.Namespace):
     """The SISConfig the options of ``relrl experiment sis`` describe."""
     from relrl.errors import ConfigError
     from relrl.experiments.sis import SISConfig
-    from relrl.learners import LEARNERS
     from relrl.sim.caregiver import make_caregiver
 
     record = apply_record(args, "sis")
@@ -278,7 +280,7 @@ def build_config(args: argparse.Namespace):
     config.block = args.block if args.block is not None else 500
     if config.points < 1:
         raise ConfigError(f"--points must be at least 1, not {config.points}")
-    _check_common(args, config, LEARNERS)
+    _check_common(args, config)
     config.learner_params = {k: v for k, v in config.learner_params.items()
                              if k in config.learners}
     make_caregiver(config.caregiver, config.caregiver_params)  # validate now, not in a worker
@@ -297,7 +299,6 @@ def build_scaling_config(args: argparse.Namespace):
     """The ScalingConfig the options of ``relrl experiment scaling`` describe."""
     from relrl.errors import ConfigError
     from relrl.experiments.scaling import ScalingConfig
-    from relrl.learners import LEARNERS
     from relrl.sim.world import World
 
     record = apply_record(args, "scaling")
@@ -309,7 +310,7 @@ def build_scaling_config(args: argparse.Namespace):
         if value is None:
             value = quick.get(name, getattr(config, name))
         setattr(config, name, value)
-    _check_common(args, config, LEARNERS)
+    _check_common(args, config)
     if config.budget < config.block:
         raise ConfigError(f"--budget ({config.budget}) must be at least --block "
                           f"({config.block})")
@@ -420,8 +421,9 @@ def _run_scaling(args: argparse.Namespace) -> int:
 def build_worlds_config(args: argparse.Namespace):
     """The WorldsConfig the options of ``relrl experiment worlds`` describe."""
     from relrl.errors import ConfigError
+    from relrl.learners import WORLDS, learners, make_world_learner
     from relrl.resources import examples_dir
-    from relrl.worlds import WORLD_LEARNERS, World, make_world_learner
+    from relrl.worlds import World
     from relrl.worlds.experiment import WorldsConfig
 
     config = WorldsConfig(seeds=_ints(args.seeds or "0,1,2", "--seeds"))
@@ -439,9 +441,9 @@ def build_worlds_config(args: argparse.Namespace):
     config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
     config.learners = [x.strip() for x in args.learners.split(",") if x.strip()]
     for name in config.learners:
-        if name not in WORLD_LEARNERS:
+        if name not in learners(WORLDS):
             raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "
-                              f"{', '.join(WORLD_LEARNERS)})")
+                              f"{', '.join(learners(WORLDS))})")
     if not config.tasks or not config.learners:
         raise ConfigError("--tasks and --learners must name at least one each")
     config.train_sizes = _ints(args.sizes, "--sizes")

@@ -45,13 +45,12 @@ def _param(text: str) -> tuple[str, float]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl learn``."""
-    from relrl.worlds import WORLD_LEARNERS
+    from relrl.learners import WORLDS, learners
 
     parser.add_argument("world", metavar="WORLD.pl", help="the world file (docs/worlds.md)")
     parser.add_argument("--learner", default="tg",
-                        help=f"{', '.join(WORLD_LEARNERS)}: tg (relational, the default), ptg "
-                             "(tg's Q-tree and a P-tree that acts: P-learning) or qtable "
-                             "(Q-learning over ground states, the baseline)")
+                        help=f"a learner of worlds: {', '.join(learners(WORLDS))} (default tg, "
+                             "relational; docs/worlds.md describes each)"),
     parser.add_argument("--task", default=None,
                         help="a task of the world: its name (stack, on) or an instance "
                              "(on(b1, b2)); default: the first the world declares")
@@ -95,8 +94,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Check the world and the options, learn, print the curve and the evaluation."""
     from relrl.errors import ConfigError
+    from relrl.learners import make_world_learner
     from relrl.outdir import OutDir
-    from relrl.worlds import World, make_world_learner
+    from relrl.worlds import World
     from relrl.worlds.learn import LearnConfig, learn_task
 
     path = Path(args.world)

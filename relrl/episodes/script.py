@@ -362,9 +362,9 @@ def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
         c.fail(w + ("seed",), f"seed must be an integer >= 0, not {ep.seed}")
         ep.seed = 0
     ep.learner = c.get(head, "learner", str, "etg", w)
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS, learners
 
-    if not c.choice(ep.learner, tuple(sorted(LEARNERS)), "learner", w + ("learner",)):
+    if not c.choice(ep.learner, learners(DOMAINS), "learner", w + ("learner",)):
         ep.learner = ""
     load = c.get(head, "policy_load", str, "", w)
     if "\0" in load:

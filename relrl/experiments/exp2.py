@@ -18,8 +18,8 @@ Usage::
 
     python -m relrl.experiments.exp2 --seeds 0-4 --out docs/results/exp2
 
-Learners come from the registry (:data:`relrl.learners.LEARNERS`): every registered learner by
-default, so one that lands later is measured too.
+Learners come from the registry (:func:`relrl.learners.learners`, asked of relrl's Prolog):
+every learner of the domains by default, so one that lands later is measured too.
 """
 
 from __future__ import annotations
@@ -249,13 +249,15 @@ def _check(args: argparse.Namespace) -> tuple[list[str], list[str], list[int]]:
     from relrl.episodes import load_episode
     from relrl.episodes.script import TIME_UNITS
     from relrl.errors import UserError
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS
+    from relrl.learners import learners as registered
 
-    learners = (sorted(LEARNERS) if args.learners == "all" else
+    known = registered(DOMAINS)
+    learners = (list(known) if args.learners == "all" else
                 [x.strip() for x in args.learners.split(",") if x.strip()])
     for name in learners:
-        if name not in LEARNERS:
-            raise UserError(f"unknown learner {name!r} (known: {', '.join(sorted(LEARNERS))})")
+        if name not in known:
+            raise UserError(f"unknown learner {name!r} (known: {', '.join(known)})")
     units = [x.strip() for x in args.time_units.split(",") if x.strip()]
     for u in units:
         if u not in TIME_UNITS:

@@ -40,9 +40,9 @@ __all__ = ["ScalingConfig", "held_out_places", "run_scaling_job"]
 
 
 def _all_learners() -> list[str]:
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS, learners
 
-    return list(LEARNERS)
+    return list(learners(DOMAINS))
 
 
 @dataclass

@@ -135,9 +135,9 @@ def claims_table(claims: dict[str, dict[str, Any]]) -> str:
 
 
 def _all_learners() -> list[str]:
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS, learners
 
-    return list(LEARNERS)
+    return list(learners(DOMAINS))
 
 
 @dataclass

@@ -1,15 +1,17 @@
-"""The learner interface and the learner registry.
+"""The learner interface and what a learner is made from: its declared parameters.
 
-A learner is chosen by name (``make_learner("etg", alpha=0.2)``). Learners that keep their
-knowledge in Prolog (ETG, contingency) choose and learn inside the engine's control step, so
-a step costs one gateway call; a learner that keeps numbers in Python (Q-learning) gets the
-state, necessity, reward and allowed responses from that same call and chooses itself.
+A learner is chosen by name (``make_learner("etg", alpha=0.2)``, :mod:`relrl.learners.registry`).
+Learners that keep their knowledge in Prolog (ETG, contingency, tg) choose and learn inside
+the engine's control step, so a step costs one gateway call; a learner that keeps numbers in
+Python (Q-learning) gets the state, necessity, reward and allowed responses from that same
+call and chooses itself.
 """
 
 from __future__ import annotations
 
 import abc
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -22,13 +24,89 @@ from relrl.terms import Term
 
 if TYPE_CHECKING:
     from relrl.engine import Engine
+    from relrl.kb import KnowledgeBase
 
-__all__ = ["Learner", "StepOut", "register", "make_learner", "LEARNERS", "COMMON_DEFAULTS"]
+__all__ = ["COMMON", "COMMON_DEFAULTS", "DOMAINS", "FAMILIES", "Learner", "LearnerSpec",
+           "Parameter", "StepOut", "WORLDS"]
 
-#: Parameters every learner takes: the reward for a perceived reinforcer and otherwise (the
-#: task's reward, :data:`relrl.reward.PAPER_REWARD`).
-COMMON_DEFAULTS: dict[str, float] = {"reward_positive": PAPER_REWARD.attention,
-                                     "reward_negative": PAPER_REWARD.other}
+#: The families of tasks a learner may serve: the domains of the simulator and the robot,
+#: and worlds written in Prolog (docs/worlds.md).
+DOMAINS = "domains"
+WORLDS = "worlds"
+FAMILIES = (DOMAINS, WORLDS)
+
+#: The kinds of parameter values (``relrl_engine:learner_parameter/4``): what each allows
+#: (``whole``: a whole number >= the parameter's ``least``), and that as text.
+_KINDS = {"unit": (lambda v: 0.0 <= v <= 1.0, "in [0, 1]"),
+          "open_unit": (lambda v: 0.0 < v < 1.0, "in (0, 1)"),
+          "nonneg": (lambda v: v >= 0, ">= 0"),
+          "whole": (lambda v: v == int(v), "a whole number"),
+          "flag": (lambda v: v in (0.0, 1.0), "0 or 1"),
+          "number": (lambda v: True, "a number")}
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A learner's parameter: its name, default and the values it takes (its kind:
+    ``unit``, ``open_unit``, ``nonneg``, ``whole`` (>= ``least``), ``flag`` or ``number``)."""
+
+    name: str
+    default: float
+    kind: str = "number"
+    least: int = 0
+
+    def __post_init__(self) -> None:
+        if self.kind not in _KINDS:
+            raise ValueError(f"parameter {self.name}: unknown kind {self.kind!r}")
+
+    def holds(self, value: float) -> bool:
+        """Whether ``value`` (a finite number) is a value of this parameter's kind."""
+        return _KINDS[self.kind][0](value) and (self.kind != "whole" or value >= self.least)
+
+    def value(self, learner: str, value: object) -> float:
+        """``value`` as this parameter of ``learner`` takes it (a float).
+
+        Raises:
+            ConfigError: not a finite number of the parameter's kind.
+        """
+        try:
+            number = float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            raise ConfigError(f"parameter {self.name} of learner {learner!r} must be a "
+                              f"number, not {value!r}") from None
+        if not math.isfinite(number):
+            raise ConfigError(f"parameter {self.name} of learner {learner!r} must be a "
+                              f"finite number, not {value!r}")
+        if not self.holds(number):
+            allowed = _KINDS[self.kind][1] + (f" >= {self.least}" if self.kind == "whole"
+                                              else "")
+            raise ConfigError(f"{self.name} must be {allowed}, not {number}")
+        return number
+
+
+#: Parameters every learner takes, read by the engine: the reward for a perceived reinforcer
+#: and otherwise (the task's reward, :data:`relrl.reward.PAPER_REWARD`).
+COMMON = (Parameter("reward_positive", PAPER_REWARD.attention),
+          Parameter("reward_negative", PAPER_REWARD.other))
+COMMON_DEFAULTS: dict[str, float] = {p.name: p.default for p in COMMON}
+
+
+@dataclass(frozen=True)
+class LearnerSpec:
+    """What a learner is chosen by: its name, the Prolog learner behind it (``external``
+    for one that chooses in Python), its own parameters in declaration order, and the
+    families of tasks it serves, each with its defaults there where they differ."""
+
+    name: str
+    engine: str
+    parameters: tuple[Parameter, ...]
+    serves: Mapping[str, Mapping[str, float]]
+    properties: tuple[str, ...] = ()
+
+    def defaults(self, family: str) -> dict[str, float]:
+        """Every parameter's default in ``family``, the common ones first."""
+        return {**COMMON_DEFAULTS, **{p.name: p.default for p in self.parameters},
+                **self.serves.get(family, {})}
 
 
 @dataclass
@@ -49,72 +127,57 @@ class StepOut:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
-LEARNERS: dict[str, type[Learner]] = {}
+class Learner(abc.ABC):
+    """Base class of relrl's learners, made from a :class:`LearnerSpec` by the registry
+    (:func:`relrl.learners.make_learner`).
 
+    A subclass is the Python side of one learner, registered under its ``name``
+    (:func:`relrl.learners.registry.register`): what Python really does for it (reading its
+    explanations, choosing in Python). A learner declared in Prolog takes its parameters
+    and families from the declarations (``relrl_engine:learner_parameter/4``,
+    ``learner_serves/3``); one that chooses in Python (through the engine's ``external``
+    learner) declares them as its class's ``python_spec``.
 
-def register(cls: type[Learner]) -> type[Learner]:
-    """Class decorator: make a learner available by its ``name``."""
-    LEARNERS[cls.name] = cls
-    return cls
-
-
-def make_learner(name: str, **params: float) -> Learner:
-    """Build the learner registered as ``name`` with ``params``.
+    Args:
+        spec: the learner's name, Prolog learner, parameters and families.
+        family: the family of tasks it learns (``domains`` or ``worlds``), whose defaults
+            it takes.
+        **params: parameters over those defaults.
 
     Raises:
-        ConfigError: unknown learner name or parameter.
-    """
-    try:
-        cls = LEARNERS[name]
-    except KeyError:
-        known = ", ".join(sorted(LEARNERS))
-        raise ConfigError(f"unknown learner {name!r} (known: {known})") from None
-    return cls(**params)
-
-
-class Learner(abc.ABC):
-    """Base class of relrl's learners.
-
-    Subclasses set ``name``, ``engine_name`` (the Prolog learner behind it: ``etg``,
-    ``contingency``, or ``external`` for a learner that chooses in Python) and
-    ``defaults``; Python-side learners override :meth:`act`.
+        ConfigError: an unknown parameter, or a value not of its parameter's kind.
     """
 
-    name: ClassVar[str]
-    engine_name: ClassVar[str]
-    defaults: ClassVar[dict[str, float]]
+    #: the learner a subclass is the Python side of (an instance's: its spec's name)
+    name: str = ""
+    #: a learner that chooses in Python: its name, parameters and families
+    python_spec: ClassVar[LearnerSpec | None] = None
 
-    def __init__(self, **params: float) -> None:
-        allowed = {**COMMON_DEFAULTS, **self.defaults}
+    def __init__(self, spec: LearnerSpec, family: str = DOMAINS, **params: float) -> None:
+        self.spec = spec
+        self.name = spec.name
+        #: the Prolog learner behind this one (``external`` for a learner choosing in Python)
+        self.engine_name = spec.engine
+        self.family = family
+        allowed = {p.name: p for p in (*COMMON, *spec.parameters)}
         unknown = sorted(set(params) - set(allowed))
         if unknown:
             raise ConfigError(f"unknown parameter {unknown[0]!r} for learner {self.name!r} "
                               f"(known: {', '.join(sorted(allowed))})")
-        self.params: dict[str, float] = {}
-        for key, default in allowed.items():
-            value = params.get(key, default)
-            try:
-                self.params[key] = float(value)
-            except (TypeError, ValueError):
-                raise ConfigError(f"parameter {key} of learner {self.name!r} must be a number, "
-                                  f"not {value!r}") from None
-            if not math.isfinite(self.params[key]):
-                raise ConfigError(f"parameter {key} of learner {self.name!r} must be a finite "
-                                  f"number, not {value!r}")
+        self.params: dict[str, float] = {
+            key: allowed[key].value(self.name, params.get(key, default))
+            for key, default in spec.defaults(family).items()}
         self._check_params()
         self.engine: Engine | None = None
         self.rng = np.random.default_rng(0)
 
     @property
-    def kb(self) -> Any:
+    def kb(self) -> KnowledgeBase | None:
         """The knowledge base the learner is attached to (None before :meth:`attach`)."""
         return self.engine.kb if self.engine is not None else None
 
-    def _check_params(self) -> None:
-        """Validate parameter ranges (override to add checks)."""
-        for key in ("alpha", "gamma", "epsilon"):
-            if key in self.params and not 0.0 <= self.params[key] <= 1.0:
-                raise ConfigError(f"{key} must be in [0, 1], not {self.params[key]}")
+    def _check_params(self) -> None:  # noqa: B027 - an optional hook
+        """Check what no one parameter's kind says (a relation between parameters)."""
 
     def attach(self, engine: Engine, seed: int | None) -> None:
         """Start learning with ``engine``: configure it, seed the random numbers."""

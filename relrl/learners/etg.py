@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from relrl.learners.base import Learner, register
+from relrl.learners.base import Learner
+from relrl.learners.registry import register
 from relrl.terms import Term, format_term
 
 __all__ = ["ETGLearner"]
@@ -14,15 +15,11 @@ __all__ = ["ETGLearner"]
 class ETGLearner(Learner):
     """A relational Q-tree grown one example per step; choices and updates run in Prolog.
 
-    Parameters: alpha, gamma, epsilon (Eq. 4 and epsilon-greedy choice), q_init (Q of an
-    action a leaf has no entry for), split_threshold (temporal-difference error above which
-    a leaf is split between two states it cannot tell apart; see prolog/etg.pl).
+    Its parameters (alpha, gamma, epsilon, q_init, split_threshold) are declared beside its
+    hooks in prolog/etg.pl; this class reads its explanations.
     """
 
     name = "etg"
-    engine_name = "etg"
-    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0,
-                "split_threshold": 0.1}
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
         """The path of tests from the root (with outcomes), the leaf, its ranked entries."""

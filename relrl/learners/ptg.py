@@ -5,44 +5,35 @@ the Q-function, a first-order tree learns P(s, a) -- 1 when the Q-tree finds ``a
 ``s``, 0 when not -- and greedy choices are made by P (ties by Q). The optimal policy often
 depends on the objects far less than the values do, so a P-tree learned in small worlds acts
 in larger ones where the Q-tree's values mislead it. A learner of worlds
-(:data:`relrl.worlds.WORLD_LEARNERS`); see docs/worlds.md.
+(``learner_serves(ptg, worlds, _)``); see docs/worlds.md.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from relrl.errors import ConfigError
-from relrl.learners.tg import TGLearner, explanation
+from relrl.learners.base import Learner
+from relrl.learners.registry import register
+from relrl.learners.tg import explanation
 from relrl.terms import Term
 
 __all__ = ["PTGLearner"]
 
 
-class PTGLearner(TGLearner):
+@register
+class PTGLearner(Learner):
     """tg's Q-tree (learned and exploring as tg does) and a P-tree that acts when greedy.
 
-    Parameters: tg's (the Q-tree's; :class:`~relrl.learners.tg.TGLearner`) and p_margin (a
-    response is labelled optimal when its Q is within this of the best response's),
-    p_alpha (a P-leaf's estimate moves at rate max(1/n, p_alpha): its labels change as the
-    Q-tree learns) and p_pairs (pairs of P-examples, one optimal response and one not,
-    inserted per learning step). The P-tree splits as the Q-tree does (significance,
-    min_examples, half_life, keep_examples).
+    Its parameters are declared beside its hooks in prolog/ptg.pl: tg's (the Q-tree's) and
+    p_margin (a response is labelled optimal when its Q is within this of the best
+    response's), p_alpha (a P-leaf's estimate moves at rate max(1/n, p_alpha): its labels
+    change as the Q-tree learns) and p_pairs (pairs of P-examples, one optimal response and
+    one not, inserted per learning step). The P-tree splits as the Q-tree does
+    (significance, min_examples, half_life, keep_examples). This class reads its
+    explanations.
     """
 
     name = "ptg"
-    engine_name = "ptg"
-    defaults = {**TGLearner.defaults, "p_margin": 0.0, "p_alpha": 0.02, "p_pairs": 1.0}
-
-    def _check_params(self) -> None:
-        super()._check_params()
-        p = self.params
-        if p["p_margin"] < 0:
-            raise ConfigError(f"p_margin must be >= 0, not {p['p_margin']}")
-        if not 0.0 <= p["p_alpha"] <= 1.0:
-            raise ConfigError(f"p_alpha must be in [0, 1], not {p['p_alpha']}")
-        if p["p_pairs"] < 1 or p["p_pairs"] != int(p["p_pairs"]):
-            raise ConfigError(f"p_pairs must be a whole number >= 1, not {p['p_pairs']}")
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
         """``ranked``: every response's P, Q and P-leaf, by P then Q; ``paths``: for each, the

@@ -8,9 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from relrl.engine import Engine
+from relrl.engine import Engine, one
 from relrl.errors import PolicyError
-from relrl.learners.base import Learner, StepOut, register
+from relrl.learners.base import DOMAINS, Learner, LearnerSpec, Parameter, StepOut
+from relrl.learners.registry import register
 from relrl.outdir import write_atomic
 from relrl.terms import Term, format_term
 
@@ -26,12 +27,16 @@ class QLearner(Learner):
     declaration order. Choice is epsilon-greedy over the allowed responses, ties broken at
     random; without exploration (evaluation) greedy.
 
-    Parameters: alpha, gamma, epsilon, q_init.
+    Parameters: alpha, gamma, epsilon, q_init. It chooses in Python (through the engine's
+    ``external`` learner), so its parameters are declared here, not in Prolog.
     """
 
     name = "qlearning"
-    engine_name = "external"
-    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "q_init": 30.0}
+    python_spec = LearnerSpec(
+        name=name, engine="external",
+        parameters=(Parameter("alpha", 0.2, "unit"), Parameter("gamma", 0.9, "unit"),
+                    Parameter("epsilon", 0.05, "unit"), Parameter("q_init", 30.0)),
+        serves={DOMAINS: {}})
 
     def attach(self, engine: Engine, seed: int | None) -> None:
         """Start learning with ``engine`` (an empty table)."""
@@ -139,13 +144,11 @@ class QLearner(Learner):
             PolicyError: not a relrl Q-table of this domain (names the file and what is
                 wrong).
         """
-        from relrl.engine import one
-
         path = Path(path)
         engine = self._engine()
         mine = [format_term(r) for r in self.responses]
         necessities = [*engine.necessities, "none"]
-        states = 1 << len(self.kb.features())
+        states = 1 << len(engine.kb.features())
         arrays = _read_table(path, max_rows=states * len(necessities), width=len(mine))
         q, codes, names = arrays["q"], arrays["codes"], arrays["necessities"]
         responses = [str(r) for r in arrays["responses"]]
@@ -168,7 +171,7 @@ class QLearner(Learner):
                                   f"under {necessity}")
             rows[key] = i
         values = np.asarray(q, dtype=float)
-        bound = float(one(self.kb, "policy_max_number"))
+        bound = float(one(engine.kb, "policy_max_number"))
         bad = np.flatnonzero(~(np.abs(values) <= bound).all(axis=1))
         if len(bad):
             i = int(bad[0])

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from relrl.errors import ConfigError
-from relrl.learners.base import Learner, register
+from relrl.learners.base import Learner
+from relrl.learners.registry import register
 from relrl.terms import Term, format_term
 
 __all__ = ["TGLearner", "explanation"]
@@ -23,53 +23,31 @@ __all__ = ["TGLearner", "explanation"]
 class TGLearner(Learner):
     """A first-order Q-tree; choices, updates and splits run in Prolog (one call a step).
 
-    Parameters (defaults chosen by measurement on Experiment 1's task, see docs/tg.md):
-    alpha (0: a leaf's Q is the mean of its Q-targets; otherwise the step size is
-    max(1/n, alpha)), gamma, temperature (> 0: Boltzmann exploration, P(a) proportional to
-    exp(Q(s, a) / T), while learning and in the behaviour evaluation), epsilon (used only
-    with temperature 0: epsilon-greedy), q_init (Q of the first, empty leaf), significance
-    (of the F-test of the best of a leaf's candidates, Bonferroni-corrected for their
-    number; the leaves keep the statistics of the TD errors), min_examples (a split must
-    leave at least this many examples on each side), stale_bonus (while learning, a leaf
-    no example has reached for the last k examples counts Q + stale_bonus * sqrt(k):
-    Dyna-Q+'s exploration bonus, per leaf; 0 turns it off), half_life (an example counts
-    half in the split statistics once this many more examples have been inserted; 0: never
-    forget), novelty_bonus and novelty_confidence (directed exploration while learning:
-    Q(s, a) counts as Q + the largest upper confidence bound, mean TD error +
-    novelty_confidence standard errors, of the regions (s, a) falls in — its leaf and the
-    yes-side of each candidate test of the leaf that succeeds on it — capped at
-    novelty_bonus, which is also the bound of a region fewer than two examples reached;
-    novelty_bonus 0 turns it off), keep_examples (each leaf keeps its last examples so
-    that a split's children start with statistics; 0: they start empty). Explore and greedy
-    choices and the Q-targets never include the bonuses. Choices are over classes of
-    responses no test of the bias tells apart in the state (scored by one representative,
-    uniform within a class).
+    Its parameters are declared beside its hooks in prolog/tg.pl, with their defaults in
+    the domains and in worlds (chosen by measurement, see docs/tg.md): alpha (0: a leaf's
+    Q is the mean of its Q-targets; otherwise the step size is max(1/n, alpha)), gamma,
+    temperature (> 0: Boltzmann exploration, P(a) proportional to exp(Q(s, a) / T), while
+    learning and in the behaviour evaluation), epsilon (used only with temperature 0:
+    epsilon-greedy), q_init (Q of the first, empty leaf), significance (of the F-test of
+    the best of a leaf's candidates, Bonferroni-corrected for their number; the leaves keep
+    the statistics of the TD errors), min_examples (a split must leave at least this many
+    examples on each side), stale_bonus (while learning, a leaf no example has reached for
+    the last k examples counts Q + stale_bonus * sqrt(k): Dyna-Q+'s exploration bonus, per
+    leaf; 0 turns it off), half_life (an example counts half in the split statistics once
+    this many more examples have been inserted; 0: never forget), novelty_bonus and
+    novelty_confidence (directed exploration while learning: Q(s, a) counts as Q + the
+    largest upper confidence bound, mean TD error + novelty_confidence standard errors, of
+    the regions (s, a) falls in — its leaf and the yes-side of each candidate test of the
+    leaf that succeeds on it — capped at novelty_bonus, which is also the bound of a region
+    fewer than two examples reached; novelty_bonus 0 turns it off), keep_examples (each
+    leaf keeps its last examples so that a split's children start with statistics; 0: they
+    start empty). Explore and greedy choices and the Q-targets never include the bonuses.
+    Choices are over classes of responses no test of the bias tells apart in the state
+    (scored by one representative, uniform within a class). This class reads its
+    explanations.
     """
 
     name = "tg"
-    engine_name = "tg"
-    defaults = {"alpha": 0.2, "gamma": 0.9, "epsilon": 0.05, "temperature": 1.0,
-                "q_init": 30.0, "significance": 0.001, "min_examples": 5.0,
-                "stale_bonus": 1.0, "half_life": 1000.0, "novelty_bonus": 20.0,
-                "novelty_confidence": 2.0, "keep_examples": 0.0}
-
-    def _check_params(self) -> None:
-        super()._check_params()
-        p = self.params
-        if not 0.0 < p["significance"] < 1.0:
-            raise ConfigError(f"significance must be in (0, 1), not {p['significance']}")
-        if p["min_examples"] < 3 or p["min_examples"] != int(p["min_examples"]):
-            raise ConfigError(f"min_examples must be a whole number >= 3, not "
-                              f"{p['min_examples']}")
-        if p["keep_examples"] < 0 or p["keep_examples"] != int(p["keep_examples"]):
-            raise ConfigError(f"keep_examples must be a whole number >= 0, not "
-                              f"{p['keep_examples']}")
-        for key in ("temperature", "stale_bonus", "half_life", "novelty_bonus"):
-            if p[key] < 0:
-                raise ConfigError(f"{key} must be >= 0, not {p[key]}")
-        if p["novelty_confidence"] < 0:
-            raise ConfigError(f"novelty_confidence must be >= 0, not "
-                              f"{p['novelty_confidence']}")
 
     def _explain_from(self, detail: Term, state: Term, necessity: str) -> dict[str, Any]:
         """``ranked``: every response's Q and leaf, best first; ``paths``: for each, the

@@ -10,14 +10,7 @@ Example:
     ...     print(score(world.episodes("stack", [6, 8, 10], 30, "greedy", optimal=True)))
 """
 
-from relrl.worlds.world import (
-                                WORLD_DEFAULTS,
-                                WORLD_LEARNERS,
-                                Episode,
-                                World,
-                                make_world_learner,
-                                score,
-)
+from relrl.learners import make_world_learner
+from relrl.worlds.world import Episode, World, score
 
-__all__ = ["WORLD_DEFAULTS", "WORLD_LEARNERS", "Episode", "World", "make_world_learner",
-           "score"]
+__all__ = ["Episode", "World", "make_world_learner", "score"]

@@ -24,6 +24,7 @@ from typing import Any
 
 from relrl.experiments.report import pyplot_or_note, save_figure, skip_plots, write_csv
 from relrl.experiments.runner import raise_kept, run_jobs
+from relrl.learners import WORLDS, learners
 from relrl.machine import machine_info
 from relrl.outdir import write_atomic, write_json_atomic
 from relrl.worlds.learn import LearnConfig, learn_task
@@ -42,7 +43,7 @@ class WorldsConfig:
 
     worlds: list[str] = field(default_factory=list)           #: world files
     tasks: list[str] = field(default_factory=lambda: ["stack", "unstack", "on"])
-    learners: list[str] = field(default_factory=lambda: ["tg", "ptg", "qtable"])
+    learners: list[str] = field(default_factory=lambda: list(learners(WORLDS)))
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
@@ -92,7 +93,8 @@ def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, se
 def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = None
                ) -> dict[str, Any]:
     """The world's optimal_steps/3 against a breadth-first search (seeded, per size)."""
-    from relrl.worlds.world import World, make_world_learner
+    from relrl.learners import make_world_learner
+    from relrl.worlds.world import World
 
     rows = []
     with World(world) as w:

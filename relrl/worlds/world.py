@@ -23,47 +23,10 @@ from relrl.bridge.calls import display_path as _display_path
 from relrl.engine import Engine, call, call_semidet, one
 from relrl.errors import ConfigError, PrologError
 from relrl.kb import KnowledgeBase
+from relrl.learners import Learner, make_world_learner
 from relrl.terms import Term, Var, format_term
 
-__all__ = ["Episode", "World", "WORLD_DEFAULTS", "WORLD_LEARNERS", "make_world_learner",
-           "score"]
-
-#: The learners of worlds: those whose Prolog learner reads the relational view.
-WORLD_LEARNERS = ("tg", "ptg", "qtable")
-
-#: Learner parameters for worlds, where they differ from the learners' own defaults (those
-#: were chosen on the simulator's rewards, 10 and -1, and its one-step reward delays): a
-#: world's rewards are of size 1, so Q starts at 0; the novelty bonus is off (its candidate
-#: tests for every action of every choice made a learning step 17 times slower on 10-block
-#: states, and the goal tasks were learned as well without it) and so is the staleness bonus.
-WORLD_DEFAULTS: dict[str, dict[str, float]] = {
-    "tg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
-    "ptg": {"q_init": 0.0, "novelty_bonus": 0.0, "stale_bonus": 0.0},
-    "qtable": {},
-}
-
-
-
-def make_world_learner(name: str, **params: float) -> Any:
-    """The learner ``name`` of :data:`WORLD_LEARNERS`, with the worlds' defaults
-    (:data:`WORLD_DEFAULTS`) under ``params``.
-
-    Raises:
-        ConfigError: an unknown learner or parameter.
-    """
-    from relrl.learners import make_learner
-    from relrl.learners.ptg import PTGLearner
-    from relrl.learners.qtable import QTableLearner
-
-    if name not in WORLD_LEARNERS:
-        raise ConfigError(f"unknown learner {name!r} for a world (learners of worlds: "
-                          f"{', '.join(WORLD_LEARNERS)})")
-    merged = {**WORLD_DEFAULTS.get(name, {}), **params}
-    if name == "qtable":
-        return QTableLearner(**merged)
-    if name == "ptg":
-        return PTGLearner(**merged)
-    return make_learner(name, **merged)
+__all__ = ["Episode", "World", "score"]
 
 
 #: Breadth-first search bound (states) for the optimal number of steps of a world that
@@ -191,16 +154,17 @@ class World:
 
     # -- learning and acting ----------------------------------------------------------------
 
-    def learner(self, name: str, **params: float) -> Any:
-        """The learner ``name`` with the worlds' defaults, the world's discount as its
-        gamma (discount/1), and ``params`` over both (:func:`make_world_learner`)."""
+    def learner(self, name: str, **params: float) -> Learner:
+        """The learner ``name`` with its defaults in worlds, the world's discount as its
+        gamma (discount/1), and ``params`` over both
+        (:func:`~relrl.learners.make_world_learner`)."""
         if self.discount is not None and "gamma" not in params:
             params = {**params, "gamma": self.discount}
         return make_world_learner(name, **params)
 
-    def attach(self, learner: Any, seed: int, task: Term | str | None = None) -> None:
-        """Start ``learner`` (a :class:`relrl.learners.Learner` whose Prolog learner reads the
-        relational view: ``tg``, ``ptg``, ``qtable``) afresh in this world, seeded; for
+    def attach(self, learner: Learner, seed: int, task: Term | str | None = None) -> None:
+        """Start ``learner`` (a learner of worlds: :func:`relrl.learners.learners`
+        ``("worlds")``) afresh in this world, seeded; for
         ``task``, its language bias holds the task's own modes too (task_rmode/2), or them
         alone (task_own_bias/1)."""
         if task is not None:

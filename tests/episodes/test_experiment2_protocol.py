@@ -13,7 +13,7 @@ import pytest
 from relrl.episodes import EpisodeError, EpisodeWorld, RunOptions, parse_episode, run_episode
 from relrl.episodes.script import TIME_UNITS
 from relrl.experiments.fruits import Naming, merge_confusions, rates, report_lines, table1
-from relrl.learners import LEARNERS
+from relrl.learners import DOMAINS, learners
 
 ROOT = Path(__file__).resolve().parents[2]
 FRUITS = ROOT / "examples" / "domains" / "fruits.pl"
@@ -46,7 +46,7 @@ def _learning(tmp_path: Path, text: str, name: str) -> tuple[list[dict], bytes, 
 
 
 @pytest.mark.parametrize("time_unit", TIME_UNITS)
-@pytest.mark.parametrize("learner", sorted(LEARNERS))
+@pytest.mark.parametrize("learner", learners(DOMAINS))
 def test_learning_is_identical_whatever_the_evaluation_interval(tmp_path, learner,
                                                                 time_unit) -> None:
     base = script(PHASES, learner=learner, time_unit=time_unit)

@@ -167,7 +167,7 @@ def test_claims_judged_on_a_summary() -> None:
 def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_path: Path,
                                                      capsys, monkeypatch) -> None:
     import relrl.experiments.main as experiments_main
-    from relrl.learners import LEARNERS
+    from relrl.learners import DOMAINS, learners
 
     ran = []
 
@@ -179,7 +179,7 @@ def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_pat
     args = ["demo", "--out", str(tmp_path / "d")] + (["--preset", preset] if preset else [])
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert f"{len(LEARNERS)} learners ({', '.join(LEARNERS)})" in out
+    assert f"{len(learners(DOMAINS))} learners ({', '.join(learners(DOMAINS))})" in out
     assert f"setting: {ran[0].setting()}" in out
     assert ran[0].preset == preset
     assert ("setting: preset paper-2012" in out) == (preset == "paper-2012")

@@ -11,9 +11,9 @@ import sys
 import time
 
 from relrl.kb import KnowledgeBase
-from relrl.learners import make_learner
+from relrl.learners import make_learner, make_world_learner
 from relrl.loop import Agent
-from relrl.worlds.world import World, make_world_learner
+from relrl.worlds.world import World
 from tests.conftest import ROOT
 
 SIS = ROOT / "examples" / "domains" / "sis.pl"

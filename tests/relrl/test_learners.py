@@ -10,7 +10,7 @@ import pytest
 
 from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase
-from relrl.learners import LEARNERS, make_learner
+from relrl.learners import DOMAINS, WORLDS, learners, make_learner, make_world_learner
 from relrl.loop import Agent, run
 from relrl.terms import Var
 from tests.conftest import ROOT
@@ -201,9 +201,18 @@ def test_explanations() -> None:
 
 
 def test_registry_and_bad_parameters() -> None:
-    assert set(LEARNERS) == {"etg", "contingency", "qlearning", "tg"}
+    assert set(learners(DOMAINS)) == {"etg", "contingency", "qlearning", "tg"}
+    assert set(learners(WORLDS)) == {"tg", "ptg", "qtable"}
     with pytest.raises(ConfigError, match="unknown learner 'sarsa'"):
         make_learner("sarsa")
+    with pytest.raises(ConfigError, match="learner 'ptg' does not learn the domains"):
+        make_learner("ptg")
+    with pytest.raises(ConfigError, match="learner 'etg' does not learn worlds"):
+        make_world_learner("etg")
+    with pytest.raises(ConfigError, match=r"significance must be in \(0, 1\)"):
+        make_world_learner("ptg", significance=1)
+    with pytest.raises(ConfigError, match="must be a finite number"):
+        make_learner("tg", alpha=float("nan"))
     with pytest.raises(ConfigError, match="unknown parameter 'alhpa'"):
         make_learner("etg", alhpa=0.1)
     with pytest.raises(ConfigError, match="epsilon must be in"):
