@@ -68,9 +68,8 @@ def catalogue() -> list[Term]:
     Raises:
         ConfigError: a learner's declarations are wrong (names the learner and what).
     """
-    module, name = prolog().goal("learners")
     try:
-        out = prolog().run((":", module, (name, Var())), _TIMEOUT, (0,))
+        out = prolog().api("learners", Var(), timeout=_TIMEOUT)
     except PrologError as exc:
         formal = exc.term[1] if isinstance(exc.term, tuple) and exc.term[0] == "error" \
             else exc.term
@@ -79,7 +78,7 @@ def catalogue() -> list[Term]:
                               "prolog/learners.pl)") from None
         raise
     if out is None:
-        raise RelrlError(f"{module}:{name}/1 failed")
+        raise RelrlError("relrl_learners:learner_catalogue/1 failed")
     return list(out[0])
 
 
