@@ -19,6 +19,7 @@ __all__ = [
     "USER_ERRORS",  # noqa: F822 (module __getattr__: imports head and perception lazily)
     "RelrlError",
     "UserError",
+    "PrologMissing",
     "JobFailed",
     "JobCrashed",
     "PrologError",
@@ -121,6 +122,11 @@ class PolicyError(UserError):
 
 class DomainError(UserError):
     """A domain file loaded but does not validate (see ``relrl check``)."""
+
+
+class PrologMissing(UserError):
+    """SWI-Prolog is not installed, or its library does not start (``make setup`` installs
+    it)."""
 
 
 class ConfigError(UserError):

@@ -34,7 +34,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from ctypes import POINTER, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
 
-from relrl.errors import RelrlError
+from relrl.errors import PrologMissing
 
 __all__ = ["Lib", "start", "STACK_LIMIT"]
 
@@ -113,13 +113,13 @@ def _find() -> tuple[str, str]:
         return path, home
     swipl = shutil.which("swipl")
     if swipl is None:
-        raise RelrlError("SWI-Prolog is not installed: swipl is not on the PATH (make setup "
+        raise PrologMissing("SWI-Prolog is not installed: swipl is not on the PATH (make setup "
                          "installs it; or set LIBSWIPL_PATH and SWI_HOME_DIR)")
     out = subprocess.run([swipl, "--dump-runtime-variables"], capture_output=True,
                          text=True, timeout=60).stdout
     found = dict(re.findall(r'^(\w+)="(.*)";$', out, re.M))
     if "PLLIBSWIPL" not in found or "PLBASE" not in found:
-        raise RelrlError(f"{swipl} did not say where libswipl is (a SWI-Prolog without "
+        raise PrologMissing(f"{swipl} did not say where libswipl is (a SWI-Prolog without "
                          "its shared library? set LIBSWIPL_PATH and SWI_HOME_DIR)")
     return found["PLLIBSWIPL"], found["PLBASE"]
 
@@ -133,7 +133,7 @@ def start(boot: Callable[[Lib], None]) -> Lib:
     ``boot`` loads the program into it, as part of the start (its signal handlers too).
 
     Raises:
-        RelrlError: SWI-Prolog is missing or does not start.
+        PrologMissing: SWI-Prolog is missing or does not start.
     """
     global _lib
     with _start_lock:
@@ -146,7 +146,7 @@ def start(boot: Callable[[Lib], None]) -> Lib:
             lib = Lib(cdll, path)
             with _python_signals():
                 if not cdll.PL_initialise(len(argv), (c_char_p * len(argv))(*argv)):
-                    raise RelrlError(f"SWI-Prolog ({path}) did not start")
+                    raise PrologMissing(f"SWI-Prolog ({path}) did not start")
                 boot(lib)
             lib.segv = _sigaction(signal.SIGSEGV)
             _lib = lib

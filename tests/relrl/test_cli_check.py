@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -94,3 +95,17 @@ def test_bad_flag_exit_2(capsys) -> None:
     with pytest.raises(SystemExit) as exc:
         main(["check", "--no-such-flag", str(FRUITS)])
     assert exc.value.code == 2
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["check", "examples/domains/sis.pl"]])
+def test_without_swi_prolog_one_line_exit_2(argv: list[str], tmp_path) -> None:
+    """No swipl on the PATH (and no LIBSWIPL_PATH): one line saying so, exit 2."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("LIBSWIPL_PATH", "SWI_HOME_DIR")}
+    env["PATH"] = str(tmp_path)           # an empty folder: no swipl
+    proc = subprocess.run([sys.executable, "-m", "relrl.cli", *argv], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.strip().splitlines() == [
+        "relrl: SWI-Prolog is not installed: swipl is not on the PATH (make setup installs "
+        "it; or set LIBSWIPL_PATH and SWI_HOME_DIR)"]
