@@ -25,7 +25,7 @@
 The Python gateway (relrl/bridge/calls.py) calls only the predicates of this module, each
 through the guard (guard.pl: once, exceptions as result terms, halt cancelled):
 
-  - gw_run/2 runs a goal of a knowledge base or of python_api/1;
+  - gw_run/2 runs a goal of a knowledge base or of python_api/2;
   - gw_step/14 is the control step (relrl_engine:engine_step/6), its result spread over
     output arguments that Python reads without decoding a term;
   - gw_answer/4 (toplevel.pl) is a user's query, one answer at a time, for relrl shell and
