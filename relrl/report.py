@@ -468,10 +468,11 @@ def _worlds_cost(run: Run) -> str:
                      _f(t.get("learning_steps_per_second"), 0),
                      " / ".join(_f(cost["us_per_step"][str(s)], 0) for s in sizes),
                      _f(cost["cost_ratio"][str(sizes[-1])]),
-                     _f(cost["size_ratio"][str(sizes[-1])])])
+                     _f(cost["size_ratio"][str(sizes[-1])]),
+                     _f(cost.get("slope"))])
     return table(["world", "task", "learner", "seed", "learning steps/s",
-                  "µs per learning step by size", "cost ratio, largest / smallest",
-                  "size ratio"], rows)
+                  "CPU µs per learning step by size", "cost ratio, largest / smallest",
+                  "size ratio", "slope k (cost ∝ size^k)"], rows)
 
 
 _CLAIM_ROWS = {"after_first_run": "all three near 0.8 CGI after the first 500-unit run",

@@ -199,10 +199,13 @@ def _summary(result: dict, t: dict) -> None:
               f"per crossing)")
     cost = t.get("step_cost_by_size")
     if cost:
-        print("learning-step cost by size (us/step, ratio to the smallest; sizes' ratio): "
+        slope = cost.get("slope")
+        print("learning-step cost by size (CPU us/step, ratio to the smallest; sizes' ratio): "
               + ", ".join(f"{s}: {cost['us_per_step'][s]:.0f} ({cost['cost_ratio'][s]:.2f}; "
                           f"{cost['size_ratio'][s]:.2f})" for s in cost["us_per_step"]
-                          if cost["us_per_step"][s] is not None))
+                          if cost["us_per_step"][s] is not None)
+              + (f"; slope {slope:.2f} (cost ∝ size^k, linear: k = 1)" if slope is not None
+                 else ""))
 
 
 def _write(out: Path, config, result: dict) -> list[Path]:

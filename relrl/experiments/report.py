@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["OUTPUTS", "aggregate", "cgi_figure", "plot", "pyplot_or_note", "save_figure",
-           "skip_plots", "summary_table", "tensorboard_runs", "write_csv", "write_json_atomic",
-           "write_outputs"]
+__all__ = ["OUTPUTS", "aggregate", "cgi_figure", "loglog_slope", "plot", "pyplot_or_note",
+           "save_figure", "skip_plots", "summary_table", "tensorboard_runs", "write_csv",
+           "write_json_atomic", "write_outputs"]
 
 #: the files Experiment 1 writes into its folder (checked for links before it runs).
 OUTPUTS = ("results.json", "timing.json", "fig5_cgi.csv", "fig4_eye_contacts.csv",
@@ -42,6 +42,16 @@ def write_csv(path: Path, header: list[str], rows: Any) -> Path:
     w.writerow(header)
     w.writerows(rows)
     return write_atomic(path, buf.getvalue(), spare=False)
+
+
+def loglog_slope(xs: Any, ys: Any) -> float | None:
+    """The exponent k of ``y ∝ x^k`` fitted by least squares on logarithms over all the
+    points (1: linear growth); None with fewer than two points or a value that is not
+    positive."""
+    pts = [(x, y) for x, y in zip(xs, ys, strict=True) if x and y and x > 0 and y > 0]
+    if len({x for x, _ in pts}) < 2:
+        return None
+    return float(np.polyfit(np.log([x for x, _ in pts]), np.log([y for _, y in pts]), 1)[0])
 
 
 def save_figure(fig: Any, path: Path, **kwargs: Any) -> Path:

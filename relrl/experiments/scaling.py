@@ -323,16 +323,14 @@ def _sizes_summary(jobs: list[dict[str, Any]], config: ScalingConfig,
 
 def growth(summary: dict[str, Any]) -> dict[str, Any]:
     """Per learner, the log-log slope of memory against world size (1: linear)."""
-    import numpy as np
+    from relrl.experiments.report import loglog_slope
 
     out = {}
     for learner, rows in summary["learn"].items():
         pts = [(int(s), r["memory_positions"]) for s, r in rows.items()
                if r["memory_positions"]]
         if len(pts) >= 2:
-            x = np.log([p for p, _ in pts])
-            y = np.log([m for _, m in pts])
-            out[learner] = {"memory_slope": float(np.polyfit(x, y, 1)[0]),
+            out[learner] = {"memory_slope": loglog_slope(*zip(*pts, strict=True)),
                             "memory_ratio": pts[-1][1] / pts[0][1],
                             "size_ratio": pts[-1][0] / pts[0][0]}
     return out

@@ -8,7 +8,8 @@ world's stated optimum (optimal_steps/3) is checked against a breadth-first sear
 start states of the small sizes, and the check is written with the results.
 
 Files: ``results.json`` (every number and the configuration; ``"partial": true`` when
-stopped early), ``timing.json`` (wall clock, steps/s, step cost by size), ``summary.csv``
+stopped early), ``timing.json`` (wall clock, steps/s, the CPU cost of a step by size and its log-log
+slope), ``summary.csv``
 (per world, task and learner: the mean over seeds), ``curves.csv``, ``test.csv``,
 ``step_cost.csv``, ``optimal_check.csv``, ``curves.png``, ``transfer.png``,
 ``step_cost.png`` and ``policies/`` (every job's learned policy, readable Prolog that loads
@@ -239,12 +240,13 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                         v["optimality"], v["success"], v["steps"], v["optimal_steps"]]
                        for j in results["jobs"] for s, v in j["test"].items()]))
     files.append(_csv(out / "step_cost.csv",
-                      ["world", "task", "learner", "seed", "size", "us_per_step",
-                       "cost_ratio", "size_ratio", "learning_steps_per_second"],
+                      ["world", "task", "learner", "seed", "size", "cpu_us_per_step",
+                       "cost_ratio", "size_ratio", "slope", "learning_steps_per_second"],
                       [[t["world"], t["task"], t["learner"], t["seed"], int(s),
                         t["step_cost_by_size"]["us_per_step"][s],
                         t["step_cost_by_size"]["cost_ratio"][s],
                         t["step_cost_by_size"]["size_ratio"][s],
+                        t["step_cost_by_size"].get("slope"),
                         t["learning_steps_per_second"]]
                        for t in timing["jobs"] if "step_cost_by_size" in t
                        for s in t["step_cost_by_size"]["us_per_step"]]))
@@ -306,7 +308,7 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
         xs = results["config"]["train_sizes"][:1] + results["config"]["test_sizes"]
         ax.plot(xs, [s / xs[0] for s in xs], color="black", ls="--", label="linear")
     ax.set_xlabel("objects")
-    ax.set_ylabel("learning-step cost / smallest size's")
+    ax.set_ylabel("learning-step CPU cost / smallest size's")
     ax.legend(fontsize=6)
     fig.tight_layout()
     files.append(save_figure(fig, out / "step_cost.png", dpi=120))

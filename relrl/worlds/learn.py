@@ -10,10 +10,10 @@ breadth-first search), so a score is a fraction of optimal: optimal / steps per 
 for an episode that missed the goal within the step bound (RRL's "percentage of optimal").
 
 Speed is measured inside the job: learning steps per second (wall clock of the learning
-batches, each one crossing into Prolog), the cost of a learning step at each size (blocks
-of learning episodes at each size from the same saved policy, sizes alternating, so the
-sizes see the same machine load), and one episode per crossing against a batch per
-crossing (the shape: how much the crossings cost).
+batches, each one crossing into Prolog), the cost of a learning step at each size (CPU
+time of blocks of learning episodes at each size from the same saved policy, sizes
+alternating, the median of five rounds; its growth as a log-log slope), and one episode
+per crossing against a batch per crossing (the shape: how much the crossings cost).
 """
 
 from __future__ import annotations
@@ -174,32 +174,39 @@ def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str,
 
 
 def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int], *,
-                      episodes: int = 20, rounds: int = 3) -> dict[str, Any]:
-    """Wall-clock microseconds per learning step at each size, from the same saved policy.
+                      episodes: int = 20, rounds: int = 5) -> dict[str, Any]:
+    """CPU microseconds per learning step at each size, from the same saved policy.
 
     For each of ``rounds`` rounds, each size in turn: load ``policy`` (not timed), learn
-    ``episodes`` episodes at that size in one crossing (timed). Sizes alternate within a
-    round, so a change of machine load touches every size alike. Returns per size the
-    median over rounds of microseconds per step, and the ratio of each size's cost to the
-    smallest size's beside the ratio of the sizes (linear growth: the two equal).
+    ``episodes`` episodes at that size in one crossing, timed by the CPU time of the
+    process (``time.process_time``: Prolog runs in it, and other work on a shared machine
+    does not count). Sizes alternate within a round, so what changes from round to round
+    touches every size alike. Returns per size the median over rounds of microseconds per
+    step; the ratio of each size's cost to the smallest size's beside the ratio of the
+    sizes (linear growth: the two equal); and ``slope``, the exponent k of cost ∝ size^k
+    fitted on logarithms over all the sizes (linear growth: k = 1).
     """
+    from relrl.experiments.report import loglog_slope
+
     per: dict[int, list[float]] = {s: [] for s in sizes}
     for _ in range(rounds):
         for size in sizes:
             world.load_policy(policy)
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             eps = world.episodes(task, [size], episodes, "learn")
-            dt = time.perf_counter() - t0
+            dt = time.process_time() - t0
             steps = sum(e.steps for e in eps)
             if steps:
                 per[size].append(1e6 * dt / steps)
     world.load_policy(policy)
     med = {s: sorted(v)[len(v) // 2] if v else None for s, v in per.items()}
     base = sizes[0]
-    return {"sizes": list(sizes), "us_per_step": {str(s): med[s] for s in sizes},
+    return {"sizes": list(sizes), "clock": "process CPU time", "rounds": rounds,
+            "us_per_step": {str(s): med[s] for s in sizes},
             "cost_ratio": {str(s): (med[s] / med[base]) if med[s] and med[base] else None
                            for s in sizes},
-            "size_ratio": {str(s): s / base for s in sizes}}
+            "size_ratio": {str(s): s / base for s in sizes},
+            "slope": loglog_slope(sizes, [med[s] for s in sizes])}
 
 
 def _shape(world: World, task: Any, policy: Path, sizes: Sequence[int], *,

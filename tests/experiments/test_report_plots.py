@@ -46,3 +46,15 @@ def test_the_figures_are_written(tmp_path: Path) -> None:
     files = plot(tmp_path, _summary())
     assert [f.name for f in files] == ["fig5_cgi.png", "fig4_eye_contacts.png"]
     assert all(f.stat().st_size > 10_000 for f in files)
+
+
+def test_loglog_slope_is_the_growth_exponent() -> None:
+    """cost ∝ size^k: k from all the points, whatever the constant; None without two sizes
+    or with a value that cannot be logged."""
+    from relrl.experiments.report import loglog_slope
+
+    assert loglog_slope([3, 6, 12], [5.0, 20.0, 80.0]) == pytest.approx(2.0)
+    assert loglog_slope([3, 5, 10], [7.0, 7.0, 7.0]) == pytest.approx(0.0)
+    assert loglog_slope([3, 4, 5], [3.0, 4.0, 5.0]) == pytest.approx(1.0)
+    assert loglog_slope([3], [1.0]) is None
+    assert loglog_slope([3, 6], [1.0, None]) is None

@@ -193,8 +193,9 @@ test(only_stack_sees_highest) :-
     assertion(memberchk(highest(+block), Stack)),
     assertion(\+ memberchk(highest(+block), Unstack)),
     assertion(\+ memberchk(highest(+block), On)),
+    findall(M, relrl_declarations:declared(KB, rmode(M)), Shared),
     subtract(Stack, [highest(+block)], Rest),
-    assertion(Rest == On).
+    assertion(Rest == Shared).                      % stack: the shared modes and highest/1
 
 test(unstack_has_a_bias_of_its_own, [Unstack == [action(move(-block, -block)),
                                                  action(move(-block, floor)),
@@ -202,9 +203,20 @@ test(unstack_has_a_bias_of_its_own, [Unstack == [action(move(-block, -block)),
     % task_own_bias(unstack): its task_rmode/2 modes alone, none of the shared rmode/1
     blocks(KB),
     bias_modes(KB, unstack, Unstack),
+    bias_modes(KB, stack, Stack),
+    assertion(memberchk(on(+block, -block), Stack)).  % the shared modes: stack keeps them
+
+test(on_has_a_bias_of_its_own, [On == [action(move(-block, -block)),
+                                       action(move(-block, floor)),
+                                       goal_on(-block, -block), goal_on(+block, +block),
+                                       goal_on(+block, -block), goal_on(-block, +block),
+                                       covers(+block, -block), clear(+block)]]) :-
+    % task_own_bias(on(_, _)), for every instance of the task: the moved block and its
+    % destination against the goal's blocks, and no on/2 from block to block (nothing that
+    % counts the blocks above A or B)
+    blocks(KB),
     bias_modes(KB, on(b1, b2), On),
-    assertion(memberchk(on(+block, -block), On)),     % the shared modes: other tasks keep them
-    assertion(memberchk(goal_on(+block, -block), On)).
+    assertion(\+ memberchk(on(+block, -block), On)).
 
 test(a_domain_keeps_its_rmodes) :-
     % no task configured (a domain's knowledge base): the bias is rmode/1

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import pytest
@@ -168,6 +169,12 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
         assert (out / name).is_file(), name
     text = render(load_run(out), "summary")
     assert "| blocks | stack | tg | 1 |" in text
+    cost = json.loads((out / "timing.json").read_text())["jobs"][0]["step_cost_by_size"]
+    assert cost["clock"] == "process CPU time" and cost["rounds"] == 5
+    # two sizes (3 and 4): the slope is the log of the cost ratio over the log of the sizes'
+    assert cost["slope"] == pytest.approx(math.log(cost["cost_ratio"]["4"]) / math.log(4 / 3))
+    assert "slope" in (out / "step_cost.csv").read_text().splitlines()[0].split(",")
+    assert "slope k (cost ∝ size^k)" in render(load_run(out), "cost")
 
 
 def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
