@@ -549,10 +549,10 @@ hook_problem(undeclared(Cap, H)) -->
 %   is, as always in a domain without constraint rules), the index of the
 %   learner's choice (-1 for a learner outside Prolog, or when nothing is allowed), and
 %   Extras, a list of Key-Value pairs for Want.
-
 %
 %   The step finds KB's record (kbstate.pl) once and hands it to working memory, the state
-%   code and the necessity units; a learner's hooks are given KB.
+%   code and the necessity units; a learner's hooks are given KB, and find the record once
+%   per call (kb_record/2).
 
 engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     kb_record(KB, Record),
