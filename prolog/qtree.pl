@@ -48,10 +48,10 @@ belongs to, qtree(Tests, Next, Nodes, Memo): Next is the next node id and Nodes 
 nodes(Node0, Node1, ...) whose argument Id+1 holds node Id (`free` beyond the last). Memo
 remembers where the last two states sorted went (see qtree_sort/3). The control step reads
 nodes in place (arg/3, no copy: sorting a state down the tree is a few argument look-ups)
-and replaces a leaf in place
-(nb_setarg/3, which copies only that leaf); a full Nodes is copied into one twice its size.
-What this module gives to callers that may bind variables (qtree_node/3, qtree_tests/2, the
-goals of qtree_path/3) is a copy (copy_term/2 shares ground parts).
+and replaces a leaf in place (nb_setarg/3, which copies only that leaf); a full Nodes is
+copied into one twice its size. What this module gives to callers that may bind variables
+(qtree_node/3, qtree_tests/2, the goals of qtree_path/3) is a copy (copy_term/2 shares
+ground parts).
 
 qtree_new/2, qtree_restore/3 and qtree_clear/1 make, replace and forget the tree of a
 knowledge base; qtree/2 gives its tree term, which every other predicate of this module
