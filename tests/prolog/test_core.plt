@@ -201,6 +201,46 @@ test(roulette_draws_the_execution_probabilities, [true(Worst < 0.01)]) :-
 :- end_tests(contingency).
 
 % ---------------------------------------------------------------------------------------
+:- begin_tests(kbstate).
+
+%   A knowledge base's record: made at first use, a part read and replaced through the
+%   record or through the knowledge base's name alike, a value stored as a copy, every
+%   read deterministic, and forgotten whole.
+test(record_parts, [true(Got =@= [t(1), t(1), f(_), none])]) :-
+    relrl_kbstate:kb_forget(krec1),
+    relrl_kbstate:kb_record(krec1, R),
+    relrl_kbstate:record_set(R, task, t(1)),
+    relrl_kbstate:kb_get(krec1, task, A),
+    relrl_kbstate:record_get(R, task, B),
+    relrl_kbstate:kb_set(krec1, learner, f(X)),
+    X = 1,                                              % the stored copy is not bound
+    relrl_kbstate:kb_record(krec1, R2),
+    relrl_kbstate:record_get(R2, learner, C),
+    relrl_kbstate:kb_forget(krec1),
+    relrl_kbstate:kb_get(krec1, task, D),               % a fresh record
+    relrl_kbstate:kb_forget(krec1),
+    Got = [A, B, C, D].
+
+test(parts_read_deterministically) :-
+    relrl_kbstate:kb_record(krec2, R),
+    forall(member(P, [engine, memory, units, learner, tree, task, kept]),
+           (   call_cleanup(relrl_kbstate:record_get(R, P, V), Det1 = true),
+               call_cleanup(relrl_kbstate:record_set(R, P, V), Det2 = true),
+               assertion(Det1-Det2 == true-true)
+           )),
+    relrl_kbstate:kb_forget(krec2).
+
+test(unknown_part, [error(domain_error(kb_part, nope)),
+                    cleanup(relrl_kbstate:kb_forget(krec3))]) :-
+    relrl_kbstate:kb_get(krec3, nope, _).
+
+test(forgotten, [fail]) :-
+    relrl_kbstate:kb_record(krec4, _),
+    relrl_kbstate:kb_forget(krec4),
+    relrl_kbstate:kb_record_exists(krec4).
+
+:- end_tests(kbstate).
+
 :- begin_tests(qtree).
 
 test(new_tree_one_empty_leaf, [Nodes == [0-leaf(none, [])]]) :-
