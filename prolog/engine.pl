@@ -144,7 +144,12 @@ gateway can name the rule.
 %   of this module sees the pair (eng/2 gives the stream as it is now).
 
 engine(KB, Engine) :-
-    kb_get(KB, engine, Engine0),
+    kb_record(KB, Record),
+    record_engine(KB, Record, Engine).
+
+%   The engine in KB's Record.
+record_engine(KB, Record, Engine) :-
+    record_get(Record, engine, Engine0),
     (   Engine0 \== none
     ->  Engine = Engine0
     ;   existence_error(engine_configuration, KB)
@@ -548,26 +553,31 @@ hook_problem(undeclared(Cap, H)) -->
 %   is, as always in a domain without constraint rules), the index of the
 %   learner's choice (-1 for a learner outside Prolog, or when nothing is allowed), and
 %   Extras, a list of Key-Value pairs for Want.
+%
+%   The step finds KB's record (kbstate.pl) once and hands it to working memory, the state
+%   code and the necessity units; a learner's hooks are given KB, and find the record once
+%   per call (kb_record/2).
 
 engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
-    engine(KB, Engine),
+    kb_record(KB, Record),
+    record_engine(KB, Record, Engine),
     Engine = engine(Run, Prev, _),
     claim_random(KB, Engine),
-    step(KB, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
+    step(KB, Record, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
     nb_setarg(2, Engine, Next).
 
-step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan, Caps),
+step(KB, Record, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan, Caps),
      Prev, Percepts, EmittedIx, Mode, Want,
      step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
      prev(State, Active)) :-
     (   EmittedIx >= 0
     ->  nth0(EmittedIx, Responses, Emitted),
-        wm_insert(KB, [emitted(Emitted)|Percepts])
-    ;   wm_insert(KB, Percepts)
+        wm_insert(KB, Record, [emitted(Emitted)|Percepts])
+    ;   wm_insert(KB, Record, Percepts)
     ),
-    view_code(KB, Plan, Code, Reinforced),
+    view_code(KB, Record, Plan, Code, Reinforced),
     learner_view(Learner, Caps, KB, Code, State),
-    motivation_values(KB, Units, _, Ys, Active),
+    motivation_values(KB, Record, Units, _, Ys, Active),
     (   Reinforced == true
     ->  memberchk(reward_positive=Reward, Params)
     ;   memberchk(reward_negative=Reward, Params)
@@ -596,11 +606,11 @@ step(KB, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan, Caps
 
 %   The state code and whether a reinforcer is sensed; for a learner that reads the
 %   relational view only, no code (0): the engine does not compute what no one reads.
-view_code(KB, Plan, Code, Reinforced) :-
+view_code(KB, Record, Plan, Code, Reinforced) :-
     (   Plan = relational(Plan0)
     ->  Code = 0,
-        plan_reinforced(KB, Plan0, Reinforced)
-    ;   plan_code(KB, Plan, Code, Reinforced)
+        plan_reinforced(Record, Plan0, Reinforced)
+    ;   plan_code(KB, Record, Plan, Code, Reinforced)
     ).
 
 %   The learner's view of the state: its learner_state/4 if it declares `state`, else
@@ -683,7 +693,8 @@ engine_explain(KB, When, Explanation) :-
     (   When == last,
         engine(KB, engine(_, prev(State, N), _))
     ->  true
-    ;   view_code(KB, Plan, Code, _),
+    ;   kb_record(KB, Record),
+        view_code(KB, Record, Plan, Code, _),
         learner_view(Learner, Caps, KB, Code, State),
         motivation_peek(KB, Units, _, N)
     ),

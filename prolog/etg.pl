@@ -64,10 +64,12 @@ etg_choose(KB, D, N, Allowed, Params, Action, Q) :-
     Allowed \== [],
     param(Params, q_init, Q0),
     param(Params, epsilon, Epsilon),
-    choose(KB, D, N, Allowed, Q0, Epsilon, Action, Q).
+    qtree(KB, Tree),
+    choose(Tree, D, N, Allowed, Q0, Epsilon, Action, Q).
 
-choose(KB, D, N, Allowed, Q0, Epsilon, Action, Q) :-
-    leaf_entries(KB, D, Entries),
+%   The predicates below take KB's tree (qtree/2), found once by the caller.
+choose(Tree, D, N, Allowed, Q0, Epsilon, Action, Q) :-
+    leaf_entries(Tree, D, Entries),
     Allowed = [A1|As],
     entry_q(Entries, A1, N, Q0, Q1),
     scores(As, Entries, N, Q0, Scored1, Q1, Best),
@@ -113,10 +115,10 @@ entry_q([e(A1, Q1, N1)|Es], A, N, Q0, Q) :-
 
 %   The entries of the state's own leaf; none when it reaches an empty branch (a state
 %   the tree has not met: every response then has Q = q_init).
-leaf_entries(KB, D, Entries) :-
-    qtree_sort(KB, D, Where),
+leaf_entries(Tree, D, Entries) :-
+    qtree_sort(Tree, D, Where),
     (   Where = leaf(Id)
-    ->  qtree_leaf(KB, Id, _, Entries)
+    ->  qtree_leaf(Tree, Id, _, Entries)
     ;   Entries = []
     ).
 
@@ -131,13 +133,14 @@ etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params) :-
     param(Params, gamma, Gamma),
     param(Params, q_init, Qinit),
     param(Params, split_threshold, Threshold),
-    update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold).
+    qtree(KB, Tree),
+    update(Tree, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold).
 
-update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold) :-
-    leaf_entries(KB, D1, Next),
+update(Tree, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold) :-
+    leaf_entries(Tree, D1, Next),
     max_q(Next, N1, Allowed1, Qinit, MaxNext),
     Target is R + Gamma * MaxNext,
-    insert_example(KB, D0, A0, N0, Target, Alpha, Qinit, Threshold).
+    insert_example(Tree, D0, A0, N0, Target, Alpha, Qinit, Threshold).
 
 max_q(Entries, N, Allowed, Qinit, Max) :-
     max_allowed(Entries, N, Allowed, none, Max1),
@@ -181,25 +184,25 @@ count_allowed([e(A, _, N1)|Es], N, Allowed, K0, K) :-
 allowed_or_any([], _) :- !.
 allowed_or_any(Allowed, A) :- memberchk(A, Allowed).
 
-insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
-    qtree_sort(KB, D, Where),
+insert_example(Tree, D, A, N, Target, Alpha, Qinit, Threshold) :-
+    qtree_sort(Tree, D, Where),
     (   Where = null(Parent, Branch)
     ->  Q is Qinit + Alpha * (Target - Qinit),
-        qtree_grow(KB, Parent, Branch, D, [e(A, Q, N)], _)
+        qtree_grow(Tree, Parent, Branch, D, [e(A, Q, N)], _)
     ;   Where = leaf(Id),
-        qtree_leaf(KB, Id, Rep0, Entries0),
+        qtree_leaf(Tree, Id, Rep0, Entries0),
         entry_q(Entries0, A, N, Qinit, Old),
         Error is Target - Old,
         (   Rep0 \== none,
             Rep0 =\= D,
             abs(Error) > Threshold,
             first_difference(Rep0, D, I)
-        ->  qtree_split(KB, Id, I),
-            insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold)
+        ->  qtree_split(Tree, Id, I),
+            insert_example(Tree, D, A, N, Target, Alpha, Qinit, Threshold)
         ;   ( Rep0 == none -> Rep = D ; Rep = Rep0 ),
             Q is Old + Alpha * Error,
             qtree_put_entry(Entries0, e(A, Q, N), Entries),
-            qtree_set_leaf(KB, Id, Rep, Entries)
+            qtree_set_leaf(Tree, Id, Rep, Entries)
         )
     ).
 
@@ -209,8 +212,9 @@ insert_example(KB, D, A, N, Target, Alpha, Qinit, Threshold) :-
 %   their outcomes, and the leaf's entries for necessity N in decreasing Q.
 
 etg_explain(KB, D, N, explain(Path, Ranked)) :-
-    qtree_path(KB, D, Path),
-    leaf_entries(KB, D, Entries),
+    qtree(KB, Tree),
+    qtree_path(Tree, D, Path),
+    leaf_entries(Tree, D, Entries),
     include(entry_for(N), Entries, Ranked).
 
 entry_for(N, e(_, _, N1)) :-
@@ -222,7 +226,8 @@ entry_for(N, e(_, _, N1)) :-
 %   paper's memory measure.
 
 etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
-    qtree_size(KB, Nodes, Leaves, Entries),
+    qtree(KB, Tree),
+    qtree_size(Tree, Nodes, Leaves, Entries),
     Positions is Nodes + Entries.
 
 %   ---- The engine's hooks (see engine.pl) ------------------------------------------------
@@ -232,13 +237,20 @@ etg_size(KB, size(Nodes, Leaves, Entries, Positions)) :-
 %   extra test above the features' bits.
 
 %   What the hooks read every step, the `learner` part of KB's record (kbstate.pl; the tree
-%   is its `tree` part): etg(NF, Extra, Numbers) — NF features, the extra tests Extra as a program of
-%   relrl_rules (their bits above the features'; `none` without extra tests), and Numbers =
-%   numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or `params` when
-%   one is missing: the hooks then read the list, and fail as etg_choose/7 does).
+%   is its `tree` part): etg(NF, Extra, Numbers) — NF features, the extra tests Extra as a
+%   program of relrl_rules (their bits above the features'; `none` without extra tests),
+%   and Numbers = numbers(Alpha, Gamma, Epsilon, Qinit, Threshold) from the parameters (or
+%   `params` when one is missing: the hooks then read the list, and fail as etg_choose/7
+%   does). A hook finds the record once for both.
 
 config(KB, Config) :-
-    kb_get(KB, learner, Config).
+    kb_record(KB, Record),
+    record_get(Record, learner, Config).
+
+config(KB, Config, Tree) :-
+    kb_record(KB, Record),
+    record_get(Record, learner, Config),
+    record_get(Record, tree, Tree).
 
 relrl_engine:learner(etg).
 relrl_engine:learner_property(etg, Cap) :-
@@ -288,14 +300,14 @@ relrl_engine:learner_state(etg, KB, Code, D) :-
     ).
 
 relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
-    config(KB, etg(_, _, Numbers)),
+    config(KB, etg(_, _, Numbers), Tree),
     (   Numbers = numbers(_, _, Epsilon0, Qinit, _)
     ->  Allowed \== [],
         (   Mode == greedy
         ->  Epsilon = 0
         ;   Epsilon = Epsilon0
         ),
-        choose(KB, D, N, Allowed, Qinit, Epsilon, Action, _)
+        choose(Tree, D, N, Allowed, Qinit, Epsilon, Action, _)
     ;   engine_params(KB, Params0),
         (   Mode == greedy
         ->  Params = [epsilon=0|Params0]
@@ -305,9 +317,9 @@ relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
     ).
 
 relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, R, _, D1, N1, Allowed1)) :-
-    config(KB, etg(_, _, Numbers)),
+    config(KB, etg(_, _, Numbers), Tree),
     (   Numbers = numbers(Alpha, Gamma, _, Qinit, Threshold)
-    ->  update(KB, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold)
+    ->  update(Tree, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold)
     ;   engine_params(KB, Params),
         etg_update(KB, D0, A0, N0, R, D1, N1, Allowed1, Params)
     ).
@@ -320,16 +332,19 @@ relrl_engine:learner_size(etg, KB, size(Positions, [nodes=Nodes, leaves=Leaves,
     etg_size(KB, size(Nodes, Leaves, Entries, Positions)).
 
 relrl_engine:learner_text(etg, KB, Text) :-
-    qtree_format(KB, Text).
+    qtree(KB, Tree),
+    qtree_format(Tree, Text).
 
 relrl_engine:learner_graph(etg, KB, Graph) :-
-    qtree_graph(KB, Graph).
+    qtree(KB, Tree),
+    qtree_graph(Tree, Graph).
 
 relrl_engine:learner_save(etg, KB, S) :-
-    qtree_tests(KB, Tests),
+    qtree(KB, Tree),
+    qtree_tests(Tree, Tests),
     portray_clause(S, etg_tests(Tests)),
     nl(S),
-    forall(qtree_node(KB, Id, Node), portray_clause(S, etg_node(Id, Node))).
+    forall(qtree_node(Tree, Id, Node), portray_clause(S, etg_node(Id, Node))).
 
 relrl_engine:learner_policy_term(etg, etg_tests(_)).
 relrl_engine:learner_policy_term(etg, etg_node(_, _)).
@@ -340,7 +355,8 @@ relrl_engine:learner_policy_term(etg, etg_node(_, _)).
 %   sorts to it; each entry a response and a necessity (or none) of the domain with a
 %   finite Q. A leaf's entries are put in decreasing Q, as the learner keeps them.
 relrl_engine:learner_restore(etg, KB, Terms) :-
-    qtree_tests(KB, Mine),
+    qtree(KB, Tree),
+    qtree_tests(Tree, Mine),
     include(is_tests, Terms, TestTerms),          % the terms read, not copies
     (   TestTerms = [TestTerm]
     ->  true

@@ -1,5 +1,8 @@
 :- module(relrl_kbstate,
-          [ kb_get/3,             % +KB, +Part, -Value
+          [ kb_record/2,          % +KB, -Record
+            record_get/3,         % +Record, +Part, -Value
+            record_set/3,         % +Record, +Part, +Value
+            kb_get/3,             % +KB, +Part, -Value
             kb_set/3,             % +KB, +Part, +Value
             kb_forget/1,          % +KB
             kb_record_exists/1    % ?KB
@@ -15,10 +18,17 @@ tree, the task a world learns, and the snapshots kept by engine_keep/2. kb_forge
 deletes the record whole; what a learner keeps as clauses of its own module it removes in
 its learner_forget/2 hook (engine.pl), so dropping a knowledge base leaves nothing of it.
 
-A part is read with kb_get/3 and replaced with kb_set/3, which copies the value into the
-record (nb_setarg/3): nothing stored depends on a binding that backtracking could undo. A
-part may also be a live term its owner changes in place with nb_setarg/3 (the engine's
-last step, a tree's nodes): kb_get/3 gives the stored term itself, not a copy.
+kb_record/2 finds the record of a knowledge base; record_get/3 reads a part of it and
+record_set/3 replaces one with a copy of the value (nb_setarg/3): nothing stored depends on
+a binding that backtracking could undo. A part may also be a live term its owner changes in
+place with nb_setarg/3 (the engine's last step, a tree's nodes): record_get/3 gives the
+stored term itself, not a copy. kb_get/3 and kb_set/3 do both in one call.
+
+The control step finds the record once (engine_step/6) and hands it to what it runs
+(working memory, the necessity units, the state code); a learner's hook finds it once per
+call. A look-up costs a clause look-up and nb_getval/2; a part is one head unification
+(record_get/3 has a clause for each part, as library(record)'s accessors do), so reading
+a part the step already has the record for costs one inference.
 
 The record is made at the first use of a knowledge base (a plain-swipl user may step
 `user`); its global variable's name is made once and found afterwards by one clause look-up
@@ -27,14 +37,14 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 
 :- dynamic key_/2.                  % KB, the name of its record's global variable
 
-%   The parts of a record, by position.
-part(engine, 1).                    % engine(Run, Prev, Random) or none (engine.pl)
-part(memory, 2).                    % wm(Clock, Span, Pairs, Elements, Now) (memory.pl)
-part(units, 3).                     % Necessity-Y pairs (motivation.pl)
-part(learner, 4).                   % the learner's own term, or none
-part(tree, 5).                      % a tree (qtree.pl, tg_tree.pl), or none
-part(task, 6).                      % the task a world learns next (world.pl), or none
-part(kept, 7).                      % Slot-Snapshot pairs (engine_keep/2)
+%   The record, kb(Engine, Memory, Units, Learner, Tree, Task, Kept):
+%     engine    engine(Run, Prev, Random) or none (engine.pl)
+%     memory    wm(Clock, Span, Pairs, Elements, Now) (memory.pl)
+%     units     Necessity-Y pairs (motivation.pl)
+%     learner   the learner's own term, or none
+%     tree      a tree (qtree.pl, tg_tree.pl), or none
+%     task      the task a world learns next (world.pl), or none
+%     kept      Slot-Snapshot pairs (engine_keep/2)
 
 empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [])).
 
@@ -46,35 +56,63 @@ new_record(KB, Record) :-
     assertz(key_(KB, Key)),
     nb_getval(Key, Record).
 
-%!  kb_get(+KB, +Part, -Value) is det.
+%!  kb_record(+KB, -Record) is det.
 %
-%   Value is the Part of KB's record (the stored term itself). A part never set has its
-%   empty value: `none`, an empty memory, [] for the units and the kept snapshots.
-%
-%   (kb_get/3 and kb_set/3 look the record up themselves: they run some twenty times an
-%   ETG step, and a predicate of its own for the look-up cost 20 of its ~450 inferences.)
+%   Record is KB's record (the stored term itself), made empty at KB's first use.
 
-kb_get(KB, Part, Value) :-
+kb_record(KB, Record) :-
     (   key_(KB, Key)
     ->  nb_getval(Key, Record)
     ;   new_record(KB, Record)
-    ),
-    (   part(Part, I)
-    ->  arg(I, Record, Value)
+    ).
+
+%!  record_get(+Record, +Part, -Value) is semidet.
+%
+%   Value is the Part of Record (the stored term itself). A part never set has its empty
+%   value: `none`, an empty memory, [] for the units and the kept snapshots. Fails when
+%   Part is not a part (kb_get/3 tells the error).
+
+record_get(kb(V, _, _, _, _, _, _), engine, V).
+record_get(kb(_, V, _, _, _, _, _), memory, V).
+record_get(kb(_, _, V, _, _, _, _), units, V).
+record_get(kb(_, _, _, V, _, _, _), learner, V).
+record_get(kb(_, _, _, _, V, _, _), tree, V).
+record_get(kb(_, _, _, _, _, V, _), task, V).
+record_get(kb(_, _, _, _, _, _, V), kept, V).
+
+%!  record_set(+Record, +Part, +Value) is semidet.
+%
+%   Part of Record becomes a copy of Value. Fails when Part is not a part.
+
+record_set(Record, Part, Value) :-
+    set_part(Part, Record, Value).
+
+set_part(engine, R, V) :- nb_setarg(1, R, V).  % Part first: indexed (the record is not)
+set_part(memory, R, V) :- nb_setarg(2, R, V).
+set_part(units, R, V) :- nb_setarg(3, R, V).
+set_part(learner, R, V) :- nb_setarg(4, R, V).
+set_part(tree, R, V) :- nb_setarg(5, R, V).
+set_part(task, R, V) :- nb_setarg(6, R, V).
+set_part(kept, R, V) :- nb_setarg(7, R, V).
+
+%!  kb_get(+KB, +Part, -Value) is det.
+%!  kb_set(+KB, +Part, +Value) is det.
+%
+%   record_get/3 and record_set/3 on KB's record.
+%
+%   @error domain_error(kb_part, Part) if Part is not a part.
+
+kb_get(KB, Part, Value) :-
+    kb_record(KB, Record),
+    (   record_get(Record, Part, Value0)
+    ->  Value = Value0
     ;   domain_error(kb_part, Part)
     ).
 
-%!  kb_set(+KB, +Part, +Value) is det.
-%
-%   Part of KB's record becomes a copy of Value.
-
 kb_set(KB, Part, Value) :-
-    (   key_(KB, Key)
-    ->  nb_getval(Key, Record)
-    ;   new_record(KB, Record)
-    ),
-    (   part(Part, I)
-    ->  nb_setarg(I, Record, Value)
+    kb_record(KB, Record),
+    (   record_set(Record, Part, Value)
+    ->  true
     ;   domain_error(kb_part, Part)
     ).
 

@@ -1,11 +1,12 @@
 :- module(relrl_memory,
           [ wm_insert/2,          % +KB, +Elements
+            wm_insert/3,          % +KB, +Record, +Elements
             wm_element/3,         % ?KB, ?Element, ?Age
             wm_has/2,             % +KB, ?Element
             wm_has_chk/2,         % +KB, ?Element
             wm_now/2,             % +KB, ?Element
             wm_has_stimulus/2,    % +KB, +Stimulus
-            wm_stamped/3,         % +KB, -Clock, -Pairs
+            wm_stamped/3,         % +Record, -Clock, -Pairs
             wm_elements/2,        % +KB, -Pairs
             wm_clear/1,           % +KB
             wm_span/2,            % +KB, -Span
@@ -47,7 +48,7 @@ argument of every predicate names it. This module is the only one that stores pe
 %   many times a step, and memberchk/2 over plain terms takes half the time of a look-up
 %   over pairs. A term in the record instead of asserted clauses keeps the robot's control
 %   step free of assert/retract churn. Readers take the term and then unify it with the
-%   wm/5 they want (State = wm(...)): a wm/5 pattern given to kb_get/3 would first be built
+%   wm/5 they want (State = wm(...)): a wm/5 pattern given to record_get/3 would first be built
 %   on the global stack, every read.
 
 %!  wm_span(+KB, -Span) is det.
@@ -57,7 +58,8 @@ argument of every predicate names it. This module is the only one that stores pe
 %   its own with a memory_span/1 declaration; wm_set_span/2 overrides it.
 
 wm_span(KB, Span) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, Span0, _, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -81,26 +83,34 @@ domain_span(KB, Span) :-
 wm_set_span(KB, Span) :-
     must_be(atom, KB),
     must_be(nonneg, Span),
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(Clock, _, Pairs, Elements, Now),
-    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
+    record_set(Record, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
 %!  wm_clock(+KB, -Clock) is det.
 %
 %   Clock is the number of insertions into KB's memory so far.
 
 wm_clock(KB, Clock) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(Clock, _, _, _, _).
 
 %!  wm_insert(+KB, +Elements:list) is det.
+%!  wm_insert(+KB, +Record, +Elements:list) is det.
 %
 %   One insertion: every element of Elements enters KB's memory with age 0, every other
-%   element ages by one, and elements older than the span expire.
+%   element ages by one, and elements older than the span expire. Record is KB's record
+%   (relrl_kbstate:kb_record/2), for a caller that has it (the control step).
 %
 %   @error instantiation_error if an element is not ground.
 
 wm_insert(KB, New) :-
+    kb_record(KB, Record),
+    wm_insert(KB, Record, New).
+
+wm_insert(KB, Record, New) :-
     (   atom(KB), is_list(New), ground(New)
     ->  true
     ;   must_be(atom, KB),
@@ -109,7 +119,7 @@ wm_insert(KB, New) :-
     ->  instantiation_error(E)
     ;   true
     ),
-    kb_get(KB, memory, State),
+    record_get(Record, memory, State),
     State = wm(Clock0, Span0, Old, _, _),
     (   Span0 == default
     ->  domain_span(KB, Span)
@@ -119,9 +129,9 @@ wm_insert(KB, New) :-
     Oldest is Clock - Span,
     stamp(New, Clock, Pairs, KeptPairs, Now, Elements, KeptElements),
     keep_old(Old, New, Oldest, KeptPairs, KeptElements),
-    kb_set(KB, memory, wm(Clock, Span, Pairs, Elements, Now)).
+    record_set(Record, memory, wm(Clock, Span, Pairs, Elements, Now)).
 
-%   The new memory is copied into the record (kb_set/3), never linked (nb_linkval/2 or
+%   The new memory is copied into the record (record_set/3), never linked (nb_linkval/2 or
 %   nb_linkarg/3): a linked term is only as safe as every binding that built it, and a
 %   signal handler that stores a term on the global stack in the middle of an insertion
 %   (an alarm re-arming itself did) freezes the stack, so that the list cells bound after
@@ -155,7 +165,8 @@ keep_old([P|Ps], New, Oldest, Pairs, Elements) :-
 %   Element is in KB's memory with age Age (0 for the latest insertion).
 
 wm_element(KB, Element, Age) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(Clock, _, Pairs, _, _),
     member(Element-Stamp, Pairs),
     Age is Clock - Stamp.
@@ -166,7 +177,8 @@ wm_element(KB, Element, Age) :-
 %   perception predicates the engine runs many times a step.
 
 wm_has(KB, Element) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, _, _, Elements, _),
     element_in(Element, Elements).
 
@@ -175,7 +187,8 @@ wm_has(KB, Element) :-
 %   once(wm_has(KB, Element)).
 
 wm_has_chk(KB, Element) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, _, _, Elements, _),
     memberchk(Element, Elements).
 
@@ -184,7 +197,8 @@ wm_has_chk(KB, Element) :-
 %   Element entered (or was renewed in) KB's memory at the latest insertion: age 0.
 
 wm_now(KB, Element) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, _, _, _, Now),
     element_in(Element, Now).
 
@@ -201,7 +215,8 @@ element_in(Element, Elements) :-
 %   (at(S, Place)) in KB's memory.
 
 wm_has_stimulus(KB, S) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, _, _, Elements, _),
     member(E, Elements),
     compound(E),
@@ -218,14 +233,15 @@ sense_name(hear).
 sense_name(smell).
 sense_name(at).
 
-%!  wm_stamped(+KB, -Clock, -Pairs:list) is det.
+%!  wm_stamped(+Record, -Clock, -Pairs:list) is det.
 %
 %   Clock is the number of insertions so far and Pairs the memory as Element-Stamp pairs,
-%   newest first (an element's age is Clock - Stamp): the whole memory in one read, for a
-%   pass over it (the state code's).
+%   newest first (an element's age is Clock - Stamp), of the knowledge base whose record
+%   (relrl_kbstate:kb_record/2) is Record: the whole memory in one read, for the control
+%   step's pass over it (the state code's).
 
-wm_stamped(KB, Clock, Pairs) :-
-    kb_get(KB, memory, State),
+wm_stamped(Record, Clock, Pairs) :-
+    record_get(Record, memory, State),
     State = wm(Clock, _, Pairs, _, _).
 
 %!  wm_elements(+KB, -Pairs:list) is det.
@@ -246,16 +262,18 @@ pair_age(Age-_, Age).
 
 wm_clear(KB) :-
     must_be(atom, KB),
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, Span, _, _, _),
-    kb_set(KB, memory, wm(0, Span, [], [], [])).
+    record_set(Record, memory, wm(0, Span, [], [], [])).
 
 %!  wm_size(+KB, -Size:nonneg) is det.
 %
 %   Size is the number of elements in KB's memory.
 
 wm_size(KB, Size) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(_, _, Pairs, _, _),
     length(Pairs, Size).
 
@@ -269,7 +287,8 @@ wm_size(KB, Size) :-
 %   @error domain_error(working_memory_state, State) if State is not such a term.
 
 wm_state(KB, wm(Clock, Span, Pairs)) :-
-    kb_get(KB, memory, State),
+    kb_record(KB, Record),
+    record_get(Record, memory, State),
     State = wm(Clock, Span, Pairs, _, _).
 
 wm_set_state(KB, State) :-

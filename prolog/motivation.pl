@@ -4,7 +4,7 @@
             motivation_units/2,     % +KB, -Units
             motivation_step/4,      % +KB, +Units, -Outputs, -Active
             motivation_peek/4,      % +KB, +Units, -Outputs, -Active
-            motivation_values/5,    % +KB, +Units, -Outputs, -Ys, -Active
+            motivation_values/6,    % +KB, +Record, +Units, -Outputs, -Ys, -Active
             motivation_compiled/3,  % +KB, +Units0, -Units
             motivation_outputs/2,   % +KB, -Outputs
             motivation_set_outputs/2, % +KB, +Outputs
@@ -41,12 +41,7 @@ paper's weights are declared as satisfiers with their printed magnitudes.
 
 %   The units' outputs of KB are the `units` part of its record (kbstate.pl), a list of
 %   Necessity-Y pairs in declaration order (no assert/retract in the robot's control step).
-
-get_outputs(KB, Outputs) :-
-    kb_get(KB, units, Outputs).
-
-put_outputs(KB, Outputs) :-
-    kb_set(KB, units, Outputs).
+%   The predicates below that are not given the record find it with kb_record/2.
 
 %!  unit_output(+U, +Delta, -Y) is det.
 %
@@ -75,14 +70,14 @@ motivation_reset(KB) :-
     findall(N-Y0, ( kb_necessity(KB, N),
                     unit_parameters(KB, N, Params),
                     memberchk(initial=Y0, Params) ), Outputs),
-    put_outputs(KB, Outputs).
+    kb_set(KB, units, Outputs).
 
 %!  motivation_outputs(+KB, -Outputs:list) is det.
 %
 %   Outputs is the list of Necessity-Y pairs of the last step.
 
 motivation_outputs(KB, Outputs) :-
-    get_outputs(KB, Outputs).
+    kb_get(KB, units, Outputs).
 
 %!  motivation_set_outputs(+KB, +Outputs:list) is det.
 %
@@ -90,7 +85,7 @@ motivation_outputs(KB, Outputs) :-
 
 motivation_set_outputs(KB, Outputs) :-
     must_be(list, Outputs),
-    put_outputs(KB, Outputs).
+    kb_set(KB, units, Outputs).
 
 %!  motivation_step(+KB, -Outputs:list, -Active) is det.
 %
@@ -145,17 +140,18 @@ input_bits([Goal-W|Is], Bit, [Goal-Bit|Gs], [W|Ws]) :-
 %   As motivation_step/3 with the units from motivation_units/2.
 
 motivation_step(KB, Units, Outputs, Active) :-
-    motivation_values(KB, Units, Outputs, _, Active).
+    kb_record(KB, Record),
+    motivation_values(KB, Record, Units, Outputs, _, Active).
 
-%!  motivation_values(+KB, +Units, -Outputs:list, -Ys:list, -Active) is det.
+%!  motivation_values(+KB, +Record, +Units, -Outputs:list, -Ys:list, -Active) is det.
 %
 %   motivation_step/4 that also gives the outputs alone, Ys (in declaration order): the
-%   control step's one pass over the units.
+%   control step's one pass over the units. Record is KB's record (kb_record/2).
 
-motivation_values(KB, Units, Outputs, Ys, Active) :-
-    get_outputs(KB, Previous),
+motivation_values(KB, Record, Units, Outputs, Ys, Active) :-
+    record_get(Record, units, Previous),
     unit_values(Units, KB, Previous, Outputs, Ys),
-    put_outputs(KB, Outputs),
+    record_set(Record, units, Outputs),
     mediate(Units, Outputs, Active).
 
 %!  motivation_peek(+KB, +Units, -Outputs, -Active) is det.
@@ -163,7 +159,7 @@ motivation_values(KB, Units, Outputs, Ys, Active) :-
 %   What motivation_step/4 would give now, without moving the units' state.
 
 motivation_peek(KB, Units, Outputs, Active) :-
-    get_outputs(KB, Previous),
+    kb_get(KB, units, Previous),
     unit_values(Units, KB, Previous, Outputs, _),
     mediate(Units, Outputs, Active).
 

@@ -1,5 +1,8 @@
 :- module(relrl_qtree,
-          [ qtree_new/2,          % +Tree, +Tests
+          [ qtree_new/2,          % +KB, +Tests
+            qtree_restore/3,      % +KB, +Tests, +Nodes
+            qtree_clear/1,        % +KB
+            qtree/2,              % +KB, -Tree
             qtree_tests/2,        % +Tree, -Tests
             qtree_sort/3,         % +Tree, +Description, -Where
             qtree_leaf/4,         % +Tree, ?Id, -Rep, -Entries
@@ -9,10 +12,8 @@
             qtree_path/3,         % +Tree, +Description, -Path
             qtree_size/4,         % +Tree, -Nodes, -Leaves, -Entries
             qtree_node/3,         % +Tree, ?Id, ?Node
-            qtree_clear/1,        % +Tree
             qtree_format/2,       % +Tree, -Text
             qtree_graph/2,        % +Tree, -Graph
-            qtree_restore/3,      % +Tree, +Tests, +Nodes
             qtree_put_entry/3,    % +Entries0, +Entry, -Entries
             qtree_entry_q/5,      % +Entries, +Action, +Necessity, +Default, -Q
             test_holds/2,         % +Description, +TestIndex
@@ -42,26 +43,40 @@ on (to update the previous step's example).
 A node is test(Index, Goal, Yes, No) or leaf(Rep, Entries); Rep is `none` until the first
 example arrives. Id 0 is the root.
 
-A tree is one term, the `tree` part of the record (kbstate.pl) of the knowledge base the
-tree is named after, qtree(Tests, Next, Nodes, Memo): Next is the next node id and Nodes a compound nodes(Node0, Node1, ...) whose argument
-Id+1 holds node Id (`free` beyond the last). Memo remembers where the last two states sorted
-went (see qtree_sort/3). The control step reads nodes in place (arg/3, no
-copy: sorting a state down the tree is a few argument look-ups) and replaces a leaf in place
-(nb_setarg/3, which copies only that leaf); a full Nodes is copied into one twice its size.
-What this module gives to callers that may bind variables (qtree_node/3, qtree_tests/2, the
-goals of qtree_path/3) is a copy (copy_term/2 shares ground parts).
+A tree is one term, the `tree` part of the record (kbstate.pl) of the knowledge base it
+belongs to, qtree(Tests, Next, Nodes, Memo): Next is the next node id and Nodes a compound
+nodes(Node0, Node1, ...) whose argument Id+1 holds node Id (`free` beyond the last). Memo
+remembers where the last two states sorted went (see qtree_sort/3). The control step reads
+nodes in place (arg/3, no copy: sorting a state down the tree is a few argument look-ups)
+and replaces a leaf in place (nb_setarg/3, which copies only that leaf); a full Nodes is
+copied into one twice its size. What this module gives to callers that may bind variables
+(qtree_node/3, qtree_tests/2, the goals of qtree_path/3) is a copy (copy_term/2 shares
+ground parts).
+
+qtree_new/2, qtree_restore/3 and qtree_clear/1 make, replace and forget the tree of a
+knowledge base; qtree/2 gives its tree term, which every other predicate of this module
+takes and reads or changes in place: a learner's hook finds it once (with its own state,
+in the same look-up of the knowledge base's record) and sorts, reads and updates it as
+often as the step needs.
 */
 
-%   Tree's term; fails when Tree was never made (or was cleared).
-tree(Tree, T) :-
-    kb_get(Tree, tree, T0),
-    T0 = qtree(_, _, _, _),
-    T = T0.
+%!  qtree(+KB, -Tree) is det.
+%
+%   Tree is KB's tree (the stored term itself).
+%
+%   @error existence_error(qtree, KB) if KB has no tree.
 
-%   Tree's term; an existence error when there is none.
-the_tree(Tree, T) :-
-    (   tree(Tree, T0)
-    ->  T = T0
+qtree(KB, Tree) :-
+    kb_get(KB, tree, T),
+    (   T = qtree(_, _, _, _)
+    ->  Tree = T
+    ;   existence_error(qtree, KB)
+    ).
+
+%   Tree is a tree term (a learner's hook may hold `none`: the tree was never made).
+the_tree(Tree) :-
+    (   Tree = qtree(_, _, _, _)
+    ->  true
     ;   existence_error(qtree, Tree)
     ).
 
@@ -69,12 +84,12 @@ node(Nodes, Id, Node) :-
     I is Id + 1,
     arg(I, Nodes, Node).
 
-%   Node Id of T, which must exist.
-existing_node(T, Tree, Id, Node) :-
+%   Node Id of tree T, which must exist.
+existing_node(T, Id, Node) :-
     T = qtree(_, Next, Nodes, _),
     (   integer(Id), Id >= 0, Id < Next
     ->  node(Nodes, Id, Node)
-    ;   existence_error(qtree_node, Tree-Id)
+    ;   existence_error(qtree_node, Id)
     ).
 
 set_node(T, Id, Node) :-
@@ -101,22 +116,22 @@ nodes_term(Capacity, Nodes) :-
     functor(Nodes, nodes, Capacity),
     forall(between(1, Capacity, I), nb_setarg(I, Nodes, free)).
 
-%!  qtree_new(+Tree, +Tests:list) is det.
+%!  qtree_new(+KB, +Tests:list) is det.
 %
-%   Make Tree a single empty leaf with the candidate Tests (goals, in index order).
+%   Make KB's tree a single empty leaf with the candidate Tests (goals, in index order).
 
-qtree_new(Tree, Tests) :-
+qtree_new(KB, Tests) :-
     must_be(list, Tests),
-    qtree_restore_(Tree, Tests, [0-leaf(none, [])], 1).
+    qtree_restore_(KB, Tests, [0-leaf(none, [])], 1).
 
-%!  qtree_restore(+Tree, +Tests, +Nodes:list) is det.
+%!  qtree_restore(+KB, +Tests, +Nodes:list) is det.
 %
-%   Make Tree the tree given by Nodes, a list of Id-Node pairs as saved by the engine.
+%   Make KB's tree the tree given by Nodes, a list of Id-Node pairs as saved by the engine.
 %
 %   @error domain_error(qtree, Nodes) if there is no root (Id 0).
 %   @error domain_error(qtree_node_id, Id) if two nodes have the same Id.
 
-qtree_restore(Tree, Tests, Nodes) :-
+qtree_restore(KB, Tests, Nodes) :-
     must_be(list, Nodes),
     (   memberchk(0-_, Nodes)
     ->  true
@@ -124,10 +139,10 @@ qtree_restore(Tree, Tests, Nodes) :-
     ),
     aggregate_all(max(Id), member(Id-_, Nodes), Max),
     Next is Max + 1,
-    qtree_restore_(Tree, Tests, Nodes, Next).
+    qtree_restore_(KB, Tests, Nodes, Next).
 
-qtree_restore_(Tree, Tests, Nodes, Next) :-
-    must_be(atom, Tree),
+qtree_restore_(KB, Tests, Nodes, Next) :-
+    must_be(atom, KB),
     Capacity is max(16, Next),
     nodes_term(Capacity, Term),
     forall(member(Id-Node, Nodes),
@@ -136,25 +151,27 @@ qtree_restore_(Tree, Tests, Nodes, Next) :-
                nb_setarg(I, Term, Node)
            ;   domain_error(qtree_node_id, Id)
            )),
-    kb_set(Tree, tree, qtree(Tests, Next, Term, none)).
+    kb_set(KB, tree, qtree(Tests, Next, Term, none)).
 
-%!  qtree_clear(+Tree) is det.
+%!  qtree_clear(+KB) is det.
 %
-%   Forget Tree.
+%   Forget KB's tree.
 
-qtree_clear(Tree) :-
-    kb_set(Tree, tree, none).
+qtree_clear(KB) :-
+    kb_set(KB, tree, none).
 
 %!  qtree_tests(+Tree, -Tests:list) is det.
 
 qtree_tests(Tree, Tests) :-
-    tree(Tree, qtree(Tests0, _, _, _)),
+    the_tree(Tree),
+    Tree = qtree(Tests0, _, _, _),
     copy_term(Tests0, Tests).
 
 %!  qtree_node(+Tree, ?Id, ?Node) is nondet.
 
 qtree_node(Tree, Id, Node) :-
-    tree(Tree, qtree(_, Next, Nodes, _)),
+    the_tree(Tree),
+    Tree = qtree(_, Next, Nodes, _),
     (   integer(Id)
     ->  Id >= 0, Id < Next
     ;   Last is Next - 1,
@@ -183,10 +200,10 @@ first_difference(D1, D2, Index) :-
 %   Sort a state down Tree. Where is leaf(Id), or null(Parent, Branch) when the state
 %   reaches an empty branch (Branch is yes or no).
 %
-%   @error existence_error(qtree, Tree) if there is no such tree.
+%   @error existence_error(qtree, Tree) if Tree is not a tree.
 
-qtree_sort(Tree, D, Where) :-
-    the_tree(Tree, T),
+qtree_sort(T, D, Where) :-
+    the_tree(T),
     T = qtree(_, Version, Nodes, Memo),
     (   Memo = memo(Version, D1, W1, D2, W2)
     ->  (   D1 =:= D
@@ -237,7 +254,8 @@ step_down(Nodes, Id, D, Goal, Branch, Next) :-
 %   ends, followed by leaf(Id) or null.
 
 qtree_path(Tree, D, Path) :-
-    the_tree(Tree, qtree(_, _, Nodes, _)),
+    the_tree(Tree),
+    Tree = qtree(_, _, Nodes, _),
     path_from(Nodes, 0, D, Path0),
     copy_term(Path0, Path).
 
@@ -259,8 +277,7 @@ path_from(Nodes, Id, D, Path) :-
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
     (   integer(Id)
-    ->  tree(Tree, T),
-        T = qtree(_, Next, Nodes, _),
+    ->  Tree = qtree(_, Next, Nodes, _),
         Id >= 0, Id < Next,
         node(Nodes, Id, leaf(Rep, Entries))
     ;   qtree_node(Tree, Id, leaf(Rep, Entries))
@@ -268,25 +285,25 @@ qtree_leaf(Tree, Id, Rep, Entries) :-
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.
 %
-%   @error existence_error(qtree_leaf, Tree-Id) if node Id is not a leaf.
+%   @error existence_error(qtree_leaf, Id) if node Id is not a leaf.
 
-qtree_set_leaf(Tree, Id, Rep, Entries) :-
-    (   tree(Tree, T),
-        T = qtree(_, Next, Nodes, _),
+qtree_set_leaf(T, Id, Rep, Entries) :-
+    (   T = qtree(_, Next, Nodes, _),
         integer(Id), Id >= 0, Id < Next,
         node(Nodes, Id, leaf(_, _))
     ->  set_node(T, Id, leaf(Rep, Entries))
-    ;   existence_error(qtree_leaf, Tree-Id)
+    ;   the_tree(T),
+        existence_error(qtree_leaf, Id)
     ).
 
 %!  qtree_grow(+Tree, +Parent, +Branch, +Rep, +Entries, -Id) is det.
 %
 %   Generate a leaf on the empty Branch (yes or no) of the test node Parent.
 
-qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
+qtree_grow(T, Parent, Branch, Rep, Entries, Id) :-
     must_be(oneof([yes, no]), Branch),
-    the_tree(Tree, T),
-    existing_node(T, Tree, Parent, Node0),
+    the_tree(T),
+    existing_node(T, Parent, Node0),
     (   Node0 = test(I, Goal, Yes, No)
     ->  true
     ;   domain_error(qtree_test_node, Parent)
@@ -308,12 +325,12 @@ qtree_grow(Tree, Parent, Branch, Rep, Entries, Id) :-
 %   Turn leaf LeafId into a test node on test TestIndex. The leaf moves to the branch its
 %   representative takes; the other branch is empty (nil).
 
-qtree_split(Tree, LeafId, I) :-
-    the_tree(Tree, T),
-    existing_node(T, Tree, LeafId, Leaf),
+qtree_split(T, LeafId, I) :-
+    the_tree(T),
+    existing_node(T, LeafId, Leaf),
     (   Leaf = leaf(Rep, Entries)
     ->  true
-    ;   existence_error(qtree_leaf, Tree-LeafId)
+    ;   existence_error(qtree_leaf, LeafId)
     ),
     T = qtree(Tests, _, _, _),
     nth0(I, Tests, Goal),

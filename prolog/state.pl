@@ -9,7 +9,8 @@
             state_plan/4,         % +KB, +Features, +Reinforcers, -Plan
             plan_code/3,          % +KB, +Plan, -Code
             plan_code/4,          % +KB, +Plan, -Code, -Reinforced
-            plan_reinforced/3,    % +KB, +Plan, -Reinforced
+            plan_code/5,          % +KB, +Record, +Plan, -Code, -Reinforced
+            plan_reinforced/3,    % +Record, +Plan, -Reinforced
             state_mark/1,         % -Mark
             state_forget/1,       % +KB
             state_forget/2,       % +KB, +Mark
@@ -24,6 +25,7 @@
 :- use_module(perception).
 :- use_module(rules).
 :- use_module(memory).
+:- use_module(kbstate, [kb_record/2]).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The state code
@@ -323,16 +325,23 @@ state_forget(KB, Mark) :-
 
 %!  plan_code(+KB, +Plan, -Code:integer) is det.
 %!  plan_code(+KB, +Plan, -Code:integer, -Reinforced) is det.
+%!  plan_code(+KB, +Record, +Plan, -Code:integer, -Reinforced) is det.
 %
 %   Code is the state code now, by a plan from state_plan/3,4; Reinforced is `true` when a
 %   stimulus of the plan's Reinforcers is sensed now (a Sense(S) percept of age 0, Sense
 %   one of see, hear, smell, at), else `false`: one pass over working memory for both.
+%   Record is KB's record (relrl_kbstate:kb_record/2), for a caller that has it (the
+%   control step).
 
 plan_code(KB, Plan, Code) :-
     plan_code(KB, Plan, Code, _).
 
-plan_code(KB, plan(Id, Program, Goals, Checked), Code, Reinforced) :-
-    wm_stamped(KB, Clock, Pairs),
+plan_code(KB, Plan, Code, Reinforced) :-
+    kb_record(KB, Record),
+    plan_code(KB, Record, Plan, Code, Reinforced).
+
+plan_code(KB, Record, plan(Id, Program, Goals, Checked), Code, Reinforced) :-
+    wm_stamped(Record, Clock, Pairs),
     (   memory_facts_hold(KB, Id, Checked)
     ->  scan(Pairs, Id, Clock, true, 0, Code0, false, Reinforced),
         program_mask(Program, Code0, Code)
@@ -340,13 +349,13 @@ plan_code(KB, plan(Id, Program, Goals, Checked), Code, Reinforced) :-
         program_mask(Goals, Code0, Code)
     ).
 
-%!  plan_reinforced(+KB, +Plan, -Reinforced) is det.
+%!  plan_reinforced(+Record, +Plan, -Reinforced) is det.
 %
-%   Reinforced is what plan_code/4 gives, without the state code: for an engine whose
-%   learner never reads the code.
+%   Reinforced is what plan_code/5 gives, without the state code: for an engine whose
+%   learner never reads the code. Record is the knowledge base's record.
 
-plan_reinforced(KB, plan(Id, _, _, _), Reinforced) :-
-    wm_stamped(KB, Clock, Pairs),
+plan_reinforced(Record, plan(Id, _, _, _), Reinforced) :-
+    wm_stamped(Record, Clock, Pairs),
     (   member(E-Stamp, Pairs),
         Stamp =:= Clock,
         plan_reinforcer_(Id, E)

@@ -201,11 +201,52 @@ test(roulette_draws_the_execution_probabilities, [true(Worst < 0.01)]) :-
 :- end_tests(contingency).
 
 % ---------------------------------------------------------------------------------------
+:- begin_tests(kbstate).
+
+%   A knowledge base's record: made at first use, a part read and replaced through the
+%   record or through the knowledge base's name alike, a value stored as a copy, every
+%   read deterministic, and forgotten whole.
+test(record_parts, [true(Got =@= [t(1), t(1), f(_), none])]) :-
+    relrl_kbstate:kb_forget(krec1),
+    relrl_kbstate:kb_record(krec1, R),
+    relrl_kbstate:record_set(R, task, t(1)),
+    relrl_kbstate:kb_get(krec1, task, A),
+    relrl_kbstate:record_get(R, task, B),
+    relrl_kbstate:kb_set(krec1, learner, f(X)),
+    X = 1,                                              % the stored copy is not bound
+    relrl_kbstate:kb_record(krec1, R2),
+    relrl_kbstate:record_get(R2, learner, C),
+    relrl_kbstate:kb_forget(krec1),
+    relrl_kbstate:kb_get(krec1, task, D),               % a fresh record
+    relrl_kbstate:kb_forget(krec1),
+    Got = [A, B, C, D].
+
+test(parts_read_deterministically) :-
+    relrl_kbstate:kb_record(krec2, R),
+    forall(member(P, [engine, memory, units, learner, tree, task, kept]),
+           (   call_cleanup(relrl_kbstate:record_get(R, P, V), Det1 = true),
+               call_cleanup(relrl_kbstate:record_set(R, P, V), Det2 = true),
+               assertion(Det1-Det2 == true-true)
+           )),
+    relrl_kbstate:kb_forget(krec2).
+
+test(unknown_part, [error(domain_error(kb_part, nope)),
+                    cleanup(relrl_kbstate:kb_forget(krec3))]) :-
+    relrl_kbstate:kb_get(krec3, nope, _).
+
+test(forgotten, [fail]) :-
+    relrl_kbstate:kb_record(krec4, _),
+    relrl_kbstate:kb_forget(krec4),
+    relrl_kbstate:kb_record_exists(krec4).
+
+:- end_tests(kbstate).
+
 :- begin_tests(qtree).
 
 test(new_tree_one_empty_leaf, [Nodes == [0-leaf(none, [])]]) :-
     relrl_qtree:qtree_new(t1, [a, b]),
-    findall(I-N, relrl_qtree:qtree_node(t1, I, N), Nodes).
+    relrl_qtree:qtree(t1, T),
+    findall(I-N, relrl_qtree:qtree_node(T, I, N), Nodes).
 
 put_all(Entries, Es) :-
     foldl(put_one, Entries, [], Es).
@@ -222,16 +263,29 @@ test(put_replaces_same_action_and_necessity, [Es == [e(b, 2, n), e(a, 0.5, n)]])
 
 test(split_and_sort, [Where == [leaf(1), null(0, no), leaf(1)]]) :-
     relrl_qtree:qtree_new(t2, [x0, x1]),
-    relrl_qtree:qtree_set_leaf(t2, 0, 1, [e(a, 1, n)]),   % representative: bit 0 set
-    relrl_qtree:qtree_split(t2, 0, 0),
-    findall(W, ( member(D, [1, 2, 3]), relrl_qtree:qtree_sort(t2, D, W) ), Where).
+    relrl_qtree:qtree(t2, T),
+    relrl_qtree:qtree_set_leaf(T, 0, 1, [e(a, 1, n)]),    % representative: bit 0 set
+    relrl_qtree:qtree_split(T, 0, 0),
+    findall(W, ( member(D, [1, 2, 3]), relrl_qtree:qtree_sort(T, D, W) ), Where).
 
 test(grow_on_null, [Leaf == leaf(2, [e(b, 4, n)])]) :-
     relrl_qtree:qtree_new(t3, [x0]),
-    relrl_qtree:qtree_set_leaf(t3, 0, 1, []),
-    relrl_qtree:qtree_split(t3, 0, 0),
-    relrl_qtree:qtree_grow(t3, 0, no, 2, [e(b, 4, n)], Id),
-    once(relrl_qtree:qtree_node(t3, Id, Leaf)).
+    relrl_qtree:qtree(t3, T),
+    relrl_qtree:qtree_set_leaf(T, 0, 1, []),
+    relrl_qtree:qtree_split(T, 0, 0),
+    relrl_qtree:qtree_grow(T, 0, no, 2, [e(b, 4, n)], Id),
+    once(relrl_qtree:qtree_node(T, Id, Leaf)).
+
+test(no_tree, [error(existence_error(qtree, t4))]) :-
+    relrl_qtree:qtree_clear(t4),
+    relrl_qtree:qtree(t4, _).
+
+test(not_a_leaf, [error(existence_error(qtree_leaf, 0))]) :-
+    relrl_qtree:qtree_new(t5, [x0]),
+    relrl_qtree:qtree(t5, T),
+    relrl_qtree:qtree_set_leaf(T, 0, 1, []),
+    relrl_qtree:qtree_split(T, 0, 0),
+    relrl_qtree:qtree_set_leaf(T, 0, 1, []).
 
 test(first_difference_lowest_bit, [I == 1]) :-
     relrl_qtree:first_difference(0b101, 0b111, I).
@@ -260,13 +314,15 @@ test(etg_by_hand) :-
     close_to(1.8625, Q4),
     % 5. dark, c, r=10: target 10 + 0.9*5.25; Q = 7.3625 goes first.
     relrl_etg:etg_update(KB, 2, c, hunger, 10, 1, hunger, [], P),
-    once(relrl_qtree:qtree_node(KB, 2, leaf(2, [e(c, Q5, hunger), e(b, _, hunger)]))),
+    relrl_qtree:qtree(KB, T),
+    once(relrl_qtree:qtree_node(T, 2, leaf(2, [e(c, Q5, hunger), e(b, _, hunger)]))),
     close_to(7.3625, Q5),
     relrl_engine:engine_size(KB, Size),
     Size == size(etg, 7, [nodes=3, leaves=2, entries=4]).
 
 tree_nodes(KB, Nodes) :-
-    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes0),
+    relrl_qtree:qtree(KB, T),
+    findall(I-N, relrl_qtree:qtree_node(T, I, N), Nodes0),
     msort(Nodes0, Nodes).
 
 :- end_tests(qtree).
@@ -304,7 +360,8 @@ test(learns_previous_step, [Entries == [e(a, 5.0, hunger)]]) :-
     relrl_engine:engine_configure(KB, etg, P, 0),
     relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
     relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, learn, [], _),
-    relrl_qtree:qtree_leaf(KB, 0, _, Entries).
+    relrl_qtree:qtree(KB, T),
+    relrl_qtree:qtree_leaf(T, 0, _, Entries).
 
 test(greedy_and_explore_do_not_learn, [Nodes == [0-leaf(none, [])]]) :-
     kb_with('tests/data/tiny.pl', KB),
@@ -313,7 +370,8 @@ test(greedy_and_explore_do_not_learn, [Nodes == [0-leaf(none, [])]]) :-
     relrl_engine:engine_step(KB, [see(light)], -1, greedy, [], _),
     relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, explore, [], _),
     relrl_engine:engine_step(KB, [see(light)], 2, greedy, [], _),
-    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes).
+    relrl_qtree:qtree(KB, T),
+    findall(I-N, relrl_qtree:qtree_node(T, I, N), Nodes).
 
 test(end_episode_cuts_the_link, [Nodes == [0-leaf(none, [])]]) :-
     kb_with('tests/data/tiny.pl', KB),
@@ -322,7 +380,8 @@ test(end_episode_cuts_the_link, [Nodes == [0-leaf(none, [])]]) :-
     relrl_engine:engine_step(KB, [see(light)], -1, learn, [], _),
     relrl_engine:engine_end_episode(KB),
     relrl_engine:engine_step(KB, [see(dark), smell(food)], 0, learn, [], _),
-    findall(I-N, relrl_qtree:qtree_node(KB, I, N), Nodes).
+    relrl_qtree:qtree(KB, T),
+    findall(I-N, relrl_qtree:qtree_node(T, I, N), Nodes).
 
 %   Each knowledge base draws from its own random stream.
 test(random_streams_per_kb, [As1 == As2]) :-
@@ -773,13 +832,14 @@ test(etg_max_q_sorted_leaves, [true(Bad == [])]) :-
 %   it was made and garbage collection.
 test(qtree_linked_leaf_survives, [true(Entries == [e(a, 2.5, n), e(b, 1.0, n)])]) :-
     relrl_qtree:qtree_new(tlink, [t0]),
+    relrl_qtree:qtree(tlink, T),
     (   X is 1.5 + 1.0, Y is 0.5 * 2,
-        relrl_qtree:qtree_set_leaf(tlink, 0, 1, [e(a, X, n), e(b, Y, n)]),
+        relrl_qtree:qtree_set_leaf(T, 0, 1, [e(a, X, n), e(b, Y, n)]),
         fail
     ;   true
     ),
     findall(Z, ( between(1, 20000, I), Z = f(I, I) ), _),
     garbage_collect,
-    relrl_qtree:qtree_leaf(tlink, 0, _, Entries).
+    relrl_qtree:qtree_leaf(T, 0, _, Entries).
 
 :- end_tests(step_parts).

@@ -81,7 +81,8 @@ test(a_tree_restores) :-
          etg_node(1, leaf(1, [e(b, 1.0, hunger), e(a, 2.0, hunger)])),
          etg_node(2, leaf(none, []))]),
     % entries put in decreasing Q, as the learner keeps them
-    relrl_qtree:qtree_leaf(KB, 1, 1, Entries),
+    relrl_qtree:qtree(KB, T),
+    relrl_qtree:qtree_leaf(T, 1, 1, Entries),
     assertion(Entries == [e(a, 2.0, hunger), e(b, 1.0, hunger)]).
 
 test(id_out_of_range, [Message == "node id 1000000000 is out of range: this policy has 2 \c
@@ -153,7 +154,8 @@ test(refused_leaves_the_tree_as_it_was) :-
     catch(relrl_engine:learner_restore(etg, KB, [etg_tests(Tests),
                                                  etg_node(0, leaf(3, [e(halt, 1.0, hunger)]))]),
           error(relrl_policy_refused(_, _), _), true),
-    relrl_qtree:qtree_leaf(KB, 0, Rep, Entries),
+    relrl_qtree:qtree(KB, T),
+    relrl_qtree:qtree_leaf(T, 0, Rep, Entries),
     assertion(Rep-Entries == 3-[e(a, 1.0, hunger)]).
 
 :- end_tests(etg_policy_shape).

@@ -49,8 +49,9 @@ memory_open_tails(KB, Steps, Open) :-
                       ), Open)).
 
 %   A leaf's entries replaced every step, as ETG's update does.
-leaf_open_tails(Tree, Steps, Open) :-
-    qtree_new(Tree, [stimulus(a)]),
+leaf_open_tails(KB, Steps, Open) :-
+    qtree_new(KB, [stimulus(a)]),
+    qtree(KB, Tree),
     under_signals(
         aggregate_all(count,
                       ( between(1, Steps, I),
