@@ -145,12 +145,19 @@ class Protocol(ABC):
         """
 
     def query_moving(self, link: Link, targets: dict[int, int]) -> bool:
-        """Ask whether any servo is still moving (``targets``: channel -> last target, us)."""
-        raise NotImplementedError(f"{self.name} cannot report motion")
+        """Ask whether any servo is still moving (``targets``: channel -> last target, us).
+
+        Raises:
+            HeadError: the protocol has no feedback (:attr:`feedback` false)."""
+        raise HeadError(f"the {self.name} protocol has no feedback: it cannot report motion")
 
     def query_positions(self, link: Link, channels: Sequence[int]) -> dict[int, float]:
-        """Ask the current pulse width of each channel, in microseconds."""
-        raise NotImplementedError(f"{self.name} cannot report positions")
+        """Ask the current pulse width of each channel, in microseconds.
+
+        Raises:
+            HeadError: the protocol has no feedback (:attr:`feedback` false)."""
+        raise HeadError(f"the {self.name} protocol has no feedback: it cannot report "
+                        "positions")
 
     def query_errors(self, link: Link) -> list[str]:
         """Ask the controller for its error flags (empty when it has none to report)."""

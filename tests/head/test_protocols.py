@@ -101,3 +101,12 @@ def test_fake_controller_flags_pulses_outside_its_limits():
     fake = FakeController("ssc32", limits={0: (1000, 2000)})
     fake.feed(b"#0P2100S100\r")
     assert fake.violations == ["ssc32: channel 0 pulse 2100 us outside 1000..2000"]
+
+
+def test_a_protocol_without_feedback_says_so_when_asked_for_it() -> None:
+    proto = get_protocol("pms5005")
+    assert not proto.feedback
+    with pytest.raises(HeadError, match="pms5005 protocol has no feedback"):
+        proto.query_moving(None, {0: 1500})  # type: ignore[arg-type]
+    with pytest.raises(HeadError, match="cannot report positions"):
+        proto.query_positions(None, [0])  # type: ignore[arg-type]
