@@ -59,10 +59,11 @@ catalogue_entry(Name, learner(Name, Properties, Parameters, Serves)) :-
 
 %   check_learner(+Name, +Properties, +Parameters, +Serves) is det.
 %
-%   Every parameter is named once, with a known kind and a default of it; an external
-%   learner declares no parameters and serves no family, any other serves at least one,
-%   each once, with overrides of its own parameters by values of their kinds; a learner
-%   of worlds reads the relational view (view(relational)).
+%   Every parameter is named once, with a kind (a name) and a number as its default; an
+%   external learner declares no parameters and serves no family, any other serves at
+%   least one, each once, with overrides of its own parameters by numbers; a learner of
+%   worlds reads the relational view (view(relational)). Whether a number is a value of
+%   its parameter's kind Python checks when it builds its registry.
 
 check_learner(Name, Properties, Parameters, Serves) :-
     forall(member(parameter(P, D, K), Parameters), check_parameter(Name, P, D, K)),
@@ -91,11 +92,11 @@ check_parameter(Name, P, D, K) :-
     ->  true
     ;   declaration_error(Name, format('parameter ~q is not an atom', [P]))
     ),
-    (   kind(K)
+    (   callable(K)
     ->  true
-    ;   declaration_error(Name, format('parameter ~q: unknown kind ~q', [P, K]))
+    ;   declaration_error(Name, format('parameter ~q: its kind ~q is not a name', [P, K]))
     ),
-    check_value(Name, P, K, D).
+    check_value(Name, P, D).
 
 check_serves(Name, Properties, Parameters, Family, Overrides) :-
     (   memberchk(Family, [domains, worlds])
@@ -113,33 +114,19 @@ check_serves(Name, Properties, Parameters, Family, Overrides) :-
     ;   declaration_error(Name, format('the overrides of ~q are not a list', [Family]))
     ),
     forall(member(O, Overrides),
-           (   O = (P = V), memberchk(parameter(P, _, K), Parameters)
-           ->  check_value(Name, P, K, V)
+           (   O = (P = V), memberchk(parameter(P, _, _), Parameters)
+           ->  check_value(Name, P, V)
            ;   declaration_error(Name, format('~q: ~q overrides no parameter of it',
                                               [Family, O]))
            )).
 
-check_value(Name, P, K, V) :-
-    (   number(V), kind_holds(K, V)
+%   A default or an override is a number: whether it is one of its parameter's kind (unit,
+%   whole(Min), ...) Python checks, the one reader of kinds (relrl/learners/base.py).
+check_value(Name, P, V) :-
+    (   number(V)
     ->  true
-    ;   declaration_error(Name, format('parameter ~q: ~q is not a value of kind ~q',
-                                       [P, V, K]))
+    ;   declaration_error(Name, format('parameter ~q: ~q is not a number', [P, V]))
     ).
-
-%   kind(?Kind): the kinds of values a parameter takes.
-kind(unit).
-kind(open_unit).
-kind(nonneg).
-kind(whole(Min)) :- integer(Min).
-kind(flag).
-kind(number).
-
-kind_holds(unit, V) :- V >= 0, V =< 1.
-kind_holds(open_unit, V) :- V > 0, V < 1.
-kind_holds(nonneg, V) :- V >= 0.
-kind_holds(whole(Min), V) :- V >= Min, V =:= truncate(V).
-kind_holds(flag, V) :- ( V =:= 0 ; V =:= 1 ), !.
-kind_holds(number, _).
 
 declaration_error(Name, format(Format, Args)) :-
     !,

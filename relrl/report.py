@@ -456,13 +456,17 @@ def _worlds_short(run: Run) -> str:
             + table(["world: task", *learners], rows))
 
 
+_CLOCK = {"process CPU time": "CPU", "wall": "wall-clock"}
+
+
 @view("worlds", "cost")
 def _worlds_cost(run: Run) -> str:
-    rows = []
+    rows, clocks = [], set()
     for t in run.timing.get("jobs", []):
         cost = t.get("step_cost_by_size")
         if not cost:
             continue
+        clocks.add(cost.get("clock", "wall"))      # runs before the CPU clock: wall time
         sizes = cost["sizes"]
         rows.append([Path(t["world"]).stem, t["task"], t["learner"], t["seed"],
                      _f(t.get("learning_steps_per_second"), 0),
@@ -471,7 +475,8 @@ def _worlds_cost(run: Run) -> str:
                      _f(cost["size_ratio"][str(sizes[-1])]),
                      _f(cost.get("slope"))])
     return table(["world", "task", "learner", "seed", "learning steps/s",
-                  "CPU µs per learning step by size", "cost ratio, largest / smallest",
+                  f"{' or '.join(sorted(_CLOCK.get(c, c) for c in clocks)) or 'CPU'} µs "
+                  "per learning step by size", "cost ratio, largest / smallest",
                   "size ratio", "slope k (cost ∝ size^k)"], rows)
 
 

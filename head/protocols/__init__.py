@@ -149,15 +149,14 @@ class Protocol(ABC):
 
         Raises:
             HeadError: the protocol has no feedback (:attr:`feedback` false)."""
-        raise HeadError(f"the {self.name} protocol has no feedback: it cannot report motion")
+        raise HeadError(f"the {self.name} protocol cannot report motion (no feedback)")
 
     def query_positions(self, link: Link, channels: Sequence[int]) -> dict[int, float]:
         """Ask the current pulse width of each channel, in microseconds.
 
         Raises:
             HeadError: the protocol has no feedback (:attr:`feedback` false)."""
-        raise HeadError(f"the {self.name} protocol has no feedback: it cannot report "
-                        "positions")
+        raise HeadError(f"the {self.name} protocol cannot report positions (no feedback)")
 
     def query_errors(self, link: Link) -> list[str]:
         """Ask the controller for its error flags (empty when it has none to report)."""

@@ -2,8 +2,8 @@
 
 Each subcommand module in :data:`SUBCOMMANDS` provides ``HELP`` (one line), ``EXAMPLE``,
 ``add_arguments(parser)`` and ``run(args) -> int``. Modules keep heavy imports (OpenCV,
-pyserial, matplotlib) inside ``run`` so ``relrl --help`` stays fast; Prolog is asked once,
-for the learner registry the options' help and defaults name (about 0.1 s).
+pyserial, matplotlib) inside ``run`` so ``relrl --help`` stays fast and needs no SWI-Prolog
+(the learner registry, Prolog's, is asked when a command runs).
 
 Errors a user can cause (:data:`relrl.errors.USER_ERRORS`: relrl's ``UserError`` and the error
 bases of the ``head`` and ``perception`` packages) print one line and exit 2 (an error that
@@ -94,11 +94,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from relrl import log
     from relrl.errors import USER_ERRORS
 
-    try:
-        parser = build_parser()
-    except USER_ERRORS as exc:  # the learners' declarations the options name (registry)
-        print(f"relrl: {exc}", file=sys.stderr)
-        return 2
+    parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     args = parser.parse_args(argv)
     verbose, quiet = getattr(args, "verbose", 0), getattr(args, "quiet", 0)

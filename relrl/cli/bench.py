@@ -12,8 +12,6 @@ EXAMPLE = ("relrl bench --json bench.json\n"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl bench``."""
-    from relrl.learners import DOMAINS, learners
-
     parser.add_argument("--json", metavar="FILE", help="also write the figures as JSON")
     parser.add_argument("--steps", type=int, default=5000, help="timed steps per learner")
     parser.add_argument("--no-perception", action="store_true",
@@ -25,8 +23,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "run and replay it in plain swipl, every decision checked "
                              "(microseconds and inferences per step)")
     parser.add_argument("--learner", default="etg",
-                        help="with --prolog-step: the learner, one of "
-                             f"{', '.join(learners(DOMAINS))} (default etg)")
+                        help="with --prolog-step: a learner of the simulator's domains "
+                             "(default etg)")
     parser.add_argument("--profile", action="store_true",
                         help="with --prolog-step: SWI-Prolog's profiler over the replayed steps")
     parser.add_argument("--top", type=int, default=25,

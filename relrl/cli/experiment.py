@@ -66,9 +66,10 @@ def _places(option: str, text: str | None) -> list[str] | None:
     return list(dict.fromkeys(places))
 
 
-def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds: str) -> None:
-    p.add_argument("--learners", default=default_learners,
-                   help=f"comma-separated learners (default: {default_learners})")
+def _common(p: argparse.ArgumentParser, *, default_seeds: str) -> None:
+    p.add_argument("--learners", default=None,
+                   help="comma-separated learners (default: every learner of the "
+                        "simulator's domains)")
     p.add_argument("--seeds", default=None, help=f"comma-separated seeds (default "
                                                  f"{default_seeds})")
     p.add_argument("--eval-runs", type=int, default=None, help="evaluation runs per point")
@@ -102,8 +103,6 @@ def _common(p: argparse.ArgumentParser, *, default_learners: str, default_seeds:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the subcommands and options of ``relrl experiment``."""
-    from relrl.learners import DOMAINS, learners
-
     sub = parser.add_subparsers(dest="name", metavar="EXPERIMENT", required=True,
                                 parser_class=type(parser))
     sis = sub.add_parser("sis", help="the paper's Experiment 1 (the learners in the SIS)",
@@ -117,7 +116,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                 "  relrl experiment sis --config runs/exp1/results.json --out "
                                 "runs/exp1-again",
                          formatter_class=argparse.RawDescriptionHelpFormatter)
-    _common(sis, default_learners=",".join(learners(DOMAINS)), default_seeds="0")
+    _common(sis, default_seeds="0")
     from relrl.experiments.sis import PRESETS
 
     sis.add_argument("--preset", default=None, choices=sorted(PRESETS),
@@ -145,7 +144,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                                "  relrl experiment scaling --learners tg --sizes 5 --transfer "
                                "sizes --transfer-sizes 9,33,129 --out runs/transfer",
                         formatter_class=argparse.RawDescriptionHelpFormatter)
-    _common(sc, default_learners=",".join(learners(DOMAINS)), default_seeds="0,1,2")
+    _common(sc, default_seeds="0,1,2")
     sc.add_argument("--sizes", default="5,9,17,33", help="world sizes P (default 5,9,17,33)")
     sc.add_argument("--world", default="", metavar="NAME=VALUE,...",
                     help="the worlds' other fields: colours, kinds, toys, scene, field "
@@ -173,14 +172,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_worlds(sub) -> None:
-    from relrl.learners import WORLDS, learners
-
-    world_learners = ",".join(learners(WORLDS))
     w = sub.add_parser("worlds", help="tasks of worlds written in Prolog (blocks world)",
                        description="Learning curves, evaluation on other sizes with no "
                                    "further learning, memory and step cost of the learners "
-                                   f"of worlds ({world_learners.replace(',', ', ')}) on tasks "
-                                   "of worlds written in Prolog; the worlds' stated optimum "
+                                   "of worlds on tasks of worlds written in Prolog; the "
+                                   "worlds' stated optimum "
                                    "checked by search.",
                        epilog="examples:\n"
                               "  relrl experiment worlds --quick --out runs/worlds-quick\n"
@@ -191,8 +187,8 @@ def _add_worlds(sub) -> None:
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
     w.add_argument("--tasks", default="stack,unstack,on",
                    help="tasks of each world (default stack,unstack,on)")
-    w.add_argument("--learners", default=world_learners,
-                   help=f"learners (default {world_learners})")
+    w.add_argument("--learners", default=None,
+                   help="comma-separated learners (default: every learner of worlds)")
     w.add_argument("--seeds", default=None, help="comma-separated seeds (default 0,1,2)")
     w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
     w.add_argument("--test-sizes", default="6,8,10",
@@ -233,7 +229,8 @@ def _check_common(args: argparse.Namespace, config) -> None:
     from relrl.learners import DOMAINS, learners, make_learner
 
     learners_known = learners(DOMAINS)
-    learners = [x.strip() for x in args.learners.split(",") if x.strip()]
+    names = ",".join(learners_known) if args.learners is None else args.learners
+    learners = [x.strip() for x in names.split(",") if x.strip()]
     for name in learners:
         if name not in learners_known:
             raise ConfigError(f"unknown learner {name!r} in --learners "
@@ -439,7 +436,8 @@ def build_worlds_config(args: argparse.Namespace):
             raise ConfigError(f"--worlds {path}: no such world file")
         config.worlds[i] = str(Path(path).resolve())
     config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
-    config.learners = [x.strip() for x in args.learners.split(",") if x.strip()]
+    names = ",".join(learners(WORLDS)) if args.learners is None else args.learners
+    config.learners = [x.strip() for x in names.split(",") if x.strip()]
     for name in config.learners:
         if name not in learners(WORLDS):
             raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "

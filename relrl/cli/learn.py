@@ -45,12 +45,10 @@ def _param(text: str) -> tuple[str, float]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl learn``."""
-    from relrl.learners import WORLDS, learners
-
     parser.add_argument("world", metavar="WORLD.pl", help="the world file (docs/worlds.md)")
     parser.add_argument("--learner", default="tg",
-                        help=f"a learner of worlds: {', '.join(learners(WORLDS))} (default tg, "
-                             "relational; docs/worlds.md describes each)"),
+                        help="a learner of worlds (default tg, relational; docs/worlds.md "
+                             "describes each)")
     parser.add_argument("--task", default=None,
                         help="a task of the world: its name (stack, on) or an instance "
                              "(on(b1, b2)); default: the first the world declares")

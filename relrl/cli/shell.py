@@ -11,14 +11,12 @@ EXAMPLE = 'echo "response(R)." | relrl shell examples/domains/fruits.pl'
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl shell``."""
-    from relrl.learners import DOMAINS, learners
-
     parser.add_argument("domain", nargs="*", metavar="DOMAIN.pl", help="domain files to load")
     parser.add_argument("--policy", metavar="FILE",
                         help="a learned policy (ETG tree, behaviour rules) saved by relrl")
     parser.add_argument("--learner", metavar="NAME",
-                        help=f"start a fresh learner ({', '.join(learners(DOMAINS))}) for "
-                             ":step")
+                        help="start a fresh learner of the simulator's domains (etg, tg, "
+                             "...) for :step")
     parser.add_argument("--timeout", type=float, default=10.0, metavar="S",
                         help="seconds each answer may take (default 10; positive: the limit "
                              "cannot be switched off)")

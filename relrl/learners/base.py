@@ -63,6 +63,11 @@ class Parameter:
         """Whether ``value`` (a finite number) is a value of this parameter's kind."""
         return _KINDS[self.kind][0](value) and (self.kind != "whole" or value >= self.least)
 
+    @property
+    def allowed(self) -> str:
+        """The values of this parameter's kind, as text (``in [0, 1]``, ...)."""
+        return _KINDS[self.kind][1] + (f" >= {self.least}" if self.kind == "whole" else "")
+
     def value(self, learner: str, value: object) -> float:
         """``value`` as this parameter of ``learner`` takes it (a float).
 
@@ -78,9 +83,8 @@ class Parameter:
             raise ConfigError(f"parameter {self.name} of learner {learner!r} must be a "
                               f"finite number, not {value!r}")
         if not self.holds(number):
-            allowed = _KINDS[self.kind][1] + (f" >= {self.least}" if self.kind == "whole"
-                                              else "")
-            raise ConfigError(f"{self.name} must be {allowed}, not {number}")
+            raise ConfigError(f"{self.name} must be {self.allowed}, not {number} (learner "
+                              f"{learner!r})")
         return number
 
 

@@ -102,10 +102,11 @@ def build_registry(entries: list[Term], classes: Mapping[str, type[Learner]]
                     found[python_name] = (cls.python_spec, cls)
             continue
         spec = LearnerSpec(name=str(name), engine=str(name),
-                           parameters=tuple(_parameter(p) for p in parameters),
+                           parameters=tuple(_parameter(str(name), p) for p in parameters),
                            serves={str(f): {str(o[1]): float(o[2]) for o in overrides}
                                    for _, f, overrides in serves},
                            properties=props)
+        _check_values(spec)
         cls = classes.get(spec.name, PrologLearner)
         if cls.python_spec is not None:
             raise RelrlError(f"learner {spec.name!r} is declared both in Prolog and in Python "
@@ -128,11 +129,32 @@ def build_registry(entries: list[Term], classes: Mapping[str, type[Learner]]
     return found
 
 
-def _parameter(term: Term) -> Parameter:
+def _parameter(learner: str, term: Term) -> Parameter:
     _, name, default, kind = term
-    if isinstance(kind, tuple):        # whole(Min)
-        return Parameter(str(name), float(default), str(kind[0]), int(kind[1]))
-    return Parameter(str(name), float(default), str(kind))
+    try:
+        if isinstance(kind, tuple) and len(kind) == 2 and isinstance(kind[1], int):
+            return Parameter(str(name), float(default), str(kind[0]), kind[1])  # whole(Min)
+        return Parameter(str(name), float(default), str(kind))
+    except ValueError as exc:                 # an unknown kind
+        raise _declaration_error(learner, str(exc)) from None
+
+
+def _check_values(spec: LearnerSpec) -> None:
+    """Every default and override of ``spec`` is a value of its parameter's kind (the one
+    check of kinds: Prolog checks the declarations' structure)."""
+    by_name = {p.name: p for p in spec.parameters}
+    values = [(p, p.default) for p in spec.parameters]
+    values += [(by_name[n], v) for overrides in spec.serves.values()
+               for n, v in overrides.items()]
+    for p, v in values:
+        if not p.holds(v):
+            raise _declaration_error(spec.name, f"parameter {p.name}: {v:g} is not "
+                                                f"{p.allowed}")
+
+
+def _declaration_error(learner: str, problem: str) -> ConfigError:
+    return ConfigError(f"learner {learner}: {problem} (the learners' declarations, "
+                       "prolog/learners.pl)")
 
 
 @functools.cache

@@ -106,7 +106,7 @@ def test_fake_controller_flags_pulses_outside_its_limits():
 def test_a_protocol_without_feedback_says_so_when_asked_for_it() -> None:
     proto = get_protocol("pms5005")
     assert not proto.feedback
-    with pytest.raises(HeadError, match="pms5005 protocol has no feedback"):
+    with pytest.raises(HeadError, match="pms5005 protocol cannot report motion"):
         proto.query_moving(None, {0: 1500})  # type: ignore[arg-type]
     with pytest.raises(HeadError, match="cannot report positions"):
         proto.query_positions(None, [0])  # type: ignore[arg-type]

@@ -97,15 +97,29 @@ def test_bad_flag_exit_2(capsys) -> None:
     assert exc.value.code == 2
 
 
-@pytest.mark.parametrize("argv", [["--help"], ["check", "examples/domains/sis.pl"]])
-def test_without_swi_prolog_one_line_exit_2(argv: list[str], tmp_path) -> None:
-    """No swipl on the PATH (and no LIBSWIPL_PATH): one line saying so, exit 2."""
+def _without_swipl(argv: list[str], tmp_path) -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items()
            if k not in ("LIBSWIPL_PATH", "SWI_HOME_DIR")}
     env["PATH"] = str(tmp_path)           # an empty folder: no swipl
-    proc = subprocess.run([sys.executable, "-m", "relrl.cli", *argv], cwd=ROOT, env=env,
+    return subprocess.run([sys.executable, "-m", "relrl.cli", *argv], cwd=ROOT, env=env,
                           capture_output=True, text=True, timeout=120)
+
+
+def test_without_swi_prolog_a_command_that_needs_it_says_so(tmp_path) -> None:
+    """No swipl on the PATH (and no LIBSWIPL_PATH): one line saying so, exit 2."""
+    proc = _without_swipl(["check", "examples/domains/sis.pl"], tmp_path)
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.strip().splitlines() == [
-        "relrl: SWI-Prolog is not installed: swipl is not on the PATH (make setup installs "
-        "it; or set LIBSWIPL_PATH and SWI_HOME_DIR)"]
+        "relrl check: SWI-Prolog is not installed: swipl is not on the PATH (make setup "
+        "installs it; or set LIBSWIPL_PATH and SWI_HOME_DIR)"]
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["--version"], ["experiment", "worlds", "--help"],
+                                  ["head", "--help"], ["report", "--help"]])
+def test_without_swi_prolog_help_and_the_other_commands_work(argv: list[str],
+                                                             tmp_path) -> None:
+    """The options need no Prolog (the learner registry is asked when a command runs): help
+    and the commands that do not use Prolog (head, perceive, report) run without it."""
+    proc = _without_swipl(argv, tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout and not proc.stderr

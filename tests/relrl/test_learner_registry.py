@@ -90,7 +90,7 @@ def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> 
     assert out["class"] == "PrologLearner"
     assert out["params"] == {**COMMON_DEFAULTS, "bias": 0.5, "rounds": 3.0}
     assert out["world_params"] == {**COMMON_DEFAULTS, "bias": 0.25, "rounds": 7.0}
-    assert out["bad"] == "rounds must be a whole number >= 1, not 0.5"
+    assert out["bad"] == "rounds must be a whole number >= 1, not 0.5 (learner 'toy')"
     assert out["action"] == "c"            # the last allowed of tiny.pl's a, b, c
     assert out["explanation"] == "last_allowed"
 
@@ -99,7 +99,8 @@ def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> 
     (("relrl_engine:learner_property(toy, view(relational)).\n", ""),
      "learner toy: serves worlds but does not read the relational view"),
     (("bias, 0.25, unit", "bias, 1.5, unit"),
-     "learner toy: parameter bias: 1.5 is not a value of kind unit"),
+     "learner toy: parameter bias: 1.5 is not in [0, 1]"),
+    (("bias, 0.25, unit", "bias, 0.25, percent"), "learner toy: parameter bias: unknown kind"),
     (("[rounds=7]", "[round=7]"), "learner toy: worlds: round=7 overrides no parameter"),
     (("relrl_engine:learner_serves(toy, domains, []).\n", "relrl_engine:learner_serves(toy, "
       "robots, []).\n"), "learner toy: unknown family of tasks robots"),
@@ -116,10 +117,11 @@ def test_a_learner_with_bad_declarations_is_an_error(tmp_path: Path, change: tup
 def test_bad_declarations_are_one_line_and_exit_2_at_the_command_line(tmp_path: Path
                                                                        ) -> None:
     proc = _with_learner(tmp_path, TOY.replace("bias, 0.25, unit", "bias, 1.5, unit"),
-                         "-m", "relrl", "learn", "--help")
+                         "-m", "relrl", "learn", "examples/worlds/blocks.pl", "--episodes",
+                         "1")
     assert proc.returncode == 2
-    assert proc.stderr == ("relrl: learner toy: parameter bias: 1.5 is not a value of kind "
-                           "unit (the learners' declarations, prolog/learners.pl)\n")
+    assert proc.stderr == ("relrl learn: learner toy: parameter bias: 1.5 is not in [0, 1] "
+                           "(the learners' declarations, prolog/learners.pl)\n")
 
 
 def _declared_in_source() -> tuple[set[str], set[str], dict[str, dict[str, float]]]:
@@ -184,3 +186,17 @@ def test_families_and_world_defaults() -> None:
         0.0, 0.0, 0.0)
     assert make_learner("tg").params["q_init"] == 30.0
     assert make_world_learner("tg", q_init=5).params["q_init"] == 5.0
+
+
+def test_a_learners_spec_tells_its_parameters_and_families() -> None:
+    from relrl.errors import ConfigError
+    from relrl.learners import learner_spec
+
+    tg = learner_spec("tg")
+    params = {p.name: p for p in tg.parameters}
+    assert params["alpha"].default == 0.2 and params["alpha"].allowed == "in [0, 1]"
+    assert params["min_examples"].allowed == "a whole number >= 3"
+    assert set(tg.serves) == {"domains", "worlds"} and tg.serves["worlds"]["q_init"] == 0.0
+    assert set(learner_spec("ptg").serves) == {"worlds"}
+    with pytest.raises(ConfigError, match="unknown learner 'sarsa'"):
+        learner_spec("sarsa")
