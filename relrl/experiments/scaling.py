@@ -34,22 +34,17 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from relrl.learners import DOMAINS, learners
 from relrl.sim.world import World
 
 __all__ = ["ScalingConfig", "held_out_places", "run_scaling_job"]
-
-
-def _all_learners() -> list[str]:
-    from relrl.learners import DOMAINS, learners
-
-    return list(learners(DOMAINS))
 
 
 @dataclass
 class ScalingConfig:
     """Everything that determines a scaling run (written into results.json)."""
 
-    learners: list[str] = field(default_factory=_all_learners)
+    learners: list[str] = field(default_factory=lambda: list(learners(DOMAINS)))
     sizes: list[int] = field(default_factory=lambda: [5, 9, 17, 33])
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
     #: World fields besides ``places`` (colours, kinds, toys, scene, field).

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from relrl.experiments.protocol import codes_met
+from relrl.learners import DOMAINS, learners
 from relrl.resources import example
 
 __all__ = ["CLAIMS", "DEFAULT_DOMAIN", "PAPER", "PRESETS", "SISConfig", "claims_table",
@@ -134,18 +135,12 @@ def claims_table(claims: dict[str, dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def _all_learners() -> list[str]:
-    from relrl.learners import DOMAINS, learners
-
-    return list(learners(DOMAINS))
-
-
 @dataclass
 class SISConfig:
     """Everything that determines an Experiment 1 run (written into results.json)."""
 
     #: the registered learners (the paper's three, and relrl's own when registered).
-    learners: list[str] = field(default_factory=_all_learners)
+    learners: list[str] = field(default_factory=lambda: list(learners(DOMAINS)))
     seeds: list[int] = field(default_factory=lambda: [0])
     points: int = 20                 #: evaluation points after the first (point 0: no learning)
     block: int = 500                 #: learning time units between evaluations
