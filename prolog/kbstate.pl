@@ -82,18 +82,13 @@ record_get(kb(_, _, _, _, _, _, V), kept, V).
 
 %!  record_set(+Record, +Part, +Value) is semidet.
 %
-%   Part of Record becomes a copy of Value. Fails when Part is not a part.
+%   Part of Record becomes a copy of Value. Fails when Part is not a part. The part's
+%   position is read from record_get/3's clauses (a record of the positions), the one
+%   table of the layout; a part is read by one head unification.
 
 record_set(Record, Part, Value) :-
-    set_part(Part, Record, Value).
-
-set_part(engine, R, V) :- nb_setarg(1, R, V).  % Part first: indexed (the record is not)
-set_part(memory, R, V) :- nb_setarg(2, R, V).
-set_part(units, R, V) :- nb_setarg(3, R, V).
-set_part(learner, R, V) :- nb_setarg(4, R, V).
-set_part(tree, R, V) :- nb_setarg(5, R, V).
-set_part(task, R, V) :- nb_setarg(6, R, V).
-set_part(kept, R, V) :- nb_setarg(7, R, V).
+    record_get(kb(1, 2, 3, 4, 5, 6, 7), Part, I),
+    nb_setarg(I, Record, Value).
 
 %!  kb_get(+KB, +Part, -Value) is det.
 %!  kb_set(+KB, +Part, +Value) is det.

@@ -105,7 +105,6 @@ class LearnerSpec:
     engine: str
     parameters: tuple[Parameter, ...]
     serves: Mapping[str, Mapping[str, float]]
-    properties: tuple[str, ...] = ()
 
     def defaults(self, family: str) -> dict[str, float]:
         """Every parameter's default in ``family``, the common ones first."""
@@ -162,7 +161,6 @@ class Learner(abc.ABC):
         self.name = spec.name
         #: the Prolog learner behind this one (``external`` for a learner choosing in Python)
         self.engine_name = spec.engine
-        self.family = family
         allowed = {p.name: p for p in (*COMMON, *spec.parameters)}
         unknown = sorted(set(params) - set(allowed))
         if unknown:

@@ -104,8 +104,7 @@ def build_registry(entries: list[Term], classes: Mapping[str, type[Learner]]
         spec = LearnerSpec(name=str(name), engine=str(name),
                            parameters=tuple(_parameter(str(name), p) for p in parameters),
                            serves={str(f): {str(o[1]): float(o[2]) for o in overrides}
-                                   for _, f, overrides in serves},
-                           properties=props)
+                                   for _, f, overrides in serves})
         _check_values(spec)
         cls = classes.get(spec.name, PrologLearner)
         if cls.python_spec is not None:
