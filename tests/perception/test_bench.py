@@ -1,5 +1,6 @@
 """perception.bench: the photo case, its stage breakdown and the two-thread figures."""
 
+import threading
 import time
 
 import perception
@@ -34,19 +35,29 @@ def test_free_cores_clock_replays_a_fifo_pool_from_cpu_times():
             tasks = [pool.submit(_burn, 0.05) for _ in range(4)]
             assert [t.result() for t in tasks] == [0.05] * 4
             assert expected <= pool.elapsed() < expected + 0.04
-        # a task cancelled before it starts costs nothing; the caller's own CPU time counts
+        # a task cancelled before it starts costs nothing; the caller's own CPU time counts.
+        # The first two hold both workers until the late ones are cancelled, so which late
+        # tasks run does not depend on how fast this thread is scheduled.
         two.restart()
-        first = [two.submit(_burn, 0.05) for _ in range(2)]
+        gate = threading.Event()
+        first = [two.submit(_burn_then_wait, 0.05, gate) for _ in range(2)]
         late = [two.submit(_burn, 0.05) for _ in range(10)]
+        assert all(t.cancel() for t in late[3:])
+        gate.set()
         first[0].result()
         first[1].result()
-        ran = [t for t in late if not t.cancel()]
+        ran = late[:3]
         for t in ran:
             t.result()
         _burn(0.02)
-        assert len(ran) < len(late)
-        expected = 0.05 + 0.05 * -(-len(ran) // 2) + 0.02
+        expected = 0.05 + 0.05 * 2 + 0.02  # three late tasks on two workers after the first two
         assert expected <= two.elapsed() < expected + 0.04
     finally:
         two.shutdown()
         one.shutdown()
+
+
+def _burn_then_wait(seconds: float, gate: threading.Event) -> float:
+    _burn(seconds)
+    gate.wait()  # blocked, not burning: no thread CPU time
+    return seconds
