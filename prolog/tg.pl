@@ -4,7 +4,8 @@
             tg_state/2,           % +KB, -Facts
             tg_q/5,               % +KB, +Facts, +Action, +Necessity, -Q
             tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
-            tg_class_values/6,    % +KB, +Facts, +Necessity, +Allowed, -Classes, -Qs
+            tg_class_values/7,    % +KB, +Facts, +Necessity, +Allowed, +Scope, -Classes, -Qs
+            tg_leaf_groups/3,     % +KB, +Scope, -Groups
             tg_bonus/5,           % +KB, +Facts, +Action, +Necessity, -Bonus
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
@@ -16,6 +17,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(random)).
+:- use_module(library(pairs)).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(tg_bias).
@@ -170,15 +172,27 @@ tg_q(KB, Facts, Action, N, Q) :-
 %   Explore and greedy choices, and the Q-targets, never include either bonus.
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
-    Allowed = [_|_],
     tg_data(KB, D),
+    D = tg(p(_, _, _, _, _, _, _, _, novelty(Beta, _), _), _, _, _, _, _),
+    (   Allowed = actions(_, _),                % a world's legal actions (world.pl)
+        \+ ( Mode == learn, Beta > 0 )
+    ->  world_choose(D, KB, Facts, N, Allowed, Mode, Action)
+    ;   class_choose(D, KB, Facts, N, Allowed, Mode, Action)
+    ).
+
+%   The choice over classes found first (a domain's; a world's with the novelty bonus, which
+%   each class's witness is tested for).
+class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
+    (   Allowed = actions(_, _)
+    ->  true
+    ;   Allowed = [_|_]
+    ),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
            Version, Clock, Index),
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
-    ;   classes(KB, Index, Facts, Allowed, Classes),
-        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   classes(KB, Index, Facts, N, Allowed, all, Classes, Ids)
     ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
@@ -200,7 +214,10 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
             random_member(Item, Ties)
         ),
         (   Item = hits(Class, Leaf, Hits)
-        ->  Noted = chose(Action, Leaf, Hits)
+        ->  (   Class = cls(_, leaf(_, _, _, _, _))
+            ->  Noted = none                    % the hits were the witness's, not the
+            ;   Noted = chose(Action, Leaf, Hits)   % member's that is drawn
+            )
         ;   Class = Item,
             Noted = none
         )
@@ -211,14 +228,55 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     ;   note_choice(Cache, Facts, N, Version, Noted)
     ).
 
-%!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, -Classes, -Qs) is det.
+%   A world's choice (tg_classes:tg_leaf_search/5): the leaves' values are known without a
+%   search, and a leaf is searched only when the choice would take it. Greedy: the leaves
+%   by their value from the largest down, until a group of equal value has a class (ties at
+%   random). Boltzmann: a leaf drawn with probability proportional to exp(Q / T), searched,
+%   and drawn again without it while no legal action reaches it: each class is taken with
+%   probability proportional to exp(Q / T) among the classes, as when every class is found
+%   first. Epsilon: the leaves in a random order, the first a legal action reaches.
+world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _), Leaves, _, _, Clock, Index),
+    tg_leaf_search(KB, Facts, N, Actions, Search),
+    tg_leaves_(KB, Ids, _),
+    (   Mode == learn, Kappa > 0
+    ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
+    ;   maplist(leaf_q(Leaves), Ids, Qs)
+    ),
+    (   Mode \== greedy, Tau =:= 0,
+        random_float < Epsilon
+    ->  tg_leaf_any(Search, Ids, Class)
+    ;   Mode \== greedy, Tau > 0
+    ->  softmax_leaf(Search, Qs, Ids, Tau, Class)
+    ;   q_ordered_groups(Qs, Ids, Groups),
+        tg_leaf_classes(Search, Groups, Ties, _),
+        random_member(Class, Ties)
+    ),
+    tg_class_member(Index, Class, Action).
+
+softmax_leaf(Search, Qs, Ids, Tau, Class) :-
+    max_list(Qs, Best),
+    weights(Qs, Best, Tau, Ws, 0.0, Total),
+    X is random_float * Total,
+    pick(Ws, Ids, X, Id),
+    (   tg_leaf_reached(Search, Id, Class0)
+    ->  Class = Class0
+    ;   once(nth1(I, Ids, Id, Ids1)),
+        nth1(I, Qs, _, Qs1),
+        softmax_leaf(Search, Qs1, Ids1, Tau, Class)
+    ).
+
+%!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, +Scope, -Classes, -Qs) is det.
 %
 %   Classes are the classes of the Allowed responses in the state Facts (every response
 %   when Allowed is []), as tg_choose/6 chooses among them (cls(Representative, Pick)
-%   terms, tg_classes.pl), and Qs their representatives' Q. The last update's look-up of
-%   the same state is reused while the tree is unchanged.
+%   terms, tg_classes.pl), and Qs their representatives' Q. Scope `all`: every class;
+%   `best`: for a world's actions, only the classes of the largest Q (the other leaves of
+%   the tree are not searched; a domain's classes are all found either way). The last
+%   update's look-up of the same state is reused while the tree is unchanged.
 
-tg_class_values(KB, Facts, N, Allowed0, Classes, Qs) :-
+tg_class_values(KB, Facts, N, Allowed0, Scope, Classes, Qs) :-
+    must_be(oneof([all, best]), Scope),
     tg_data(KB, D),
     D = tg(_, Leaves, Cache, Version, _, Index),
     (   Allowed0 == []
@@ -228,8 +286,7 @@ tg_class_values(KB, Facts, N, Allowed0, Classes, Qs) :-
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
-    ;   classes(KB, Index, Facts, Allowed, Classes),
-        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   classes(KB, Index, Facts, N, Allowed, Scope, Classes, Ids)
     ),
     maplist(leaf_q(Leaves), Ids, Qs).
 
@@ -244,13 +301,62 @@ note_choice(Cache, Facts, N, Version, Noted) :-
     ;   true
     ).
 
-%   The classes of the Allowed responses in the state Facts; when no constraint rule
-%   forbids a response (Allowed is the engine's own list of every response) they come from
-%   the index without a pass over the responses.
-classes(KB, Index, Facts, Allowed, Classes) :-
-    (   engine_all_allowed(KB, Allowed)
-    ->  tg_classes(Index, Facts, Allowed, true, Classes)
-    ;   tg_classes(Index, Facts, Allowed, false, Classes)
+%   The classes of the Allowed responses in the state Facts and the leaves their
+%   representatives sort to. A world's legal actions (actions(A, Goal), world.pl): the
+%   leaves some legal action reaches (tg_leaf_classes/7), all of them (Scope `all`) or,
+%   searching the leaves by their Q from the largest down, those of the largest Q that
+%   some legal action reaches (Scope `best`: what a greedy choice and a Q-target read). A
+%   domain's responses (Scope is not used): when no constraint rule forbids a response
+%   (Allowed is the engine's own list of every response) the classes come from the index
+%   without a pass over the responses.
+classes(KB, Index, Facts, N, Allowed, Scope, Classes, Ids) :-
+    (   Allowed = actions(_, _)
+    ->  tg_leaf_groups(KB, Scope, Groups),
+        tg_leaf_search(KB, Facts, N, Allowed, Search),
+        tg_leaf_classes(Search, Groups, Classes, Ids)
+    ;   engine_all_allowed(KB, Allowed)
+    ->  tg_classes(Index, Facts, Allowed, true, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   tg_classes(Index, Facts, Allowed, false, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ).
+
+%!  tg_leaf_groups(+KB, +Scope, -Groups:list) is det.
+%
+%   Groups are the leaves of KB's tree to search for classes of a world's actions
+%   (tg_classes:tg_leaf_classes/4): Scope `all`, every leaf in one group; `best`, the leaves
+%   grouped by their Q, the largest first (leaves of one Q in tree order).
+
+tg_leaf_groups(KB, Scope, Groups) :-
+    must_be(oneof([all, best]), Scope),
+    tg_leaves_(KB, Ids, _),
+    (   Scope == all
+    ->  Groups = [Ids]
+    ;   tg_data(KB, D),
+        arg(2, D, Leaves),
+        maplist(leaf_q(Leaves), Ids, Qs),
+        q_ordered_groups(Qs, Ids, Groups)
+    ).
+
+%   The leaves Ids grouped by their values Qs, the largest first (a stable sort: leaves of
+%   one value in the order given).
+q_ordered_groups(Qs, Ids, Groups) :-
+    pairs_keys_values(Keyed, Qs, Ids),
+    sort(1, @>=, Keyed, ByQ),
+    q_groups(ByQ, Groups).
+
+q_groups([], []).
+q_groups([Q-Id|More], [[Id|Ids]|Groups]) :-
+    same_q(More, Q, Ids, Rest),
+    q_groups(Rest, Groups).
+
+same_q([], _, [], []).
+same_q([Q1-Id|More], Q, Ids, Rest) :-
+    (   Q1 =:= Q
+    ->  Ids = [Id|Ids1],
+        same_q(More, Q, Ids1, Rest)
+    ;   Ids = [],
+        Rest = [Q1-Id|More]
     ).
 
 class_leaf(KB, Facts, N, cls(A, _), Leaf) :-
@@ -375,12 +481,14 @@ tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
-    classes(KB, Index, S1, Next, Classes),
-    maplist(class_leaf(KB, S1, N1), Classes, Ids),
+    classes(KB, Index, S1, N1, Next, best, Classes, Ids),
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none)),
+    (   Next = actions(_, _)                    % a world's: only the best classes were
+    ->  nb_setarg(3, D, none)                   % found, not what a choice needs
+    ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
+    ),
     insert(KB, D, S0, A0, N0, Known, Target).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
