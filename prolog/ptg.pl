@@ -16,10 +16,11 @@
 :- use_module(library(pairs)).
 :- use_module(library(random)).
 :- use_module(tg).
-:- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3]).
+:- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3,
+                         tg_sort_/5]).
 :- use_module(kbstate, [kb_forget/1]).
-:- use_module(tg_classes, [tg_class_member/3, tg_class_members/2, tg_leaf_search/5,
-                            tg_leaf_classes/4, tg_leaf_any/3]).
+:- use_module(tg_classes, [tg_class_members/2, tg_leaf_search/5, tg_leaf_classes/4,
+                            tg_leaf_reached/3]).
 
 /** <module> ptg: P-learning beside TG's Q-tree
 
@@ -39,13 +40,14 @@ ptg is tg (tg.pl) with a second tree:
     Boltzmann exploration over classes of responses);
   - **the P-tree** is a tree of the same code (tg_init/3 under the key of ptg_key/2): the
     same language bias and candidate tests, examples (state, action, 0/1). After each
-    transition into a state s' that is not terminal, the Q-tree labels the classes of
-    responses allowed in s' (tg_class_values/7, the values the Q-target's max was taken
-    over): a class is optimal when its Q is within `p_margin` of the best. `p_pairs` times,
-    one optimal class and one that is not (when there is one), drawn uniformly, are
-    inserted with targets 1 and 0: the P-tree learns to tell them apart with as many
-    examples of each, and a learning step inserts a fixed number of P-examples whatever the
-    number of responses (RRL labels every action of every state it met);
+    transition into a state s' that is not terminal, the Q-tree labels the actions legal
+    in s': an action is optimal when the Q of its leaf is within `p_margin` of the best.
+    `p_pairs` times, one optimal action and one that is not (when there is one), each drawn
+    uniformly among the actions of its label, are inserted with targets 1 and 0: the P-tree
+    learns to tell them apart with as many examples of each, and a learning step inserts a
+    fixed number of P-examples whatever the number of actions (RRL labels every action of
+    every state it met). Uniform over actions, not over the Q-tree's leaves: a label drawn
+    by leaf would over-weigh the leaves of the regions the Q-tree splits finely;
   - **greedy choices** (evaluation, acting on a learned policy) are by P, ties by Q, further
     ties at random: a leaf's P is the share of its examples the Q-tree found optimal, so the
     class most often optimal in states like this one wins.
@@ -117,12 +119,11 @@ ptg_p(KB, Facts, A, N, P) :-
 %!  ptg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
 %   With Mode greedy, Action is a legal action (Allowed: a world's actions(A, Goal) term,
-%   world.pl) with the largest P, ties broken by the largest Q, then at random: the classes
-%   are the P-tree's leaves some legal action reaches (tg_classes:tg_leaf_classes/7), of
-%   which only those of the largest P are searched for; their members are sorted down the
-%   Q-tree. With Mode learn or
-%   explore, tg's choice (tg_choose/6: Boltzmann over the Q-tree's classes, with its
-%   bonuses while learning).
+%   world.pl) with the largest P, ties broken by the largest Q, then at random: the P-tree's
+%   leaves are searched from the largest P down until a legal action reaches one
+%   (tg_class_values/7, scope best), and the members of those of that P are sorted down
+%   the Q-tree. With Mode learn or explore, tg's choice (tg_choose/6: Boltzmann over the
+%   Q-tree's classes, with its bonuses while learning).
 
 ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     (   Mode == greedy
@@ -143,12 +144,13 @@ ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
 %!  ptg_update(+KB, +Transition) is det.
 %
 %   Learn from a transition as tg does (tg_update/2); then, unless its next state is
-%   terminal, label the classes of the actions legal there by the Q-tree and insert p_pairs
-%   pairs of P-examples (an optimal class, target 1; one that is not, target 0), each a
-%   class drawn uniformly among those of its label and a member of it uniformly. The
-%   classes are the leaves of the Q-tree a legal action reaches (tg_classes.pl): the best
-%   is found by searching the leaves from the largest Q down, a class of a label by
-%   searching that label's leaves in a random order (tg_leaf_any/3).
+%   terminal, label the actions legal there by the Q-tree and insert p_pairs pairs of
+%   P-examples: an optimal action (its leaf's Q within p_margin of the best), target 1, and
+%   one that is not (when there is one), target 0, each drawn uniformly among the legal
+%   actions of its label. The best Q is found by searching the Q-tree's leaves from the
+%   largest Q down (tg_classes.pl); the optimal actions are the members of the optimal
+%   leaves a legal action reaches; the other is found by sorting the legal actions, in a
+%   random order, until one reaches a leaf that is not optimal.
 
 ptg_update(KB, T) :-
     tg_update(KB, T),
@@ -165,10 +167,8 @@ ptg_update(KB, T) :-
         tg_leaves_(KB, Ids, _),
         partition(optimal_leaf(KB, Cut), Ids, Optimal, Other),
         ptg_key(KB, PK),
-        tg_data(KB, D),
-        arg(6, D, Index),
         forall(between(1, Pairs, _),
-               label_pair(PK, Index, Search, S1, N1, Optimal, Other))
+               label_pair(KB, PK, Search, S1, N1, Optimal, Other))
     ).
 
 optimal_leaf(KB, Cut, Id) :-
@@ -176,13 +176,24 @@ optimal_leaf(KB, Cut, Id) :-
     arg(1, L, Q),
     Q >= Cut.
 
-label_pair(PK, Index, Search, S, N, Optimal, Other) :-
-    tg_leaf_any(Search, Optimal, C),
-    tg_class_member(Index, C, A),
-    tg_insert(PK, S, A, N, 1),
-    (   tg_leaf_any(Search, Other, C1)
-    ->  tg_class_member(Index, C1, B),
-        tg_insert(PK, S, B, N, 0)
+%   An optimal action, uniformly among the legal actions of the optimal leaves (their
+%   members), and one that is not, uniformly among the other legal actions (the legal
+%   actions in a random order, each sorted until one reaches a leaf that is not optimal).
+label_pair(KB, PK, Search, S, N, Optimal, Other) :-
+    findall(A, ( member(Id, Optimal),
+                 tg_leaf_reached(Search, Id, C),
+                 tg_class_members(C, Ms),
+                 member(A, Ms) ), Good),
+    random_member(G, Good),
+    tg_insert(PK, S, G, N, 1),
+    Search = search(_, _, _, actions(B0, Goal), _),
+    findall(B0, Goal, Legal0),
+    list_to_set(Legal0, Legal),
+    random_permutation(Legal, Order),
+    (   member(B, Order),
+        tg_sort_(KB, S, B, N, Leaf),
+        memberchk(Leaf, Other)
+    ->  tg_insert(PK, S, B, N, 0)
     ;   true
     ).
 

@@ -231,10 +231,14 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
 %   A world's choice (tg_classes:tg_leaf_search/5): the leaves' values are known without a
 %   search, and a leaf is searched only when the choice would take it. Greedy: the leaves
 %   by their value from the largest down, until a group of equal value has a class (ties at
-%   random). Boltzmann: a leaf drawn with probability proportional to exp(Q / T), searched,
-%   and drawn again without it while no legal action reaches it: each class is taken with
+%   random), and a member of it uniformly. Epsilon (temperature 0, the worlds' default): a
+%   legal action uniformly — over the world's actions, not over the leaves, whose number
+%   grows where the tree has split: exploring over leaves draws exploration to the regions
+%   the tree already splits finely (docs/tg.md). Boltzmann (temperature > 0): over the
+%   leaves, a leaf drawn with probability proportional to exp(Q / T), searched, and drawn
+%   again without it while no legal action reaches it — each class is taken with
 %   probability proportional to exp(Q / T) among the classes, as when every class is found
-%   first. Epsilon: the leaves in a random order, the first a legal action reaches.
+%   first — then a member uniformly.
 world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _), Leaves, _, _, Clock, Index),
     tg_leaf_search(KB, Facts, N, Actions, Search),
@@ -245,14 +249,18 @@ world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
     ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  tg_leaf_any(Search, Ids, Class)
-    ;   Mode \== greedy, Tau > 0
-    ->  softmax_leaf(Search, Qs, Ids, Tau, Class)
-    ;   q_ordered_groups(Qs, Ids, Groups),
-        tg_leaf_classes(Search, Groups, Ties, _),
-        random_member(Class, Ties)
-    ),
-    tg_class_member(Index, Class, Action).
+    ->  Actions = actions(A, Goal),             % a legal action uniformly: the world
+        findall(A, Goal, As0),                  % lists them (world_legal/3's order)
+        list_to_set(As0, As),
+        random_member(Action, As)
+    ;   (   Mode \== greedy, Tau > 0
+        ->  softmax_leaf(Search, Qs, Ids, Tau, Class)
+        ;   q_ordered_groups(Qs, Ids, Groups),
+            tg_leaf_classes(Search, Groups, Ties, _),
+            random_member(Class, Ties)
+        ),
+        tg_class_member(Index, Class, Action)
+    ).
 
 softmax_leaf(Search, Qs, Ids, Tau, Class) :-
     max_list(Qs, Best),
@@ -811,7 +819,8 @@ relrl_engine:learner_parameter(tg, novelty_bonus, 20.0, nonneg).
 relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
 relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
 relrl_engine:learner_serves(tg, domains, []).
-relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0]).
+relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
+                                          temperature=0.0]).
 
 relrl_engine:learner_forget(tg, KB) :-
     tg_forget(KB).

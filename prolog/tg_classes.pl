@@ -4,7 +4,6 @@
             tg_leaf_search/5,     % +KB, +Facts, +Necessity, +Actions, -Search
             tg_leaf_reached/3,    % +Search, +LeafId, -Class
             tg_leaf_classes/4,    % +Search, +Groups, -Classes, -LeafIds
-            tg_leaf_any/3,        % +Search, +LeafIds, -Class
             tg_class_member/3,    % +Index, +Class, -Action
             tg_class_members/2,   % +Class, -Actions
             tg_class_size/3,      % +Index, +Class, -Size
@@ -51,20 +50,24 @@ actions legal in a state come with it, as a goal that binds an action template t
 appears in on/2), so no two ground actions share a signature and a class of signatures
 would be one action: N blocks on the floor have N(N - 1) moves. What the learner reads
 of an action is the leaf of its Q-tree it sorts to, so its classes are the leaves that
-some legal action reaches (tg_leaf_search/5), found without listing the actions: for each
-leaf, left to right, the leaf's path query (its tests on the yes-branches, tg_path_/5) is
-proved with the action open, which binds the action's arguments from the state's facts
-(action(move(B, floor)), on(B1, floor) ...), the world's goal completes the action
-(precondition/2 with a partly bound template), and the action is sorted down the tree
-(tg_sort_/5, which also holds the tests of the no-branches). Every action so sorted marks
-the leaf it reaches, and a leaf's search stops at the first action that reaches it: a leaf
-already marked is not searched. A class is cls(Witness, leaf(...)), scored by its leaf's
-Q; the member drawn when it is chosen is uniform over the legal actions that reach its
-leaf (tg_class_member/3: the leaf's path query, the world's goal and the sort enumerate
-them). The search of a leaf whose path query binds the action's arguments costs the
-solutions of that query; that of a leaf whose path binds none (a no-branch below the
-root's test: the world's goal alone proposes actions) costs as many legal actions as come
-before the first that reaches it, and all of them when none does (docs/tg.md, *Classes*).
+some legal action reaches, found without listing the actions (tg_leaf_search/5): a leaf's
+path query (its tests on the yes-branches, tg_path_/5) is proved with the action open,
+which binds the action's arguments from the state's facts (action(move(B, floor)),
+on(B1, floor) ...), the world's goal completes the action (precondition/2 with a partly
+bound template), and the action is sorted down the tree (tg_sort_/5, which also holds the
+tests of the no-branches). Every action so sorted marks the leaf it reaches, a leaf's search
+stops at the first action that reaches it, and a leaf is searched at most once per state
+and tree, only when asked about (tg_leaf_reached/3): a greedy choice or a Q-target asks
+about the leaves from the largest Q down (tg_leaf_classes/4), a Boltzmann choice about the
+leaves it draws (tg.pl). A class is cls(Witness, leaf(...)), scored by its leaf's Q; its
+member is drawn uniformly among the legal actions that reach its leaf (tg_class_member/3:
+the leaf's path query, the world's goal and the sort enumerate them).
+
+**Cost of a world's classes.** A leaf whose path query binds the action's arguments costs
+the solutions of that query; one whose path binds none (below the root's no-branch: the
+world's goal alone proposes actions) costs as many legal actions as come before the first
+that reaches it, all of them when none does. Drawing a member lists the chosen class
+(docs/tg.md, *Classes of a world's actions*).
 */
 
 %!  tg_response_index(+Bias, +Responses:list, -Index) is det.
@@ -252,8 +255,7 @@ group_class(Rs, [I|Is], cls(Rep, Pick)) :-
 %
 %   Search is a search of the leaves of KB's tree that a world's legal actions reach in
 %   the state Facts (Actions = actions(A, Goal), Goal binding A to each legal action,
-%   world_actions/3): tg_leaf_reached/3, tg_leaf_classes/4 and tg_leaf_any/3 ask it about
-%   leaves, and a leaf is searched at most once per Search, when first asked about or when
+%   world_actions/3): tg_leaf_reached/3 and tg_leaf_classes/4 ask it about leaves, and a leaf is searched at most once per Search, when first asked about or when
 %   an action found for another leaf reaches it.
 
 tg_leaf_search(KB, Facts, N, Actions, search(KB, Facts, N, Actions, Seen)) :-
@@ -290,18 +292,6 @@ first_group([Group|Groups], Search, Pairs) :-
     ->  first_group(Groups, Search, Pairs)
     ;   Pairs = Pairs0
     ).
-
-%!  tg_leaf_any(+Search, +LeafIds:list, -Class) is semidet.
-%
-%   Class is the class of a leaf of LeafIds that some legal action reaches, drawn uniformly
-%   among those (library(random)): the leaves are searched in a random order until one is
-%   reached, so that the others need not be.
-
-tg_leaf_any(Search, Ids, Class) :-
-    random_permutation(Ids, Order),
-    member(Id, Order),
-    tg_leaf_reached(Search, Id, Class),
-    !.
 
 %   Unless leaf Id was searched or is known to be reached: the candidates of its path
 %   query, completed by the world and sorted, each marking the leaf it reaches, until one

@@ -61,7 +61,9 @@ a size and a start state, then choose, act, reward and learn until the goal hold
 bound is reached or no action is legal. The learner is the knowledge base's configured one
 (engine_configure/4), reached through the engine's learner hooks (learner_choose/7,
 learner_update/3), and it draws from the knowledge base's own random stream, as in a
-control step. A transition into the goal is terminal: its Q-target is the reward alone
+control step. The learner gets a state's legal actions as a goal, not a list
+(world_actions/3): it asks what it reads, and the runner only whether some action is
+legal. A transition into the goal is terminal: its Q-target is the reward alone
 (learner_update/3 with `terminal` for the next state). With updates(episode) (RRL's) the
 examples of an episode are given to the learner when it ends, last first, so a reward
 reaches the start of the episode within one episode; with updates(online) each step's
