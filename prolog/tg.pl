@@ -150,7 +150,10 @@ tg_q(KB, Facts, Action, N, Q) :-
 %
 %   Action is one of the Allowed responses, chosen over the *classes* of responses no test
 %   of the language bias tells apart in the state Facts (tg_classes.pl): each class is
-%   scored by one representative, a class is chosen, and a member of it uniformly. With
+%   scored by one representative, a class is chosen, and a member of it uniformly. Allowed
+%   is a list of responses, or a world's legal actions as a goal (actions(A, Goal),
+%   world.pl), whose classes are the leaves a legal action reaches and whose exploring
+%   choice with temperature 0 is over the legal actions (world_choose/7 below). With
 %   Mode learn or explore: with temperature T > 0, a class is drawn with probability
 %   proportional to exp(Q / T) (Boltzmann exploration); with T = 0, a random class with
 %   probability epsilon and otherwise a greedy one. With Mode greedy, one with the largest
@@ -247,32 +250,107 @@ world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
     ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
     ;   maplist(leaf_q(Leaves), Ids, Qs)
     ),
+    pairs_keys_values(Valued, Qs, Ids),
+    sort(1, @>=, Valued, ByQ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  Actions = actions(A, Goal),             % a legal action uniformly: the world
-        findall(A, Goal, As0),                  % lists them (world_legal/3's order)
-        list_to_set(As0, As),
-        random_member(Action, As)
-    ;   (   Mode \== greedy, Tau > 0
-        ->  softmax_leaf(Search, Qs, Ids, Tau, Class)
-        ;   q_ordered_groups(Qs, Ids, Groups),
-            tg_leaf_classes(Search, Groups, Ties, _),
-            random_member(Class, Ties)
-        ),
+    ->  legal_list(Actions, Legal),
+        tg_symmetry(Index, Facts, Sym),
+        uniform_class_action(Sym, Legal, Action)
+    ;   Mode \== greedy, Tau > 0
+    ->  tg_symmetry(Index, Facts, Sym),
+        boltzmann_action(KB, Facts, N, Actions, Sym, Search, ByQ, Tau, Action)
+    ;   q_groups(ByQ, Groups),
+        tg_leaf_classes(Search, Groups, Ties, _),
+        random_member(Class, Ties),
         tg_class_member(Index, Class, Action)
     ).
 
-softmax_leaf(Search, Qs, Ids, Tau, Class) :-
-    max_list(Qs, Best),
-    weights(Qs, Best, Tau, Ws, 0.0, Total),
-    X is random_float * Total,
-    pick(Ws, Ids, X, Id),
-    (   tg_leaf_reached(Search, Id, Class0)
-    ->  Class = Class0
-    ;   once(nth1(I, Ids, Id, Ids1)),
-        nth1(I, Qs, _, Qs1),
-        softmax_leaf(Search, Qs1, Ids1, Tau, Class)
+%   A class of the legal actions uniformly (the actions no test could tell apart, tg_classes'
+%   signatures), then a member of it uniformly: a legal action uniformly, accepted with
+%   probability 1 / the size of its class.
+uniform_class_action(Sym, Legal, Action) :-
+    random_member(A, Legal),
+    tg_symmetric(Sym, A, Legal, K),
+    (   random_float * K < 1
+    ->  Action = A
+    ;   uniform_class_action(Sym, Legal, Action)
     ).
+
+%   The legal actions, listed by the world (world_legal/3's order).
+legal_list(actions(A, Goal), Legal) :-
+    findall(A, Goal, Legal0),
+    list_to_set(Legal0, Legal).
+
+%   Boltzmann over the classes of the legal actions, tg's choice over classes of responses
+%   (tg_classes.pl: actions no test of the bias could tell apart in the state, which in
+%   blocks world are the single moves), a class with probability proportional to
+%   exp(Q / T) and a member uniformly: each legal action m with probability proportional to
+%   w(m) / k(m), w(m) = exp((Q(m) - Q*) / T), Q(m) its leaf's value, Q* the best value a
+%   legal action reaches, k(m) the size of its class (tg_symmetric/4). By rejection: a
+%   proposal is, with probability 1/2 each, a member of the best leaves uniformly (the set
+%   B) or a legal action uniformly (the world's list, M actions), so q(m) = [m in B] / 2|B|
+%   + 1 / 2M; it is sorted to its leaf and accepted with probability w(m) / (k(m) C q(m)),
+%   C = max(2|B|, 2M w2), w2 the weight of the next value a legal action reaches, so that
+%   w(m) / k(m) <= C q(m) for every m: the action taken is drawn exactly. A proposal is
+%   accepted with probability (sum over classes of w) / C: at least 1/2 when the classes
+%   are single actions and the best leaves stand well above the rest (C = 2|B|), about the
+%   mean weight over 2 w2 when they do not. Cost: the world's list, the members of the best
+%   leaves, a sort per proposal (not every legal action valued).
+boltzmann_action(KB, Facts, N, Actions, Sym, Search, ByQ, Tau, Action) :-
+    q_groups(ByQ, Groups),
+    reached_groups(Groups, ByQ, Search, Best-QBest, Next),
+    findall(A, ( member(Id, Best),
+                 tg_leaf_reached(Search, Id, C),
+                 tg_class_members(C, Ms),
+                 member(A, Ms) ), Members),
+    length(Members, NB),
+    legal_list(Actions, Legal),
+    length(Legal, M),
+    (   Next = _-Q2
+    ->  W2 is exp((Q2 - QBest) / Tau)
+    ;   W2 = 0.0
+    ),
+    Bound is max(2 * NB, 2 * M * W2),
+    Draw = draw(KB, Facts, N, Sym, ByQ, Tau, QBest, Best, Members, NB, Legal, M, Bound),
+    propose(Draw, Action).
+
+propose(Draw, Action) :-
+    Draw = draw(KB, Facts, N, Sym, ByQ, Tau, QBest, Best, Members, NB, Legal, M, Bound),
+    (   random_float < 0.5
+    ->  random_member(A, Members)
+    ;   random_member(A, Legal)
+    ),
+    tg_sort_(KB, Facts, A, N, Leaf),
+    memberchk(Q-Leaf, ByQ),
+    W is exp((Q - QBest) / Tau),
+    (   memberchk(Leaf, Best)
+    ->  QA is 0.5 / NB + 0.5 / M
+    ;   QA is 0.5 / M
+    ),
+    tg_symmetric(Sym, A, Legal, K),
+    (   random_float * Bound * QA * K < W
+    ->  Action = A
+    ;   propose(Draw, Action)
+    ).
+
+%   The reached leaves of the first group of leaves (by value, the largest first) that a
+%   legal action reaches, with its value, and the value of the next such group (or none).
+reached_groups(Groups, ByQ, Search, Best-QBest, Next) :-
+    append(_, [Group|Rest], Groups),
+    include(reached(Search), Group, Best),
+    Best = [Id|_],
+    !,
+    memberchk(QBest-Id, ByQ),
+    (   append(_, [G2|_], Rest),
+        include(reached(Search), G2, [Id2|_])
+    ->  memberchk(Q2-Id2, ByQ),
+        Next = Id2-Q2
+    ;   Next = none
+    ).
+
+reached(Search, Id) :-
+    tg_leaf_reached(Search, Id, _).
 
 %!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, +Scope, -Classes, -Qs) is det.
 %
@@ -343,15 +421,10 @@ tg_leaf_groups(KB, Scope, Groups) :-
     ;   tg_data(KB, D),
         arg(2, D, Leaves),
         maplist(leaf_q(Leaves), Ids, Qs),
-        q_ordered_groups(Qs, Ids, Groups)
+        pairs_keys_values(Keyed, Qs, Ids),
+        sort(1, @>=, Keyed, ByQ),                   % stable: one value in tree order
+        q_groups(ByQ, Groups)
     ).
-
-%   The leaves Ids grouped by their values Qs, the largest first (a stable sort: leaves of
-%   one value in the order given).
-q_ordered_groups(Qs, Ids, Groups) :-
-    pairs_keys_values(Keyed, Qs, Ids),
-    sort(1, @>=, Keyed, ByQ),
-    q_groups(ByQ, Groups).
 
 q_groups([], []).
 q_groups([Q-Id|More], [[Id|Ids]|Groups]) :-
@@ -805,7 +878,9 @@ relrl_engine:learner_property(tg, Cap) :-
 %   measurement on Experiment 1's task). In worlds, whose rewards are of size 1, Q starts
 %   at 0 and both exploration bonuses are off: the novelty bonus's candidate tests for every
 %   action of every choice made a learning step 17 times slower on 10-block states, and the
-%   goal tasks were learned as well without it (docs/worlds.md).
+%   goal tasks were learned as well without it; exploring is epsilon-greedy over the legal
+%   actions (temperature 0: Boltzmann would be over the classes, the tree's leaves, and
+%   draw exploration to where the tree has split most; docs/worlds.md).
 relrl_engine:learner_parameter(tg, alpha, 0.2, unit).
 relrl_engine:learner_parameter(tg, gamma, 0.9, unit).
 relrl_engine:learner_parameter(tg, epsilon, 0.05, unit).
@@ -819,8 +894,7 @@ relrl_engine:learner_parameter(tg, novelty_bonus, 20.0, nonneg).
 relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
 relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
 relrl_engine:learner_serves(tg, domains, []).
-relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
-                                          temperature=0.0]).
+relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0]).
 
 relrl_engine:learner_forget(tg, KB) :-
     tg_forget(KB).

@@ -7,7 +7,9 @@
             tg_class_member/3,    % +Index, +Class, -Action
             tg_class_members/2,   % +Class, -Actions
             tg_class_size/3,      % +Index, +Class, -Size
-            tg_signature/3        % +Response, +Known, -Signature
+            tg_signature/3,       % +Response, +Known, -Signature
+            tg_symmetry/3,        % +Index, +Facts, -Symmetry
+            tg_symmetric/4        % +Symmetry, +Action, +Actions, -Count
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -15,6 +17,7 @@
 :- use_module(library(pairs)).
 :- use_module(library(assoc)).
 :- use_module(library(random)).
+:- use_module(library(aggregate)).
 :- use_module(tg_bias, [bias_constants/2, term_constant/2]).
 :- use_module(tg_tree, [tg_sort_/5, tg_path_/5, tg_leaves_/3]).
 
@@ -311,6 +314,29 @@ search_leaf(search(KB, Facts, N, actions(A, Goal), Seen), Id) :-
                 Leaf == Id )
     ->  true
     ;   nb_setarg(Id, Seen, empty)
+    ).
+
+%!  tg_symmetry(+Index, +Facts, -Symmetry) is det.
+%
+%   Symmetry is what tg_symmetric/4 needs to tell, in the state Facts, which actions no
+%   test of the bias could tell apart: the constants the bias or the state names.
+
+tg_symmetry(rindex(_, Known, _, _, _), Facts, known(Known, StateAtoms)) :-
+    state_atoms(Facts, Known, StateAtoms).
+
+%!  tg_symmetric(+Symmetry, +Action, +Actions:list, -Count:integer) is det.
+%
+%   Count is the number of Actions (a world's legal actions) with Action's signature: the
+%   actions no test of the bias could tell from Action in the state (they differ only in
+%   constants neither the bias nor the state names). 1 without a look at Actions when
+%   every constant of Action is named (every block of blocks world is in its state).
+
+tg_symmetric(Known, Action, Actions, Count) :-
+    (   \+ ( term_constant(Action, C), \+ known(Known, C) )
+    ->  Count = 1
+    ;   tg_signature(Action, Known, Sig),
+        aggregate_all(count, ( member(B, Actions), tg_signature(B, Known, SigB),
+                               SigB =@= Sig ), Count)
     ).
 
 %!  tg_class_members(+Class, -Actions:list) is det.
