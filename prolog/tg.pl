@@ -152,8 +152,8 @@ tg_q(KB, Facts, Action, N, Q) :-
 %   of the language bias tells apart in the state Facts (tg_classes.pl): each class is
 %   scored by one representative, a class is chosen, and a member of it uniformly. Allowed
 %   is a list of responses, or a world's legal actions as a goal (actions(A, Goal),
-%   world.pl), whose classes are the leaves a legal action reaches and whose exploring
-%   choice with temperature 0 is over the legal actions (world_choose/7 below). With
+%   world.pl): its greedy choice is over the leaves a legal action reaches, its exploring
+%   choice over the classes of the legal actions (world_choose/7 below). With
 %   Mode learn or explore: with temperature T > 0, a class is drawn with probability
 %   proportional to exp(Q / T) (Boltzmann exploration); with T = 0, a random class with
 %   probability epsilon and otherwise a greedy one. With Mode greedy, one with the largest
@@ -232,16 +232,14 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
     ).
 
 %   A world's choice (tg_classes:tg_leaf_search/5): the leaves' values are known without a
-%   search, and a leaf is searched only when the choice would take it. Greedy: the leaves
-%   by their value from the largest down, until a group of equal value has a class (ties at
-%   random), and a member of it uniformly. Epsilon (temperature 0, the worlds' default): a
-%   legal action uniformly — over the world's actions, not over the leaves, whose number
-%   grows where the tree has split: exploring over leaves draws exploration to the regions
-%   the tree already splits finely (docs/tg.md). Boltzmann (temperature > 0): over the
-%   leaves, a leaf drawn with probability proportional to exp(Q / T), searched, and drawn
-%   again without it while no legal action reaches it — each class is taken with
-%   probability proportional to exp(Q / T) among the classes, as when every class is found
-%   first — then a member uniformly.
+%   search, and a leaf is searched only when the choice needs it. Greedy: the leaves by
+%   their value from the largest down, until a group of equal value has a class (ties at
+%   random), and a member of it uniformly. Exploring is over the classes of the legal
+%   actions that no test of the bias could tell apart (tg_symmetric/4; in blocks world the
+%   single moves), as over a domain's classes of responses: Boltzmann (temperature > 0),
+%   drawn exactly without valuing every legal action (boltzmann_action/9); epsilon
+%   (temperature 0), a class uniformly. Exploring over the leaves instead would draw
+%   exploration to the regions the tree already splits finely (docs/tg.md).
 world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _), Leaves, _, _, Clock, Index),
     tg_leaf_search(KB, Facts, N, Actions, Search),
@@ -878,9 +876,7 @@ relrl_engine:learner_property(tg, Cap) :-
 %   measurement on Experiment 1's task). In worlds, whose rewards are of size 1, Q starts
 %   at 0 and both exploration bonuses are off: the novelty bonus's candidate tests for every
 %   action of every choice made a learning step 17 times slower on 10-block states, and the
-%   goal tasks were learned as well without it; exploring is epsilon-greedy over the legal
-%   actions (temperature 0: Boltzmann would be over the classes, the tree's leaves, and
-%   draw exploration to where the tree has split most; docs/worlds.md).
+%   goal tasks were learned as well without it (docs/worlds.md).
 relrl_engine:learner_parameter(tg, alpha, 0.2, unit).
 relrl_engine:learner_parameter(tg, gamma, 0.9, unit).
 relrl_engine:learner_parameter(tg, epsilon, 0.05, unit).

@@ -368,3 +368,34 @@ test(every_choice_is_legal) :-
              assertion(memberchk(M, Moves)) )).
 
 :- end_tests(world_leaf_classes).
+
+:- begin_tests(world_exploration).
+
+test(boltzmann_draw_is_boltzmann_over_the_moves) :-
+    % blocks world's classes are single moves: the exploring draw, made by rejection
+    % without valuing every move, against exp(Q / T) over every legal move (seeded)
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    world_for_task(KB, stack),
+    relrl_engine:engine_configure(KB, tg, [alpha=0.2, gamma=1, epsilon=0.05,
+        temperature=1.0, q_init=0, significance=0.001, min_examples=5, stale_bonus=0,
+        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0], 1),
+    world_episodes(KB, episodes(stack, [3, 4, 5], 300, learn, []), _),
+    towers([[b1, b2, b3], [b4], [b5, b6]], S),
+    world_view(KB, stack, S, V),
+    world_actions(KB, S, Actions),
+    world_legal(KB, S, Moves),
+    findall(M-W, ( member(M, Moves), relrl_tg:tg_q(KB, V, M, none, Q), W is exp(Q) ), MW),
+    findall(Q, ( member(M, Moves), relrl_tg:tg_q(KB, V, M, none, Q) ), Qs0),
+    sort(Qs0, Qs),
+    assertion(Qs = [_, _|_]),                   % the moves are valued apart
+    aggregate_all(sum(W), member(_-W, MW), Z),
+    N = 4000,
+    findall(A, ( between(1, N, _),
+                 relrl_engine:learner_choose(tg, KB, V, none, Actions, explore, A) ), As),
+    msort(As, Sorted),
+    clumped(Sorted, Counts),
+    foldl([M-W, D0, D]>>( ( memberchk(M-C, Counts) -> true ; C = 0 ),
+                          D is D0 + abs(C / N - W / Z) / 2 ), MW, 0, TV),
+    assertion(TV < 0.05).
+
+:- end_tests(world_exploration).
