@@ -253,6 +253,10 @@ test(nested_record, [V-Gone == 1-true]) :-
 
 :- begin_tests(qtree).
 
+test(leaf_of_no_tree, [error(existence_error(qtree, none))]) :-
+    % a hook holding `none` (the tree never made) is an error, as for every accessor
+    relrl_qtree:qtree_leaf(none, 0, _, _).
+
 test(new_tree_one_empty_leaf, [Nodes == [0-leaf(none, [])]]) :-
     relrl_qtree:qtree_new(t1, [a, b]),
     relrl_qtree:qtree(t1, T),
