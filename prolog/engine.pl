@@ -432,7 +432,8 @@ forget_learner(KB) :-
         kb_get(KB, engine, engine(run(Learner, _, _, _, _, _, _, _, _, _), _, _))
     ->  hook(learner_forget(Learner, KB)),
         kb_set(KB, learner, none),
-        kb_set(KB, tree, none)
+        kb_set(KB, tree, none),
+        kb_set(KB, inner, none)
     ;   true
     ).
 

@@ -4,6 +4,7 @@
             record_set/3,         % +Record, +Part, +Value
             kb_get/3,             % +KB, +Part, -Value
             kb_set/3,             % +KB, +Part, +Value
+            kb_nest/3,            % +Owner, +Key, +Options
             kb_forget/1,          % +KB
             kb_record_exists/1    % ?KB
           ]).
@@ -14,8 +15,9 @@
 Everything the engine and its learners keep for a knowledge base between two calls lives
 in one term, the knowledge base's record, in one global variable: its engine (the run and
 the last step), working memory, the necessity units' outputs, the learner's own term, a
-tree, the task a world learns, and the snapshots kept by engine_keep/2. kb_forget/1
-deletes the record whole; what a learner keeps as clauses of its own module it removes in
+tree, the task a world learns, the snapshots kept by engine_keep/2, and a second record
+kept inside this one for a learner with a second tree (ptg's P-tree: kb_nest/3).
+kb_forget/1 deletes the record whole, the record inside it with it; what a learner keeps as clauses of its own module it removes in
 its learner_forget/2 hook (engine.pl), so dropping a knowledge base leaves nothing of it.
 
 kb_record/2 finds the record of a knowledge base; record_get/3 reads a part of it and
@@ -36,8 +38,9 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 */
 
 :- dynamic key_/2.                  % KB, the name of its record's global variable
+:- dynamic inner_/2.                % Key, Owner: Key's record is kept inside Owner's
 
-%   The record, kb(Engine, Memory, Units, Learner, Tree, Task, Kept):
+%   The record, kb(Engine, Memory, Units, Learner, Tree, Task, Kept, Inner):
 %     engine    engine(Run, Prev, Random) or none (engine.pl)
 %     memory    wm(Clock, Span, Pairs, Elements, Now) (memory.pl)
 %     units     Necessity-Y pairs (motivation.pl)
@@ -45,8 +48,10 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 %     tree      a tree (qtree.pl, tg_tree.pl), or none
 %     task      the task a world learns next (world.pl), or none
 %     kept      Slot-Snapshot pairs (engine_keep/2)
+%     inner     inner(Key, Options, Record): the record of Key kept inside this one, with
+%               the options of the learner that made it (kb_nest/3), or none
 
-empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [])).
+empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [], none)).
 
 new_record(KB, Record) :-
     must_be(atom, KB),
@@ -63,6 +68,12 @@ new_record(KB, Record) :-
 kb_record(KB, Record) :-
     (   key_(KB, Key)
     ->  nb_getval(Key, Record)
+    ;   inner_(KB, Owner)
+    ->  kb_record(Owner, Outer),
+        (   record_get(Outer, inner, inner(KB, _, Inner))
+        ->  Record = Inner
+        ;   existence_error(kb_record, KB)
+        )
     ;   new_record(KB, Record)
     ).
 
@@ -72,13 +83,14 @@ kb_record(KB, Record) :-
 %   value: `none`, an empty memory, [] for the units and the kept snapshots. Fails when
 %   Part is not a part (kb_get/3 tells the error).
 
-record_get(kb(V, _, _, _, _, _, _), engine, V).
-record_get(kb(_, V, _, _, _, _, _), memory, V).
-record_get(kb(_, _, V, _, _, _, _), units, V).
-record_get(kb(_, _, _, V, _, _, _), learner, V).
-record_get(kb(_, _, _, _, V, _, _), tree, V).
-record_get(kb(_, _, _, _, _, V, _), task, V).
-record_get(kb(_, _, _, _, _, _, V), kept, V).
+record_get(kb(V, _, _, _, _, _, _, _), engine, V).
+record_get(kb(_, V, _, _, _, _, _, _), memory, V).
+record_get(kb(_, _, V, _, _, _, _, _), units, V).
+record_get(kb(_, _, _, V, _, _, _, _), learner, V).
+record_get(kb(_, _, _, _, V, _, _, _), tree, V).
+record_get(kb(_, _, _, _, _, V, _, _), task, V).
+record_get(kb(_, _, _, _, _, _, V, _), kept, V).
+record_get(kb(_, _, _, _, _, _, _, V), inner, V).
 
 %!  record_set(+Record, +Part, +Value) is semidet.
 %
@@ -87,7 +99,7 @@ record_get(kb(_, _, _, _, _, _, V), kept, V).
 %   table of the layout; a part is read by one head unification.
 
 record_set(Record, Part, Value) :-
-    record_get(kb(1, 2, 3, 4, 5, 6, 7), Part, I),
+    record_get(kb(1, 2, 3, 4, 5, 6, 7, 8), Part, I),
     nb_setarg(I, Record, Value).
 
 %!  kb_get(+KB, +Part, -Value) is det.
@@ -111,20 +123,38 @@ kb_set(KB, Part, Value) :-
     ;   domain_error(kb_part, Part)
     ).
 
+%!  kb_nest(+Owner, +Key, +Options) is det.
+%
+%   Key's record becomes an empty record kept inside Owner's (its `inner` part, replacing
+%   any), with Options: what a learner with a second tree keeps for it (ptg.pl keeps its
+%   P-tree under a Key of its own, and its options). kb_get/3 and kb_set/3 on Key then
+%   work on that record; forgetting Owner forgets it.
+
+kb_nest(Owner, Key, Options) :-
+    must_be(atom, Key),
+    kb_record(Owner, Outer),
+    empty(Empty),
+    record_set(Outer, inner, inner(Key, Options, Empty)),
+    kb_forget(Key),
+    assertz(inner_(Key, Owner)).
+
 %!  kb_forget(+KB) is det.
 %
-%   Delete KB's record and the name of its global variable.
+%   Delete KB's record (and the record kept inside it) and the name of its global
+%   variable. For a record kept inside another, forget the name only: the record goes with
+%   its owner's.
 
 kb_forget(KB) :-
     must_be(atom, KB),
     (   retract(key_(KB, Key))
-    ->  nb_delete(Key)
-    ;   true
+    ->  nb_delete(Key),
+        retractall(inner_(_, KB))
+    ;   retractall(inner_(KB, _))
     ).
 
 %!  kb_record_exists(?KB) is nondet.
 %
-%   KB has a record (it was used and not forgotten).
+%   KB has a record of its own (it was used and not forgotten).
 
 kb_record_exists(KB) :-
     key_(KB, _).

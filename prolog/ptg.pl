@@ -18,7 +18,7 @@
 :- use_module(tg).
 :- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3,
                          tg_sort_/5]).
-:- use_module(kbstate, [kb_forget/1]).
+:- use_module(kbstate, [kb_nest/3, kb_get/3, kb_forget/1]).
 :- use_module(tg_classes, [tg_class_members/2, tg_leaf_search/5, tg_leaf_classes/4,
                             tg_leaf_reached/3]).
 
@@ -61,13 +61,12 @@ Params: tg's (tg_init/2) and p_margin, p_alpha, p_pairs.
 
 %!  ptg_key(+KB, -Key) is det.
 %
-%   Key is the key the P-tree of KB is kept under (tg_init/3).
+%   Key is the key the P-tree of KB is kept under (tg_init/3): the name of its compiled
+%   clauses and of its record, which is kept inside KB's (kbstate.pl's kb_nest/3, with
+%   ptg's own options pp(Margin, Pairs)).
 
 ptg_key(KB, Key) :-
     atom_concat('$ptg:', KB, Key).
-
-params_key(KB, Key) :-
-    atom_concat('$ptg_params:', KB, Key).
 
 %!  ptg_init(+KB, +Params:list) is det.
 %
@@ -87,9 +86,8 @@ ptg_init(KB, Params) :-
     tg_init(KB, QParams),
     selectchk(alpha=_, QParams, alpha=PAlpha, PParams),
     ptg_key(KB, PK),
-    tg_init(PK, KB, PParams),
-    params_key(KB, K),
-    nb_setval(K, pp(Margin, Pairs)).
+    kb_nest(KB, PK, pp(Margin, Pairs)),
+    tg_init(PK, KB, PParams).
 
 p_param(Name=_) :-
     memberchk(Name, [p_margin, p_alpha, p_pairs]).
@@ -102,8 +100,7 @@ param(Params, Name, Value) :-
     ).
 
 ptg_params(KB, P) :-
-    params_key(KB, K),
-    (   nb_current(K, P0)
+    (   kb_get(KB, inner, inner(_, P0, _))
     ->  P = P0
     ;   existence_error(ptg_learner, KB)
     ).
@@ -295,14 +292,13 @@ relrl_engine:learner_serves(ptg, worlds, Overrides) :-
     relrl_engine:learner_serves(tg, worlds, Overrides).
 
 %   The Q-tree is tg's under KB; the P-tree is a tree of its own, under its own key: its
-%   record (kbstate.pl) and compiled clauses go with it, and the options' global.
+%   compiled clauses go here, its record (kept inside KB's, with ptg's options) with
+%   KB's learner (engine.pl's forget_learner/1).
 relrl_engine:learner_forget(ptg, KB) :-
     tg_forget(KB),
     ptg_key(KB, PK),
     tg_forget(PK),
-    kb_forget(PK),
-    params_key(KB, K),
-    nb_delete(K).
+    kb_forget(PK).
 
 relrl_engine:learner_init(ptg, KB, Params) :-
     ptg_init(KB, Params).

@@ -274,13 +274,15 @@ path_from(Nodes, Id, D, Path) :-
 %
 %   Leaf Id of Tree. With Id given, Rep and Entries are the tree's own (not copied: the
 %   control step reads them every time unit); they are ground.
+%
+%   @error existence_error(qtree, Tree) if Tree is not a tree (as qtree_node/3).
 
 qtree_leaf(Tree, Id, Rep, Entries) :-
-    (   integer(Id)
-    ->  Tree = qtree(_, Next, Nodes, _),
-        Id >= 0, Id < Next,
+    (   integer(Id),
+        Tree = qtree(_, Next, Nodes, _)
+    ->  Id >= 0, Id < Next,
         node(Nodes, Id, leaf(Rep, Entries))
-    ;   qtree_node(Tree, Id, leaf(Rep, Entries))
+    ;   qtree_node(Tree, Id, leaf(Rep, Entries))    % raises for a term that is no tree
     ).
 
 %!  qtree_set_leaf(+Tree, +Id, +Rep, +Entries) is det.

@@ -239,9 +239,23 @@ test(forgotten, [fail]) :-
     relrl_kbstate:kb_forget(krec4),
     relrl_kbstate:kb_record_exists(krec4).
 
+test(nested_record, [V-Gone == 1-true]) :-
+    % a record kept inside another: read and set under its own key, gone with its owner
+    relrl_kbstate:kb_nest(krec5, krec5_inner, opts),
+    relrl_kbstate:kb_set(krec5_inner, learner, 1),
+    relrl_kbstate:kb_get(krec5_inner, learner, V),
+    relrl_kbstate:kb_get(krec5, inner, inner(krec5_inner, opts, kb(_, _, _, 1, _, _, _, _))),
+    \+ relrl_kbstate:kb_record_exists(krec5_inner),
+    relrl_kbstate:kb_forget(krec5),
+    (   relrl_kbstate:inner_(krec5_inner, _) -> Gone = false ; Gone = true ).
+
 :- end_tests(kbstate).
 
 :- begin_tests(qtree).
+
+test(leaf_of_no_tree, [error(existence_error(qtree, none))]) :-
+    % a hook holding `none` (the tree never made) is an error, as for every accessor
+    relrl_qtree:qtree_leaf(none, 0, _, _).
 
 test(new_tree_one_empty_leaf, [Nodes == [0-leaf(none, [])]]) :-
     relrl_qtree:qtree_new(t1, [a, b]),

@@ -145,6 +145,22 @@ test(bad_margin, [error(domain_error(nonneg, -1))]) :-
     selectchk(p_margin=_, P0, p_margin= -1, P),
     ptg_init(KB, P).
 
+test(one_record_per_kb, [Globals-Names == [Own]-[PK]]) :-
+    % the P-tree's record and ptg's options are kept inside the knowledge base's record:
+    % one global variable per knowledge base, and reconfiguring forgets the P-tree's name
+    blocks_kb(KB),
+    params(P),
+    relrl_engine:engine_configure(KB, ptg, P, 0),
+    ptg_key(KB, PK),
+    relrl_tg_tree:tg_leaf(PK, 1, _),
+    findall(G, ( nb_current(G, _), atom(G), sub_atom(G, _, _, 0, KB) ), Globals),
+    atom_concat('$relrl_kb:', KB, Own),
+    findall(K, relrl_kbstate:inner_(K, KB), Names),
+    relrl_engine:engine_configure(KB, tg, P, 0),
+    assertion(\+ relrl_kbstate:inner_(_, KB)),
+    catch(relrl_tg_tree:tg_leaf(PK, 1, _), error(existence_error(tg_learner, PK), _), true),
+    relrl_gateway:gw_drop_kb(KB).
+
 :- end_tests(ptg).
 
 term_string_list(Text, Terms) :-
