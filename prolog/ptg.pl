@@ -16,9 +16,11 @@
 :- use_module(library(pairs)).
 :- use_module(library(random)).
 :- use_module(tg).
-:- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1]).
+:- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3,
+                         tg_sort_/5]).
 :- use_module(kbstate, [kb_nest/3, kb_get/3, kb_forget/1]).
-:- use_module(tg_classes, [tg_class_member/3]).
+:- use_module(tg_classes, [tg_class_members/2, tg_leaf_search/5, tg_leaf_classes/4,
+                            tg_leaf_reached/3]).
 
 /** <module> ptg: P-learning beside TG's Q-tree
 
@@ -38,13 +40,14 @@ ptg is tg (tg.pl) with a second tree:
     Boltzmann exploration over classes of responses);
   - **the P-tree** is a tree of the same code (tg_init/3 under the key of ptg_key/2): the
     same language bias and candidate tests, examples (state, action, 0/1). After each
-    transition into a state s' that is not terminal, the Q-tree labels the classes of
-    responses allowed in s' (tg_class_values/6, the values the Q-target's max was taken
-    over): a class is optimal when its Q is within `p_margin` of the best. `p_pairs` times,
-    one optimal class and one that is not (when there is one), drawn uniformly, are
-    inserted with targets 1 and 0: the P-tree learns to tell them apart with as many
-    examples of each, and a learning step inserts a fixed number of P-examples whatever the
-    number of responses (RRL labels every action of every state it met);
+    transition into a state s' that is not terminal, the Q-tree labels the actions legal
+    in s': an action is optimal when the Q of its leaf is within `p_margin` of the best.
+    `p_pairs` times, one optimal action and one that is not (when there is one), each drawn
+    uniformly among the actions of its label, are inserted with targets 1 and 0: the P-tree
+    learns to tell them apart with as many examples of each, and a learning step inserts a
+    fixed number of P-examples whatever the number of actions (RRL labels every action of
+    every state it met). Uniform over actions, not over the Q-tree's leaves: a label drawn
+    by leaf would over-weigh the leaves of the regions the Q-tree splits finely;
   - **greedy choices** (evaluation, acting on a learned policy) are by P, ties by Q, further
     ties at random: a leaf's P is the share of its examples the Q-tree found optimal, so the
     class most often optimal in states like this one wins.
@@ -112,74 +115,83 @@ ptg_p(KB, Facts, A, N, P) :-
 
 %!  ptg_choose(+KB, +Facts, +Necessity, +Allowed, +Mode, -Action) is det.
 %
-%   With Mode greedy, Action is a member of the class of Allowed responses (every response
-%   when Allowed is []) with the largest P, ties broken by the largest Q, then at random. With Mode learn or explore, tg's choice
-%   (tg_choose/6: Boltzmann over the Q-tree's values, with its bonuses while learning).
+%   With Mode greedy, Action is a legal action (Allowed: a world's actions(A, Goal) term,
+%   world.pl) with the largest P, ties broken by the largest Q, then at random: the P-tree's
+%   leaves are searched from the largest P down until a legal action reaches one
+%   (tg_class_values/7, scope best), and the members of those of that P are sorted down
+%   the Q-tree. With Mode learn or explore, tg's choice (tg_choose/6: Boltzmann over the
+%   Q-tree's classes, with its bonuses while learning).
 
 ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     (   Mode == greedy
-    ->  tg_class_values(KB, Facts, N, Allowed, Classes, Qs),
-        ptg_key(KB, PK),
-        maplist(class_p(PK, Facts, N), Classes, Qs, Scored),
-        max_member(s(BestP, _, _), Scored),
-        include(p_is(BestP), Scored, ByP),
-        max_member(s(_, BestQ, _), ByP),
-        include(q_is(BestQ), ByP, Ties),
-        random_member(s(_, _, Class), Ties),
-        tg_data(KB, D),
-        arg(6, D, Index),
-        tg_class_member(Index, Class, Action)
+    ->  ptg_key(KB, PK),
+        tg_class_values(PK, Facts, N, Allowed, best, Classes, _),
+        findall(Q-A, ( member(Class, Classes),
+                       tg_class_members(Class, Members),
+                       member(A, Members),
+                       tg_q(KB, Facts, A, N, Q) ),
+                Scored),
+        pairs_keys(Scored, Qs),
+        max_list(Qs, BestQ),
+        findall(A, ( member(Q-A, Scored), Q =:= BestQ ), Ties),
+        random_member(Action, Ties)
     ;   tg_choose(KB, Facts, N, Allowed, Mode, Action)
     ).
-
-%   s(P, Q, Class): P first, so that max_member/2 finds the largest P (standard order of
-%   terms compares numbers by value; a Q tie then by Q).
-class_p(PK, Facts, N, Class, Q, s(P, Q, Class)) :-
-    Class = cls(A, _),
-    tg_q(PK, Facts, A, N, P).
-
-p_is(P, s(P1, _, _)) :-
-    P1 =:= P.
-
-q_is(Q, s(_, Q1, _)) :-
-    Q1 =:= Q.
 
 %!  ptg_update(+KB, +Transition) is det.
 %
 %   Learn from a transition as tg does (tg_update/2); then, unless its next state is
-%   terminal, label the classes of the responses allowed there by the Q-tree and insert
-%   p_pairs pairs of P-examples (an optimal class, target 1; one that is not, target 0).
+%   terminal, label the actions legal there by the Q-tree and insert p_pairs pairs of
+%   P-examples: an optimal action (its leaf's Q within p_margin of the best), target 1, and
+%   one that is not (when there is one), target 0, each drawn uniformly among the legal
+%   actions of its label. The best Q is found by searching the Q-tree's leaves from the
+%   largest Q down (tg_classes.pl); the optimal actions are the members of the optimal
+%   leaves a legal action reaches; the other is found by sorting the legal actions, in a
+%   random order, until one reaches a leaf that is not optimal.
 
 ptg_update(KB, T) :-
     tg_update(KB, T),
-    T = transition(_, _, _, _, _, S1, N1, Allowed1),
+    T = transition(_, _, _, _, _, S1, N1, Actions),
     (   S1 == terminal
     ->  true
     ;   ptg_params(KB, pp(Margin, Pairs)),
-        tg_class_values(KB, S1, N1, Allowed1, Classes, Qs),
-        max_list(Qs, Best),
+        tg_leaf_search(KB, S1, N1, Actions, Search),
+        tg_leaf_groups(KB, best, Groups),
+        tg_leaf_classes(Search, Groups, _, [BestId|_]),
+        tg_leaf(KB, BestId, BestLeaf),
+        arg(1, BestLeaf, Best),
         Cut is Best - Margin,
-        labelled(Qs, Classes, Cut, Optimal, Other),
+        tg_leaves_(KB, Ids, _),
+        partition(optimal_leaf(KB, Cut), Ids, Optimal, Other),
         ptg_key(KB, PK),
         forall(between(1, Pairs, _),
-               label_pair(PK, S1, N1, Optimal, Other))
+               label_pair(KB, PK, Search, S1, N1, Optimal, Other))
     ).
 
-labelled([], [], _, [], []).
-labelled([Q|Qs], [C|Cs], Cut, Optimal, Other) :-
-    (   Q >= Cut
-    ->  Optimal = [C|Optimal1], Other = Other1
-    ;   Optimal = Optimal1, Other = [C|Other1]
-    ),
-    labelled(Qs, Cs, Cut, Optimal1, Other1).
+optimal_leaf(KB, Cut, Id) :-
+    tg_leaf(KB, Id, L),
+    arg(1, L, Q),
+    Q >= Cut.
 
-label_pair(PK, S, N, Optimal, Other) :-
-    random_member(cls(A, _), Optimal),
-    tg_insert(PK, S, A, N, 1),
-    (   Other == []
-    ->  true
-    ;   random_member(cls(B, _), Other),
-        tg_insert(PK, S, B, N, 0)
+%   An optimal action, uniformly among the legal actions of the optimal leaves (their
+%   members), and one that is not, uniformly among the other legal actions (the legal
+%   actions in a random order, each sorted until one reaches a leaf that is not optimal).
+label_pair(KB, PK, Search, S, N, Optimal, Other) :-
+    findall(A, ( member(Id, Optimal),
+                 tg_leaf_reached(Search, Id, C),
+                 tg_class_members(C, Ms),
+                 member(A, Ms) ), Good),
+    random_member(G, Good),
+    tg_insert(PK, S, G, N, 1),
+    Search = search(_, _, _, actions(B0, Goal), _),
+    findall(B0, Goal, Legal0),
+    list_to_set(Legal0, Legal),
+    random_permutation(Legal, Order),
+    (   member(B, Order),
+        tg_sort_(KB, S, B, N, Leaf),
+        memberchk(Leaf, Other)
+    ->  tg_insert(PK, S, B, N, 0)
+    ;   true
     ).
 
 %!  ptg_size(+KB, -Size) is det.

@@ -4,7 +4,8 @@
             tg_state/2,           % +KB, -Facts
             tg_q/5,               % +KB, +Facts, +Action, +Necessity, -Q
             tg_choose/6,          % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
-            tg_class_values/6,    % +KB, +Facts, +Necessity, +Allowed, -Classes, -Qs
+            tg_class_values/7,    % +KB, +Facts, +Necessity, +Allowed, +Scope, -Classes, -Qs
+            tg_leaf_groups/3,     % +KB, +Scope, -Groups
             tg_bonus/5,           % +KB, +Facts, +Action, +Necessity, -Bonus
             tg_update/2,          % +KB, +Transition
             tg_insert/5,          % +KB, +Facts, +Action, +Necessity, +Target
@@ -16,6 +17,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(random)).
+:- use_module(library(pairs)).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(tg_bias).
@@ -148,7 +150,10 @@ tg_q(KB, Facts, Action, N, Q) :-
 %
 %   Action is one of the Allowed responses, chosen over the *classes* of responses no test
 %   of the language bias tells apart in the state Facts (tg_classes.pl): each class is
-%   scored by one representative, a class is chosen, and a member of it uniformly. With
+%   scored by one representative, a class is chosen, and a member of it uniformly. Allowed
+%   is a list of responses, or a world's legal actions as a goal (actions(A, Goal),
+%   world.pl): its greedy choice is over the leaves a legal action reaches, its exploring
+%   choice over the classes of the legal actions (world_choose/7 below). With
 %   Mode learn or explore: with temperature T > 0, a class is drawn with probability
 %   proportional to exp(Q / T) (Boltzmann exploration); with T = 0, a random class with
 %   probability epsilon and otherwise a greedy one. With Mode greedy, one with the largest
@@ -170,15 +175,27 @@ tg_q(KB, Facts, Action, N, Q) :-
 %   Explore and greedy choices, and the Q-targets, never include either bonus.
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
-    Allowed = [_|_],
     tg_data(KB, D),
+    D = tg(p(_, _, _, _, _, _, _, _, novelty(Beta, _), _), _, _, _, _, _),
+    (   Allowed = actions(_, _),                % a world's legal actions (world.pl)
+        \+ ( Mode == learn, Beta > 0 )
+    ->  world_choose(D, KB, Facts, N, Allowed, Mode, Action)
+    ;   class_choose(D, KB, Facts, N, Allowed, Mode, Action)
+    ).
+
+%   The choice over classes found first (a domain's; a world's with the novelty bonus, which
+%   each class's witness is tested for).
+class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
+    (   Allowed = actions(_, _)
+    ->  true
+    ;   Allowed = [_|_]
+    ),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
            Version, Clock, Index),
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
-    ;   classes(KB, Index, Facts, Allowed, Classes),
-        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   classes(KB, Index, Facts, N, Allowed, all, Classes, Ids)
     ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
@@ -200,7 +217,10 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
             random_member(Item, Ties)
         ),
         (   Item = hits(Class, Leaf, Hits)
-        ->  Noted = chose(Action, Leaf, Hits)
+        ->  (   Class = cls(_, leaf(_, _, _, _, _))
+            ->  Noted = none                    % the hits were the witness's, not the
+            ;   Noted = chose(Action, Leaf, Hits)   % member's that is drawn
+            )
         ;   Class = Item,
             Noted = none
         )
@@ -211,14 +231,136 @@ tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     ;   note_choice(Cache, Facts, N, Version, Noted)
     ).
 
-%!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, -Classes, -Qs) is det.
+%   A world's choice (tg_classes:tg_leaf_search/5): the leaves' values are known without a
+%   search, and a leaf is searched only when the choice needs it. Greedy: the leaves by
+%   their value from the largest down, until a group of equal value has a class (ties at
+%   random), and a member of it uniformly. Exploring is over the classes of the legal
+%   actions that no test of the bias could tell apart (tg_symmetric/4; in blocks world the
+%   single moves), as over a domain's classes of responses: Boltzmann (temperature > 0),
+%   drawn exactly without valuing every legal action (boltzmann_action/9); epsilon
+%   (temperature 0), a class uniformly. Exploring over the leaves instead would draw
+%   exploration to the regions the tree already splits finely (docs/tg.md).
+world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _), Leaves, _, _, Clock, Index),
+    tg_leaf_search(KB, Facts, N, Actions, Search),
+    tg_leaves_(KB, Ids, _),
+    (   Mode == learn, Kappa > 0
+    ->  maplist(bonus_q(Leaves, Kappa, Clock), Ids, Qs)
+    ;   maplist(leaf_q(Leaves), Ids, Qs)
+    ),
+    pairs_keys_values(Valued, Qs, Ids),
+    sort(1, @>=, Valued, ByQ),
+    (   Mode \== greedy, Tau =:= 0,
+        random_float < Epsilon
+    ->  legal_list(Actions, Legal),
+        tg_symmetry(Index, Facts, Sym),
+        uniform_class_action(Sym, Legal, Action)
+    ;   Mode \== greedy, Tau > 0
+    ->  tg_symmetry(Index, Facts, Sym),
+        boltzmann_action(KB, Facts, N, Actions, Sym, Search, ByQ, Tau, Action)
+    ;   q_groups(ByQ, Groups),
+        tg_leaf_classes(Search, Groups, Ties, _),
+        random_member(Class, Ties),
+        tg_class_member(Index, Class, Action)
+    ).
+
+%   A class of the legal actions uniformly (the actions no test could tell apart, tg_classes'
+%   signatures), then a member of it uniformly: a legal action uniformly, accepted with
+%   probability 1 / the size of its class.
+uniform_class_action(Sym, Legal, Action) :-
+    random_member(A, Legal),
+    tg_symmetric(Sym, A, Legal, K),
+    (   random_float * K < 1
+    ->  Action = A
+    ;   uniform_class_action(Sym, Legal, Action)
+    ).
+
+%   The legal actions, listed by the world (world_legal/3's order).
+legal_list(actions(A, Goal), Legal) :-
+    findall(A, Goal, Legal0),
+    list_to_set(Legal0, Legal).
+
+%   Boltzmann over the classes of the legal actions, tg's choice over classes of responses
+%   (tg_classes.pl: actions no test of the bias could tell apart in the state, which in
+%   blocks world are the single moves), a class with probability proportional to
+%   exp(Q / T) and a member uniformly: each legal action m with probability proportional to
+%   w(m) / k(m), w(m) = exp((Q(m) - Q*) / T), Q(m) its leaf's value, Q* the best value a
+%   legal action reaches, k(m) the size of its class (tg_symmetric/4). By rejection: a
+%   proposal is, with probability 1/2 each, a member of the best leaves uniformly (the set
+%   B) or a legal action uniformly (the world's list, M actions), so q(m) = [m in B] / 2|B|
+%   + 1 / 2M; it is sorted to its leaf and accepted with probability w(m) / (k(m) C q(m)),
+%   C = max(2|B|, 2M w2), w2 the weight of the next value a legal action reaches, so that
+%   w(m) / k(m) <= C q(m) for every m: the action taken is drawn exactly. A proposal is
+%   accepted with probability (sum over classes of w) / C: at least 1/2 when the classes
+%   are single actions and the best leaves stand well above the rest (C = 2|B|), about the
+%   mean weight over 2 w2 when they do not. Cost: the world's list, the members of the best
+%   leaves, a sort per proposal (not every legal action valued).
+boltzmann_action(KB, Facts, N, Actions, Sym, Search, ByQ, Tau, Action) :-
+    q_groups(ByQ, Groups),
+    reached_groups(Groups, ByQ, Search, Best-QBest, Next),
+    findall(A, ( member(Id, Best),
+                 tg_leaf_reached(Search, Id, C),
+                 tg_class_members(C, Ms),
+                 member(A, Ms) ), Members),
+    length(Members, NB),
+    legal_list(Actions, Legal),
+    length(Legal, M),
+    (   Next = _-Q2
+    ->  W2 is exp((Q2 - QBest) / Tau)
+    ;   W2 = 0.0
+    ),
+    Bound is max(2 * NB, 2 * M * W2),
+    Draw = draw(KB, Facts, N, Sym, ByQ, Tau, QBest, Best, Members, NB, Legal, M, Bound),
+    propose(Draw, Action).
+
+propose(Draw, Action) :-
+    Draw = draw(KB, Facts, N, Sym, ByQ, Tau, QBest, Best, Members, NB, Legal, M, Bound),
+    (   random_float < 0.5
+    ->  random_member(A, Members)
+    ;   random_member(A, Legal)
+    ),
+    tg_sort_(KB, Facts, A, N, Leaf),
+    memberchk(Q-Leaf, ByQ),
+    W is exp((Q - QBest) / Tau),
+    (   memberchk(Leaf, Best)
+    ->  QA is 0.5 / NB + 0.5 / M
+    ;   QA is 0.5 / M
+    ),
+    tg_symmetric(Sym, A, Legal, K),
+    (   random_float * Bound * QA * K < W
+    ->  Action = A
+    ;   propose(Draw, Action)
+    ).
+
+%   The reached leaves of the first group of leaves (by value, the largest first) that a
+%   legal action reaches, with its value, and the value of the next such group (or none).
+reached_groups(Groups, ByQ, Search, Best-QBest, Next) :-
+    append(_, [Group|Rest], Groups),
+    include(reached(Search), Group, Best),
+    Best = [Id|_],
+    !,
+    memberchk(QBest-Id, ByQ),
+    (   append(_, [G2|_], Rest),
+        include(reached(Search), G2, [Id2|_])
+    ->  memberchk(Q2-Id2, ByQ),
+        Next = Id2-Q2
+    ;   Next = none
+    ).
+
+reached(Search, Id) :-
+    tg_leaf_reached(Search, Id, _).
+
+%!  tg_class_values(+KB, +Facts, +Necessity, +Allowed, +Scope, -Classes, -Qs) is det.
 %
 %   Classes are the classes of the Allowed responses in the state Facts (every response
 %   when Allowed is []), as tg_choose/6 chooses among them (cls(Representative, Pick)
-%   terms, tg_classes.pl), and Qs their representatives' Q. The last update's look-up of
-%   the same state is reused while the tree is unchanged.
+%   terms, tg_classes.pl), and Qs their representatives' Q. Scope `all`: every class;
+%   `best`: for a world's actions, only the classes of the largest Q (the other leaves of
+%   the tree are not searched; a domain's classes are all found either way). The last
+%   update's look-up of the same state is reused while the tree is unchanged.
 
-tg_class_values(KB, Facts, N, Allowed0, Classes, Qs) :-
+tg_class_values(KB, Facts, N, Allowed0, Scope, Classes, Qs) :-
+    must_be(oneof([all, best]), Scope),
     tg_data(KB, D),
     D = tg(_, Leaves, Cache, Version, _, Index),
     (   Allowed0 == []
@@ -228,8 +370,7 @@ tg_class_values(KB, Facts, N, Allowed0, Classes, Qs) :-
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
-    ;   classes(KB, Index, Facts, Allowed, Classes),
-        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   classes(KB, Index, Facts, N, Allowed, Scope, Classes, Ids)
     ),
     maplist(leaf_q(Leaves), Ids, Qs).
 
@@ -244,13 +385,57 @@ note_choice(Cache, Facts, N, Version, Noted) :-
     ;   true
     ).
 
-%   The classes of the Allowed responses in the state Facts; when no constraint rule
-%   forbids a response (Allowed is the engine's own list of every response) they come from
-%   the index without a pass over the responses.
-classes(KB, Index, Facts, Allowed, Classes) :-
-    (   engine_all_allowed(KB, Allowed)
-    ->  tg_classes(Index, Facts, Allowed, true, Classes)
-    ;   tg_classes(Index, Facts, Allowed, false, Classes)
+%   The classes of the Allowed responses in the state Facts and the leaves their
+%   representatives sort to. A world's legal actions (actions(A, Goal), world.pl): the
+%   leaves some legal action reaches (tg_leaf_classes/7), all of them (Scope `all`) or,
+%   searching the leaves by their Q from the largest down, those of the largest Q that
+%   some legal action reaches (Scope `best`: what a greedy choice and a Q-target read). A
+%   domain's responses (Scope is not used): when no constraint rule forbids a response
+%   (Allowed is the engine's own list of every response) the classes come from the index
+%   without a pass over the responses.
+classes(KB, Index, Facts, N, Allowed, Scope, Classes, Ids) :-
+    (   Allowed = actions(_, _)
+    ->  tg_leaf_groups(KB, Scope, Groups),
+        tg_leaf_search(KB, Facts, N, Allowed, Search),
+        tg_leaf_classes(Search, Groups, Classes, Ids)
+    ;   engine_all_allowed(KB, Allowed)
+    ->  tg_classes(Index, Facts, Allowed, true, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ;   tg_classes(Index, Facts, Allowed, false, Classes),
+        maplist(class_leaf(KB, Facts, N), Classes, Ids)
+    ).
+
+%!  tg_leaf_groups(+KB, +Scope, -Groups:list) is det.
+%
+%   Groups are the leaves of KB's tree to search for classes of a world's actions
+%   (tg_classes:tg_leaf_classes/4): Scope `all`, every leaf in one group; `best`, the leaves
+%   grouped by their Q, the largest first (leaves of one Q in tree order).
+
+tg_leaf_groups(KB, Scope, Groups) :-
+    must_be(oneof([all, best]), Scope),
+    tg_leaves_(KB, Ids, _),
+    (   Scope == all
+    ->  Groups = [Ids]
+    ;   tg_data(KB, D),
+        arg(2, D, Leaves),
+        maplist(leaf_q(Leaves), Ids, Qs),
+        pairs_keys_values(Keyed, Qs, Ids),
+        sort(1, @>=, Keyed, ByQ),                   % stable: one value in tree order
+        q_groups(ByQ, Groups)
+    ).
+
+q_groups([], []).
+q_groups([Q-Id|More], [[Id|Ids]|Groups]) :-
+    same_q(More, Q, Ids, Rest),
+    q_groups(Rest, Groups).
+
+same_q([], _, [], []).
+same_q([Q1-Id|More], Q, Ids, Rest) :-
+    (   Q1 =:= Q
+    ->  Ids = [Id|Ids1],
+        same_q(More, Q, Ids1, Rest)
+    ;   Ids = [],
+        Rest = [Q1-Id|More]
     ).
 
 class_leaf(KB, Facts, N, cls(A, _), Leaf) :-
@@ -375,12 +560,14 @@ tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
     ->  tg_get_tree(KB, tree(_, _, _, Next))
     ;   Next = Allowed1
     ),
-    classes(KB, Index, S1, Next, Classes),
-    maplist(class_leaf(KB, S1, N1), Classes, Ids),
+    classes(KB, Index, S1, N1, Next, best, Classes, Ids),
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max),
     Target is Reward + Gamma * Max,
-    nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none)),
+    (   Next = actions(_, _)                    % a world's: only the best classes were
+    ->  nb_setarg(3, D, none)                   % found, not what a choice needs
+    ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
+    ),
     insert(KB, D, S0, A0, N0, Known, Target).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.

@@ -1,9 +1,15 @@
 :- module(relrl_tg_classes,
           [ tg_response_index/3,  % +Bias, +Responses, -Index
             tg_classes/5,         % +Index, +Facts, +Allowed, +All, -Classes
+            tg_leaf_search/5,     % +KB, +Facts, +Necessity, +Actions, -Search
+            tg_leaf_reached/3,    % +Search, +LeafId, -Class
+            tg_leaf_classes/4,    % +Search, +Groups, -Classes, -LeafIds
             tg_class_member/3,    % +Index, +Class, -Action
+            tg_class_members/2,   % +Class, -Actions
             tg_class_size/3,      % +Index, +Class, -Size
-            tg_signature/3        % +Response, +Known, -Signature
+            tg_signature/3,       % +Response, +Known, -Signature
+            tg_symmetry/3,        % +Index, +Facts, -Symmetry
+            tg_symmetric/4        % +Symmetry, +Action, +Actions, -Count
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -11,7 +17,9 @@
 :- use_module(library(pairs)).
 :- use_module(library(assoc)).
 :- use_module(library(random)).
+:- use_module(library(aggregate)).
 :- use_module(tg_bias, [bias_constants/2, term_constant/2]).
+:- use_module(tg_tree, [tg_sort_/5, tg_path_/5, tg_leaves_/3]).
 
 /** <module> Classes of responses the TG learner cannot tell apart
 
@@ -38,6 +46,31 @@ state names are grouped by their signature given the state, and every group of t
 keeps the rest as one class ("all but these"), drawn from by rejection. No pass over the
 responses, unless constraint rules allow only some of them (then the allowed ones are
 grouped one by one).
+
+**A world's actions: classes are leaves.** A world (world.pl) declares no responses: the
+actions legal in a state come with it, as a goal that binds an action template to each
+(actions(A, Goal), world_actions/3). Every object of a world is in its state (a block
+appears in on/2), so no two ground actions share a signature and a class of signatures
+would be one action: N blocks on the floor have N(N - 1) moves. What the learner reads
+of an action is the leaf of its Q-tree it sorts to, so its classes are the leaves that
+some legal action reaches, found without listing the actions (tg_leaf_search/5): a leaf's
+path query (its tests on the yes-branches, tg_path_/5) is proved with the action open,
+which binds the action's arguments from the state's facts (action(move(B, floor)),
+on(B1, floor) ...), the world's goal completes the action (precondition/2 with a partly
+bound template), and the action is sorted down the tree (tg_sort_/5, which also holds the
+tests of the no-branches). Every action so sorted marks the leaf it reaches, a leaf's search
+stops at the first action that reaches it, and a leaf is searched at most once per state
+and tree, only when asked about (tg_leaf_reached/3): a greedy choice or a Q-target asks
+about the leaves from the largest Q down (tg_leaf_classes/4), a Boltzmann choice about the
+leaves it draws (tg.pl). A class is cls(Witness, leaf(...)), scored by its leaf's Q; its
+member is drawn uniformly among the legal actions that reach its leaf (tg_class_member/3:
+the leaf's path query, the world's goal and the sort enumerate them).
+
+**Cost of a world's classes.** A leaf whose path query binds the action's arguments costs
+the solutions of that query; one whose path binds none (below the root's no-branch: the
+world's goal alone proposes actions) costs as many legal actions as come before the first
+that reaches it, all of them when none does. Drawing a member lists the chosen class
+(docs/tg.md, *Classes of a world's actions*).
 */
 
 %!  tg_response_index(+Bias, +Responses:list, -Index) is det.
@@ -131,12 +164,11 @@ known(known(Assoc, Extra), X) :-
 %
 %   Classes partitions the Allowed responses in the state Facts into classes no test of the
 %   bias tells apart: cls(Rep, Pick), Rep the representative the class is scored by, Pick
-%   how to draw a member: one (Rep itself), among(Positions) (uniformly), rest(Group,
-%   Excluded) (uniformly among the members of Group not in Excluded) or terms(Actions)
-%   (uniformly; for an index of no responses, a world's, whose actions come with each
-%   state). All = true says
+%   how to draw a member: one (Rep itself), among(Positions) (uniformly) or rest(Group,
+%   Excluded) (uniformly among the members of Group not in Excluded). All = true says
 %   Allowed are all the responses (no constraint rule forbids one): the classes then come
-%   from the index, without a pass over the responses. Classes are in a fixed order: the
+%   from the index, without a pass over the responses. (A world's actions, which come with
+%   each state, are classed by tg_leaf_search/5.) Classes are in a fixed order: the
 %   index's groups, then the responses the state names by their first position.
 
 tg_classes(rindex(Rs, Known, Groups, GroupOf, Atoms), Facts, Allowed, All, Classes) :-
@@ -149,8 +181,6 @@ tg_classes(rindex(Rs, Known, Groups, GroupOf, Atoms), Facts, Allowed, All, Class
         maplist(position_sig(Rs, Known1), Named, Pairs),
         sig_classes(Pairs, Rs, NamedClasses),
         append(Rest, NamedClasses, Classes)
-    ;   functor(Rs, _, 0)               % no declared responses: a world's actions come
-    ->  term_classes(Allowed, Known1, Classes)  % with each state (world.pl)
     ;   allowed_pairs(Allowed, Rs, 1, Known1, Pairs),
         sig_classes(Pairs, Rs, Classes)
     ).
@@ -224,26 +254,106 @@ group_class(Rs, [I|Is], cls(Rep, Pick)) :-
     ;   Pick = among([I|Is])
     ).
 
-%   The classes of actions that are not positions of the index (a world declares no
-%   responses: its legal actions come with each state): grouped by their signature, in
-%   order of first occurrence; cls(Rep, terms(Members)) for a class of several. Signatures
-%   are ground, so a stable key sort groups them.
-term_classes(Allowed, Known, Classes) :-
-    findall(Sig-(I-A), ( nth1(I, Allowed, A), tg_signature(A, Known, Sig) ), Pairs),
-    keysort(Pairs, Sorted),
-    group_pairs_by_key(Sorted, Groups),
-    findall(I-Cls, ( member(_-[I-Rep|More], Groups),
-                     term_class(Rep, More, Cls) ),
-            Keyed),
-    keysort(Keyed, InOrder),
-    pairs_values(InOrder, Classes).
+%!  tg_leaf_search(+KB, +Facts, +Necessity, +Actions, -Search) is det.
+%
+%   Search is a search of the leaves of KB's tree that a world's legal actions reach in
+%   the state Facts (Actions = actions(A, Goal), Goal binding A to each legal action,
+%   world_actions/3): tg_leaf_reached/3 and tg_leaf_classes/4 ask it about leaves, and a leaf is searched at most once per Search, when first asked about or when
+%   an action found for another leaf reaches it.
 
-term_class(Rep, More, Cls) :-
-    (   More == []
-    ->  Cls = cls(Rep, one)
-    ;   pairs_values(More, Others),
-        Cls = cls(Rep, terms([Rep|Others]))
+tg_leaf_search(KB, Facts, N, Actions, search(KB, Facts, N, Actions, Seen)) :-
+    must_be(compound, Actions),
+    tg_leaves_(KB, _, Max),
+    functor(Seen, seen, Max).           % per leaf: unknown (a variable), w(Witness), empty
+
+%!  tg_leaf_reached(+Search, +LeafId, -Class) is semidet.
+%
+%   Some legal action reaches leaf LeafId; Class is its class, cls(Witness, leaf(KB,
+%   LeafId, Facts, Necessity, Actions)), Witness the first such action found.
+
+tg_leaf_reached(Search, Id, cls(W, leaf(KB, Id, Facts, N, Actions))) :-
+    Search = search(KB, Facts, N, Actions, Seen),
+    search_leaf(Search, Id),
+    arg(Id, Seen, w(W)).
+
+%!  tg_leaf_classes(+Search, +Groups:list, -Classes:list, -LeafIds:list) is det.
+%
+%   Groups is a list of lists of leaf ids, searched in turn: Classes are the classes of the
+%   first group that has any (tg_leaf_reached/3), in the group's order, LeafIds their
+%   leaves; [] when no group has one. Every leaf in one group: all the classes; the leaves
+%   grouped by their Q, the largest first: the classes of the largest Q, without searching
+%   the leaves below it.
+
+tg_leaf_classes(Search, Groups, Classes, Ids) :-
+    first_group(Groups, Search, Pairs),
+    pairs_keys_values(Pairs, Ids, Classes).
+
+first_group([], _, []).
+first_group([Group|Groups], Search, Pairs) :-
+    findall(Id-C, ( member(Id, Group), tg_leaf_reached(Search, Id, C) ), Pairs0),
+    (   Pairs0 == []
+    ->  first_group(Groups, Search, Pairs)
+    ;   Pairs = Pairs0
     ).
+
+%   Unless leaf Id was searched or is known to be reached: the candidates of its path
+%   query, completed by the world and sorted, each marking the leaf it reaches, until one
+%   reaches Id; none: Id is empty.
+search_leaf(search(KB, Facts, N, actions(A, Goal), Seen), Id) :-
+    arg(Id, Seen, S),
+    (   nonvar(S)
+    ->  true
+    ;   \+ \+ ( tg_path_(KB, Id, Facts, A, N),    % (the bindings are undone: \+ \+)
+                call(Goal),
+                tg_sort_(KB, Facts, A, N, Leaf),
+                arg(Leaf, Seen, S1),
+                (   var(S1)
+                ->  nb_setarg(Leaf, Seen, w(A))
+                ;   true
+                ),
+                Leaf == Id )
+    ->  true
+    ;   nb_setarg(Id, Seen, empty)
+    ).
+
+%!  tg_symmetry(+Index, +Facts, -Symmetry) is det.
+%
+%   Symmetry is what tg_symmetric/4 needs to tell, in the state Facts, which actions no
+%   test of the bias could tell apart: the constants the bias or the state names.
+
+tg_symmetry(rindex(_, Known, _, _, _), Facts, known(Known, StateAtoms)) :-
+    state_atoms(Facts, Known, StateAtoms).
+
+%!  tg_symmetric(+Symmetry, +Action, +Actions:list, -Count:integer) is det.
+%
+%   Count is the number of Actions (a world's legal actions) with Action's signature: the
+%   actions no test of the bias could tell from Action in the state (they differ only in
+%   constants neither the bias nor the state names). 1 without a look at Actions when
+%   every constant of Action is named (every block of blocks world is in its state).
+
+tg_symmetric(Known, Action, Actions, Count) :-
+    (   \+ ( term_constant(Action, C), \+ known(Known, C) )
+    ->  Count = 1
+    ;   tg_signature(Action, Known, Sig),
+        aggregate_all(count, ( member(B, Actions), tg_signature(B, Known, SigB),
+                               SigB =@= Sig ), Count)
+    ).
+
+%!  tg_class_members(+Class, -Actions:list) is det.
+%
+%   Actions are the members of a leaf class (tg_leaf_search/5), the legal actions that
+%   reach its leaf, in standard order: its path query, the world's goal and the sort
+%   enumerate them.
+
+tg_class_members(cls(_, Pick), Members) :-
+    leaf_members(Pick, Members).
+
+leaf_members(leaf(KB, Id, Facts, N, actions(A, Goal)), Members) :-
+    findall(A, ( tg_path_(KB, Id, Facts, A, N),
+                 call(Goal),
+                 tg_sort_(KB, Facts, A, N, Id) ),
+            Members0),
+    sort(Members0, Members).
 
 %   Sig-Position pairs of the Allowed responses (a sub-list of the responses, in their
 %   order: one walk along both).
@@ -266,7 +376,8 @@ next_position(Rs, R, I, J) :-
 
 %!  tg_class_member(+Index, +Class, -Action) is det.
 %
-%   Action is a member of Class drawn uniformly (library(random)).
+%   Action is a member of Class drawn uniformly (library(random)); of a leaf class
+%   (tg_leaf_search/5), uniformly among the legal actions that reach the leaf.
 
 tg_class_member(rindex(Rs, _, Groups, _, _), cls(Rep, Pick), Action) :-
     (   Pick == one
@@ -274,8 +385,9 @@ tg_class_member(rindex(Rs, _, Groups, _, _), cls(Rep, Pick), Action) :-
     ;   Pick = among(Is)
     ->  random_member(I, Is),
         arg(I, Rs, Action)
-    ;   Pick = terms(As)
-    ->  random_member(Action, As)
+    ;   Pick = leaf(_, _, _, _, _)
+    ->  leaf_members(Pick, Members),
+        random_member(Action, Members)
     ;   Pick = rest(G, Excluded),
         arg(G, Groups, grp(Members, Size)),
         draw_free(Members, Size, Excluded, I),
@@ -300,8 +412,9 @@ tg_class_size(rindex(_, _, Groups, _, _), cls(_, Pick), Size) :-
     ->  Size = 1
     ;   Pick = among(Is)
     ->  length(Is, Size)
-    ;   Pick = terms(As)
-    ->  length(As, Size)
+    ;   Pick = leaf(_, _, _, _, _)
+    ->  leaf_members(Pick, Members),
+        length(Members, Size)
     ;   Pick = rest(G, Excluded),
         arg(G, Groups, grp(_, GSize)),
         length(Excluded, E),

@@ -13,7 +13,9 @@
             tg_forget_leaves/1,   % +KB
             tg_tree_leaf/2,       % +Tree, ?Leaf
             tg_sort_/5,           % +KB, +Facts, +Action, +Necessity, -LeafId
-            tg_cands_/6           % +KB, +LeafId, +Facts, +Action, +Necessity, -Hits
+            tg_cands_/6,          % +KB, +LeafId, +Facts, +Action, +Necessity, -Hits
+            tg_path_/5,           % +KB, +LeafId, +Facts, ?Action, +Necessity
+            tg_leaves_/3          % +KB, -LeafIds, -MaxId
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -25,14 +27,19 @@
 
 What the TG learner (tg.pl) knows, kept per knowledge base, and the tree compiled into
 clauses: tg_sort_/5 sorts an example (facts, action, necessity) to its leaf, tg_cands_/6
-tests every candidate of a leaf on an example. Both are recompiled when the tree changes
+tests every candidate of a leaf on an example, tg_path_/5 proves a leaf's path query (the
+tests on the yes-branches above it) with the action left open, so that it binds the
+action's arguments from the facts (tg_classes.pl: the leaves some legal action of a world
+reaches), and tg_leaves_/3 lists the leaves. They are recompiled when the tree changes
 (a split, a restore), never on the hot path. tg.pl learns with them; tg_knowledge.pl
 explains, draws, saves and restores them.
 */
 
 :- dynamic
     tg_sort_/5,      % KB, Facts, Action, Necessity, LeafId   (the compiled tree)
-    tg_cands_/6.     % KB, LeafId, Facts, Action, Necessity, Hits (a leaf's candidates)
+    tg_cands_/6,     % KB, LeafId, Facts, Action, Necessity, Hits (a leaf's candidates)
+    tg_path_/5,      % KB, LeafId, Facts, Action, Necessity    (a leaf's path query)
+    tg_leaves_/3.    % KB, LeafIds, MaxId                       (the leaves, left to right)
 
 % ---- the learner's state -------------------------------------------------------------------
 
@@ -138,13 +145,18 @@ tg_new_stats(Q, N, K, Clock, Keep, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock, Ring)) 
 %!  tg_compile_tree(+KB, +Root) is det.
 %
 %   Compile the tree Root into KB's tg_sort_/5 clause: an if-then-else per node, whose
-%   condition proves the node's query (its path and its test) on the example's facts.
+%   condition proves the node's query (its path and its test) on the example's facts; and
+%   its tg_leaves_/3 fact: the leaf ids left to right and the largest.
 
 tg_compile_tree(KB, Root) :-
     copy_term(Root, Tree),
     tree_goal(Tree, [], Facts, Action, N, Leaf, Body),
     retractall(tg_sort_(KB, _, _, _, _)),
-    assertz((tg_sort_(KB, Facts, Action, N, Leaf) :- Body)).
+    assertz((tg_sort_(KB, Facts, Action, N, Leaf) :- Body)),
+    findall(Id, tg_tree_leaf(Root, leaf(Id, _, _, _)), Ids),
+    max_list(Ids, Max),
+    retractall(tg_leaves_(KB, _, _)),
+    assertz(tg_leaves_(KB, Ids, Max)).
 
 tree_goal(leaf(Id, _, _, _), _, _, _, _, Leaf, Leaf = Id).
 tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )) :-
@@ -157,9 +169,13 @@ tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )
 %!  tg_compile_leaf(+KB, +Leaf) is det.
 %
 %   Add the tg_cands_/6 clause of Leaf: it tests every candidate of the leaf on an example,
-%   Hits listing the positions (from 1) of those that succeed, in order.
+%   Hits listing the positions (from 1) of those that succeed, in order; and its tg_path_/5
+%   clause: every solution of its path query (the action an open term the query binds).
 
 tg_compile_leaf(KB, leaf(Id, PathLits0, _, Cands0)) :-
+    copy_term(PathLits0, PathLits1),
+    conj_goal(PathLits1, PF, PA, PN, all, PathBody),
+    assertz((tg_path_(KB, Id, PF, PA, PN) :- PathBody)),
     copy_term(PathLits0-Cands0, PathLits-Cands),
     term_variables(PathLits, PV),
     (   PV == []
@@ -193,14 +209,16 @@ cand_goal(path(V, Sols), F, A, N, cand(Lits, _), hit(I, Goal), I, I1) :-
 %   Remove the tg_cands_/6 clause of leaf LeafId (it was split).
 
 tg_forget_leaf(KB, Id) :-
-    retractall(tg_cands_(KB, Id, _, _, _, _)).
+    retractall(tg_cands_(KB, Id, _, _, _, _)),
+    retractall(tg_path_(KB, Id, _, _, _)).
 
 %!  tg_forget_leaves(+KB) is det.
 %
 %   Remove every tg_cands_/6 clause of KB (a new tree follows).
 
 tg_forget_leaves(KB) :-
-    retractall(tg_cands_(KB, _, _, _, _, _)).
+    retractall(tg_cands_(KB, _, _, _, _, _)),
+    retractall(tg_path_(KB, _, _, _, _)).
 
 %!  tg_forget(+KB) is det.
 %
@@ -208,6 +226,7 @@ tg_forget_leaves(KB) :-
 
 tg_forget(KB) :-
     retractall(tg_sort_(KB, _, _, _, _)),
+    retractall(tg_leaves_(KB, _, _)),
     tg_forget_leaves(KB).
 
 hits_body([], [], true).

@@ -2,6 +2,8 @@
           [ world_episodes/3,     % +KB, +Spec, -Episodes
             world_start/5,        % +KB, +Task, +Size, -State, -Goal
             world_legal/3,        % +KB, +State, -Actions
+            world_action/3,       % +KB, +State, ?Action
+            world_actions/3,      % +KB, +State, -Actions
             world_next/6,         % +KB, +Goal, +State0, +Action, -State, -Outcome
             world_view/4,         % +KB, +Goal, +State, -View
             world_optimal/5,      % +KB, +Goal, +State, +Limit, -Steps
@@ -59,7 +61,9 @@ a size and a start state, then choose, act, reward and learn until the goal hold
 bound is reached or no action is legal. The learner is the knowledge base's configured one
 (engine_configure/4), reached through the engine's learner hooks (learner_choose/7,
 learner_update/3), and it draws from the knowledge base's own random stream, as in a
-control step. A transition into the goal is terminal: its Q-target is the reward alone
+control step. The learner gets a state's legal actions as a goal, not a list
+(world_actions/3): it asks what it reads, and the runner only whether some action is
+legal. A transition into the goal is terminal: its Q-target is the reward alone
 (learner_update/3 with `terminal` for the next state). With updates(episode) (RRL's) the
 examples of an episode are given to the learner when it ends, last first, so a reward
 reaches the start of the episode within one episode; with updates(online) each step's
@@ -160,21 +164,39 @@ holds_goal(KB, Goal, State) :-
 
 %!  world_legal(+KB, +State, -Actions:list) is det.
 %
-%   The actions legal in State: each action/1 template bound by precondition/2, in the
-%   order they are found, without duplicates. Each must be ground.
+%   The actions legal in State (world_action/3), in the order they are found, without
+%   duplicates.
 
 world_legal(KB, State, Actions) :-
-    findall(A, ( rule_solution(KB, action(A)),
-                 rule_solution(KB, precondition(A, State)) ), As0),
-    (   ground(As0)
-    ->  list_to_set(As0, Actions)
-    ;   member(A, As0), \+ ground(A)
-    ->  copy_term(A, Shown),
+    findall(A, world_action(KB, State, A), As0),
+    list_to_set(As0, Actions).
+
+%!  world_action(+KB, +State, ?Action) is nondet.
+%
+%   Action is legal in State: an action/1 template bound by precondition/2. Action may come
+%   partly bound (move(b1, _)): the world completes it. A solution must be ground.
+
+world_action(KB, State, A) :-
+    rule_solution(KB, action(A)),
+    rule_solution(KB, precondition(A, State)),
+    (   ground(A)
+    ->  true
+    ;   copy_term(A, Shown),
         numbervars(Shown, 0, _, [singletons(true)]),
         contract(KB, precondition(A, State), "precondition/2 left the action ~W unbound (it \c
                  must bind every argument of the template)",
                  [Shown, [quoted(true), numbervars(true)]])
     ).
+
+%!  world_actions(+KB, +State, -Actions) is det.
+%
+%   Actions is actions(A, Goal): Goal binds A to each action legal in State
+%   (world_action/3), the form in which the episode runner gives a learner the legal
+%   actions of a state (learner_choose/7, learner_update/3). No list of them is made: a
+%   learner asks what it reads (tg: whether some legal action reaches a leaf of its tree,
+%   tg_classes.pl); one that reads every action (qtable) lists them (world_legal/3).
+
+world_actions(KB, State, actions(A, relrl_world:world_action(KB, State, A))).
 
 %!  world_next(+KB, +Goal, +State0, +Action, -State, -Outcome) is det.
 %
@@ -303,7 +325,7 @@ episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)
     ;   Optimal = none
     ),
     world_view(KB, Goal, S0, V0),
-    world_legal(KB, S0, A0),
+    world_actions(KB, S0, A0),
     steps(Run, Goal, S0, V0, A0, 0, Bound, 0, Steps, Return, Reached, [], Examples, Trace),
     (   Run = run(_, Learner, learn, episode, _, _)
     ->  forall(member(T, Examples), learner_update(Learner, KB, T))
@@ -311,10 +333,11 @@ episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)
     ).
 
 %   steps(Run, Goal, State, View, Legal, T, Bound, ...): from step T, until the goal holds,
-%   T reaches Bound or nothing is legal. Examples (updates(episode)) are the episode's
+%   T reaches Bound or nothing is legal. Legal is the state's world_actions/3 term (no list
+%   of the legal actions is made). Examples (updates(episode)) are the episode's
 %   transitions, last first.
 steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, Trace) :-
-    (   ( T >= Bound ; Legal == [] )
+    (   ( T >= Bound ; \+ any_action(Legal) )
     ->  Steps = T, Return = Ret0, Reached = false, Ex = Ex0,
         end_trace(Run, S, Trace)
     ;   Run = run(KB, Learner, Mode, Updates, _, KeepTrace),
@@ -325,8 +348,8 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
         (   Done == true
         ->  Next = terminal, Legal1 = []
         ;   world_view(KB, Goal, S1, V1),
-            world_legal(KB, S1, Legal1),
-            (   Legal1 == []
+            world_actions(KB, S1, Legal1),
+            (   \+ any_action(Legal1)
             ->  Next = terminal                     % a dead end: nothing more to gain
             ;   Next = V1
             )
@@ -349,6 +372,9 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
                   Ex, Trace1)
         )
     ).
+
+any_action(actions(_, Goal)) :-
+    \+ \+ call(Goal).
 
 end_trace(run(_, _, _, _, _, KeepTrace), S, Trace) :-
     (   KeepTrace == true

@@ -69,7 +69,8 @@ qtable_q(KB, S, N, A, Q) :-
     ;   params(KB, p(_, _, _, _, Q))
     ).
 
-choose(KB, S, N, Allowed, Mode, Action) :-
+choose(KB, S, N, Allowed0, Mode, Action) :-
+    listed(Allowed0, Allowed),
     Allowed = [_|_],
     params(KB, p(_, _, Epsilon, Tau, _)),
     maplist(qtable_q(KB, S, N), Allowed, Qs),
@@ -110,8 +111,21 @@ pick([W|Ws], [A|As], X, Action) :-
         pick(Ws, As, X1, Action)
     ).
 
-update(KB, transition(S0, A0, N0, R, _, S1, N1, Allowed1)) :-
+%   A table reads every legal action: the runner's actions(A, Goal) term (world.pl's
+%   world_actions/3) as the list of its solutions, in the order found, without duplicates.
+listed(Allowed, List) :-
+    (   Allowed = actions(A, Goal)
+    ->  findall(A, Goal, List0),
+        list_to_set(List0, List)
+    ;   List = Allowed
+    ).
+
+update(KB, transition(S0, A0, N0, R, _, S1, N1, Allowed0)) :-
     params(KB, p(Alpha, Gamma, _, _, Qinit)),
+    (   S1 == terminal
+    ->  Allowed1 = []
+    ;   listed(Allowed0, Allowed1)
+    ),
     (   ( S1 == terminal ; Allowed1 == [] )
     ->  Target = R
     ;   maplist(qtable_q(KB, S1, N1), Allowed1, Qs),

@@ -81,8 +81,8 @@ test(p_ranks_an_optimal_move_first_in_a_larger_world) :-
     ptg_p(KB, V, move(b4, floor), none, Good),
     ptg_p(KB, V, move(b4, b6), none, Bad),
     assertion(Good > Bad),
-    relrl_engine:learner_choose(ptg, KB, V, none, [move(b4, b6), move(b4, floor),
-                                                   move(b6, b4)], greedy, A),
+    Moves = [move(b4, b6), move(b4, floor), move(b6, b4)],
+    relrl_engine:learner_choose(ptg, KB, V, none, actions(M, member(M, Moves)), greedy, A),
     assertion(A == move(b4, floor)).
 
 test(terminal_transition_adds_no_p_example, [N == 0]) :-
@@ -108,7 +108,7 @@ test(a_step_labels_a_pair, [N == 2]) :-
     towers([[b1, b2], [b3]], S1),
     world_view(KB, unstack, S0, V0),
     world_view(KB, unstack, S1, V1),
-    world_legal(KB, S1, Allowed),
+    world_actions(KB, S1, Allowed),
     relrl_tg:tg_size(PK, size(_, D0)),
     memberchk(leaves=L, D0),
     findall(Id-C, ( between(1, 1000, Id), relrl_tg_tree:tg_leaf(PK, Id, l(_, C, _, _, _, _,

@@ -274,3 +274,128 @@ test(trace_ends_with_the_last_state) :-
     last(Trace, end(_)).
 
 :- end_tests(world_episodes).
+
+:- begin_tests(world_leaf_classes).
+
+%   A tg learner that learned some unstack on blocks_moves.pl (a tree of a few leaves).
+learned_tg(KB) :-
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    world_for_task(KB, unstack),
+    P = [alpha=0.2, gamma=1, epsilon=0.05, temperature=0, q_init=0, significance=0.001,
+         min_examples=5, stale_bonus=0, half_life=1000, novelty_bonus=0,
+         novelty_confidence=2, keep_examples=0],
+    relrl_engine:engine_configure(KB, tg, P, 3),
+    world_episodes(KB, episodes(unstack, [3, 4, 5], 150, learn, []), _).
+
+all_floor(N, State) :-
+    numlist(1, N, Is),
+    findall(T, ( member(I, Is), atom_concat(b, I, B), T = [B] ), Towers),
+    towers(Towers, State).
+
+test(classes_are_the_leaves_the_legal_moves_reach) :-
+    % on random states of 3-8 blocks: the leaves found by the search are those the legal
+    % moves sort to, and each class's members are the moves that sort to its leaf
+    learned_tg(KB),
+    relrl_tg_tree:tg_leaves_(KB, Leaves, _),
+    assertion(Leaves = [_, _|_]),
+    forall(( member(Size, [3, 5, 8]), between(1, 10, _) ),
+           ( world_start(KB, unstack, Size, S, G),
+             world_view(KB, G, S, V),
+             world_actions(KB, S, Actions),
+             relrl_tg_classes:tg_leaf_search(KB, V, none, Actions, Search),
+             relrl_tg_classes:tg_leaf_classes(Search, [Leaves], Classes, Ids),
+             world_legal(KB, S, Moves),
+             findall(L-M, ( member(M, Moves), relrl_tg_tree:tg_sort_(KB, V, M, none, L) ),
+                     Sorted),
+             findall(L, member(L-_, Sorted), Ls0), sort(Ls0, Expected),
+             msort(Ids, Found),
+             assertion(Found == Expected),
+             forall(nth1(I, Ids, Id),
+                    ( nth1(I, Classes, C),
+                      relrl_tg_classes:tg_class_members(C, Members),
+                      findall(M, member(Id-M, Sorted), Ms0), sort(Ms0, Ms),
+                      assertion(Members == Ms) )) )).
+
+test(the_classes_are_found_without_listing_the_moves, [Asked == 1]) :-
+    % 10 blocks on the floor have 90 moves; a tree of one leaf is reached by the first
+    % legal move the world proposes: one solution of the world's goal is asked for
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    world_for_task(KB, unstack),
+    relrl_engine:engine_configure(KB, tg, [alpha=0.2, gamma=1, epsilon=0.05,
+        temperature=0, q_init=0, significance=0.001, min_examples=5, stale_bonus=0,
+        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0], 0),
+    all_floor(10, S),
+    world_legal(KB, S, Moves),
+    length(Moves, 90),
+    world_view(KB, unstack, S, V),
+    Counter = count(0),
+    Actions = actions(A, ( relrl_world:world_action(KB, S, A),
+                           arg(1, Counter, C0), C1 is C0 + 1, nb_setarg(1, Counter, C1) )),
+    relrl_tg:tg_leaf_groups(KB, best, Groups),
+    relrl_tg_classes:tg_leaf_search(KB, V, none, Actions, Search),
+    relrl_tg_classes:tg_leaf_classes(Search, Groups, [_], [1]),
+    arg(1, Counter, Asked).
+
+test(a_greedy_choice_searches_fewer_moves_than_are_legal) :-
+    learned_tg(KB),
+    all_floor(10, S0),
+    world_next(KB, unstack, S0, move(b1, b2), S1, _),   % one tower of two, 8 alone
+    world_view(KB, unstack, S1, V),
+    world_legal(KB, S1, Moves),
+    length(Moves, NMoves),
+    Counter = count(0),
+    Actions = actions(A, ( relrl_world:world_action(KB, S1, A),
+                           arg(1, Counter, C0), C1 is C0 + 1, nb_setarg(1, Counter, C1) )),
+    relrl_tg:tg_leaf_groups(KB, best, Groups),
+    relrl_tg_classes:tg_leaf_search(KB, V, none, Actions, Search),
+    relrl_tg_classes:tg_leaf_classes(Search, Groups, [_|_], _),
+    arg(1, Counter, Asked),
+    assertion(Asked < NMoves).
+
+test(every_choice_is_legal) :-
+    % greedy, epsilon-greedy and Boltzmann over the leaves (empty leaves drawn and
+    % rejected) all give a legal move
+    learned_tg(KB),
+    forall(( member(Mode-Tau, [greedy-0, learn-0, learn-1.0, explore-1.0]),
+             between(1, 30, _) ),
+           ( world_start(KB, unstack, 6, S, G),
+             world_view(KB, G, S, V),
+             world_actions(KB, S, Actions),
+             relrl_tg_tree:tg_data(KB, D), arg(1, D, Ps),
+             nb_setarg(4, Ps, Tau),
+             relrl_engine:learner_choose(tg, KB, V, none, Actions, Mode, M),
+             world_legal(KB, S, Moves),
+             assertion(memberchk(M, Moves)) )).
+
+:- end_tests(world_leaf_classes).
+
+:- begin_tests(world_exploration).
+
+test(boltzmann_draw_is_boltzmann_over_the_moves) :-
+    % blocks world's classes are single moves: the exploring draw, made by rejection
+    % without valuing every move, against exp(Q / T) over every legal move (seeded)
+    world_kb('examples/worlds/blocks_moves.pl', KB),
+    world_for_task(KB, stack),
+    relrl_engine:engine_configure(KB, tg, [alpha=0.2, gamma=1, epsilon=0.05,
+        temperature=1.0, q_init=0, significance=0.001, min_examples=5, stale_bonus=0,
+        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0], 1),
+    world_episodes(KB, episodes(stack, [3, 4, 5], 300, learn, []), _),
+    towers([[b1, b2, b3], [b4], [b5, b6]], S),
+    world_view(KB, stack, S, V),
+    world_actions(KB, S, Actions),
+    world_legal(KB, S, Moves),
+    findall(M-W, ( member(M, Moves), relrl_tg:tg_q(KB, V, M, none, Q), W is exp(Q) ), MW),
+    findall(Q, ( member(M, Moves), relrl_tg:tg_q(KB, V, M, none, Q) ), Qs0),
+    sort(Qs0, Qs),
+    assertion(Qs = [_, _|_]),                   % the moves are valued apart
+    aggregate_all(sum(W), member(_-W, MW), Z),
+    N = 4000,
+    findall(A, ( between(1, N, _),
+                 relrl_engine:learner_choose(tg, KB, V, none, Actions, explore, A) ), As),
+    msort(As, Sorted),
+    clumped(Sorted, Counts),
+    foldl([M-W, D0, D]>>( ( memberchk(M-C, Counts) -> true ; C = 0 ),
+                          D is D0 + abs(C / N - W / Z) / 2 ), MW, 0, TV),
+    assertion(TV < 0.05).
+
+:- end_tests(world_exploration).
