@@ -19,6 +19,7 @@
 :- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3,
                          tg_sort_/5]).
 :- use_module(kbstate, [kb_nest/3, kb_get/3, kb_forget/1]).
+:- use_module(world, [world_action_list/2]).
 :- use_module(tg_classes, [tg_class_members/2, tg_leaf_search/5, tg_leaf_classes/4,
                             tg_leaf_reached/3]).
 
@@ -183,9 +184,8 @@ label_pair(KB, PK, Search, S, N, Optimal, Other) :-
                  member(A, Ms) ), Good),
     random_member(G, Good),
     tg_insert(PK, S, G, N, 1),
-    Search = search(_, _, _, actions(B0, Goal), _),
-    findall(B0, Goal, Legal0),
-    list_to_set(Legal0, Legal),
+    Search = search(_, _, _, Actions, _),
+    world_action_list(Actions, Legal),
     random_permutation(Legal, Order),
     (   member(B, Order),
         tg_sort_(KB, S, B, N, Leaf),

@@ -24,6 +24,7 @@
 :- use_module(tg_stats).
 :- use_module(tg_tree).
 :- use_module(tg_classes).
+:- use_module(world, [world_action_list/2]).
 :- reexport(tg_knowledge).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
@@ -252,7 +253,7 @@ world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
     sort(1, @>=, Valued, ByQ),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
-    ->  legal_list(Actions, Legal),
+    ->  world_action_list(Actions, Legal),
         tg_symmetry(Index, Facts, Sym),
         uniform_class_action(Sym, Legal, Action)
     ;   Mode \== greedy, Tau > 0
@@ -274,11 +275,6 @@ uniform_class_action(Sym, Legal, Action) :-
     ->  Action = A
     ;   uniform_class_action(Sym, Legal, Action)
     ).
-
-%   The legal actions, listed by the world (world_legal/3's order).
-legal_list(actions(A, Goal), Legal) :-
-    findall(A, Goal, Legal0),
-    list_to_set(Legal0, Legal).
 
 %   Boltzmann over the classes of the legal actions, tg's choice over classes of responses
 %   (tg_classes.pl: actions no test of the bias could tell apart in the state, which in
@@ -303,7 +299,7 @@ boltzmann_action(KB, Facts, N, Actions, Sym, Search, ByQ, Tau, Action) :-
                  tg_class_members(C, Ms),
                  member(A, Ms) ), Members),
     length(Members, NB),
-    legal_list(Actions, Legal),
+    world_action_list(Actions, Legal),
     length(Legal, M),
     (   Next = _-Q2
     ->  W2 is exp((Q2 - QBest) / Tau)
@@ -387,7 +383,7 @@ note_choice(Cache, Facts, N, Version, Noted) :-
 
 %   The classes of the Allowed responses in the state Facts and the leaves their
 %   representatives sort to. A world's legal actions (actions(A, Goal), world.pl): the
-%   leaves some legal action reaches (tg_leaf_classes/7), all of them (Scope `all`) or,
+%   leaves some legal action reaches (tg_leaf_classes/4), all of them (Scope `all`) or,
 %   searching the leaves by their Q from the largest down, those of the largest Q that
 %   some legal action reaches (Scope `best`: what a greedy choice and a Q-target read). A
 %   domain's responses (Scope is not used): when no constraint rule forbids a response

@@ -17,7 +17,6 @@
 :- use_module(library(pairs)).
 :- use_module(library(assoc)).
 :- use_module(library(random)).
-:- use_module(library(aggregate)).
 :- use_module(tg_bias, [bias_constants/2, term_constant/2]).
 :- use_module(tg_tree, [tg_sort_/5, tg_path_/5, tg_leaves_/3]).
 
@@ -258,8 +257,9 @@ group_class(Rs, [I|Is], cls(Rep, Pick)) :-
 %
 %   Search is a search of the leaves of KB's tree that a world's legal actions reach in
 %   the state Facts (Actions = actions(A, Goal), Goal binding A to each legal action,
-%   world_actions/3): tg_leaf_reached/3 and tg_leaf_classes/4 ask it about leaves, and a leaf is searched at most once per Search, when first asked about or when
-%   an action found for another leaf reaches it.
+%   world_actions/3): tg_leaf_reached/3 and tg_leaf_classes/4 ask it about leaves, and a
+%   leaf is searched at most once per Search, when first asked about or when an action
+%   found for another leaf reaches it.
 
 tg_leaf_search(KB, Facts, N, Actions, search(KB, Facts, N, Actions, Seen)) :-
     must_be(compound, Actions),
@@ -319,24 +319,36 @@ search_leaf(search(KB, Facts, N, actions(A, Goal), Seen), Id) :-
 %!  tg_symmetry(+Index, +Facts, -Symmetry) is det.
 %
 %   Symmetry is what tg_symmetric/4 needs to tell, in the state Facts, which actions no
-%   test of the bias could tell apart: the constants the bias or the state names.
+%   test of the bias could tell apart: the constants the bias or the state names, and room
+%   for the sizes of the classes of one draw's legal actions (counted once, when first
+%   needed).
 
-tg_symmetry(rindex(_, Known, _, _, _), Facts, known(Known, StateAtoms)) :-
+tg_symmetry(rindex(_, Known, _, _, _), Facts, sym(known(Known, StateAtoms), sizes(none))) :-
     state_atoms(Facts, Known, StateAtoms).
 
 %!  tg_symmetric(+Symmetry, +Action, +Actions:list, -Count:integer) is det.
 %
-%   Count is the number of Actions (a world's legal actions) with Action's signature: the
-%   actions no test of the bias could tell from Action in the state (they differ only in
-%   constants neither the bias nor the state names). 1 without a look at Actions when
-%   every constant of Action is named (every block of blocks world is in its state).
+%   Count is the number of Actions (a world's legal actions, the same list at every call
+%   with one Symmetry) with Action's signature: the actions no test of the bias could tell
+%   from Action in the state (they differ only in constants neither the bias nor the state
+%   names). 1 without a look at Actions when every constant of Action is named (every block
+%   of blocks world is in its state); otherwise the actions' signatures are counted at the
+%   first such call, one pass, and looked up afterwards.
 
-tg_symmetric(Known, Action, Actions, Count) :-
+tg_symmetric(sym(Known, Sizes), Action, Actions, Count) :-
     (   \+ ( term_constant(Action, C), \+ known(Known, C) )
     ->  Count = 1
-    ;   tg_signature(Action, Known, Sig),
-        aggregate_all(count, ( member(B, Actions), tg_signature(B, Known, SigB),
-                               SigB =@= Sig ), Count)
+    ;   arg(1, Sizes, Counted0),
+        (   Counted0 == none
+        ->  findall(Sig, ( member(B, Actions), tg_signature(B, Known, Sig) ), Sigs),
+            msort(Sigs, Sorted),
+            clumped(Sorted, Pairs),
+            list_to_assoc(Pairs, Counted),
+            nb_setarg(1, Sizes, Counted)
+        ;   Counted = Counted0
+        ),
+        tg_signature(Action, Known, Sig),
+        get_assoc(Sig, Counted, Count)
     ).
 
 %!  tg_class_members(+Class, -Actions:list) is det.

@@ -206,7 +206,7 @@ cand_goal(path(V, Sols), F, A, N, cand(Lits, _), hit(I, Goal), I, I1) :-
 
 %!  tg_forget_leaf(+KB, +LeafId) is det.
 %
-%   Remove the tg_cands_/6 clause of leaf LeafId (it was split).
+%   Remove the tg_cands_/6 and tg_path_/5 clauses of leaf LeafId (it was split).
 
 tg_forget_leaf(KB, Id) :-
     retractall(tg_cands_(KB, Id, _, _, _, _)),
@@ -214,7 +214,7 @@ tg_forget_leaf(KB, Id) :-
 
 %!  tg_forget_leaves(+KB) is det.
 %
-%   Remove every tg_cands_/6 clause of KB (a new tree follows).
+%   Remove every tg_cands_/6 and tg_path_/5 clause of KB (a new tree follows).
 
 tg_forget_leaves(KB) :-
     retractall(tg_cands_(KB, _, _, _, _, _)),

@@ -4,6 +4,7 @@
             world_legal/3,        % +KB, +State, -Actions
             world_action/3,       % +KB, +State, ?Action
             world_actions/3,      % +KB, +State, -Actions
+            world_action_list/2,  % +Actions, -List
             world_next/6,         % +KB, +Goal, +State0, +Action, -State, -Outcome
             world_view/4,         % +KB, +Goal, +State, -View
             world_optimal/5,      % +KB, +Goal, +State, +Limit, -Steps
@@ -168,13 +169,14 @@ holds_goal(KB, Goal, State) :-
 %   duplicates.
 
 world_legal(KB, State, Actions) :-
-    findall(A, world_action(KB, State, A), As0),
-    list_to_set(As0, Actions).
+    world_actions(KB, State, Goal),
+    world_action_list(Goal, Actions).
 
 %!  world_action(+KB, +State, ?Action) is nondet.
 %
 %   Action is legal in State: an action/1 template bound by precondition/2. Action may come
-%   partly bound (move(b1, _)): the world completes it. A solution must be ground.
+%   partly bound (move(b1, _)): the world completes it, and must then give exactly the
+%   legal actions that match (world_check.pl tries it). A solution must be ground.
 
 world_action(KB, State, A) :-
     rule_solution(KB, action(A)),
@@ -197,6 +199,15 @@ world_action(KB, State, A) :-
 %   tg_classes.pl); one that reads every action (qtable) lists them (world_legal/3).
 
 world_actions(KB, State, actions(A, relrl_world:world_action(KB, State, A))).
+
+%!  world_action_list(+Actions, -List:list) is det.
+%
+%   List holds the actions of an actions(A, Goal) term (world_actions/3) in the order Goal
+%   finds them, without duplicates: what a learner that reads every legal action lists.
+
+world_action_list(actions(A, Goal), List) :-
+    findall(A, Goal, List0),
+    list_to_set(List0, List).
 
 %!  world_next(+KB, +Goal, +State0, +Action, -State, -Outcome) is det.
 %

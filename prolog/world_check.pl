@@ -188,6 +188,16 @@ walk(KB, Goal, S, N, Found) :-
         format(string(Msg), "precondition/2 gave the action ~q, which no action/1 template \c
                              covers", [A]),
         Found = found(problem(File, Line, Msg))
+    ;   partial_mismatch(KB, S, As, T, Got, Expected)
+    ->  rule_where(KB, precondition(_, _), Where),
+        where_file_line(Where, File, Line),
+        copy_term(T, Shown),
+        numbervars(Shown, 0, _, [singletons(true)]),
+        format(string(Msg), "precondition/2 called with ~W gives ~q, but the legal actions \c
+                             it matches are ~q (learners ask with some arguments bound: the \c
+                             answer must be the same actions)",
+               [Shown, [quoted(true), numbervars(true)], Got, Expected]),
+        Found = found(problem(File, Line, Msg))
     ;   N =:= 0
     ->  Found = none
     ;   As == []
@@ -202,6 +212,24 @@ walk(KB, Goal, S, N, Found) :-
             walk(KB, Goal, S1, N1, Found)
         )
     ).
+
+%   A template with one argument bound to a value some legal action has there, for which
+%   the world's legal actions (world_action/3 with the template) are not the legal actions
+%   it matches: a precondition written for an open template only (tg proves its leaves'
+%   tests first, which bind some arguments, and lets the world complete the action).
+partial_mismatch(KB, S, As, T, Got, Expected) :-
+    findall(Name/Arity-I-V, ( member(A, As), compound(A), functor(A, Name, Arity),
+                              arg(I, A, V) ), Keys0),
+    sort(Keys0, Keys),
+    member(Name/Arity-I-V, Keys),
+    functor(T, Name, Arity),
+    arg(I, T, V),
+    findall(T, world_action(KB, S, T), Got0),
+    sort(Got0, Got),
+    include(subsumes_term(T), As, Expected0),
+    sort(Expected0, Expected),
+    Got \== Expected,
+    !.
 
 covered_action(KB, A) :-
     declared(KB, action(T)),

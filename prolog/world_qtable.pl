@@ -10,6 +10,7 @@
 :- use_module(engine).
 :- use_module(kbstate).
 :- use_module(declarations).
+:- use_module(world, [world_action_list/2]).
 
 /** <module> qtable: Q-learning over ground relational states (the baseline of worlds)
 
@@ -114,9 +115,8 @@ pick([W|Ws], [A|As], X, Action) :-
 %   A table reads every legal action: the runner's actions(A, Goal) term (world.pl's
 %   world_actions/3) as the list of its solutions, in the order found, without duplicates.
 listed(Allowed, List) :-
-    (   Allowed = actions(A, Goal)
-    ->  findall(A, Goal, List0),
-        list_to_set(List0, List)
+    (   Allowed = actions(_, _)
+    ->  world_action_list(Allowed, List)
     ;   List = Allowed
     ).
 

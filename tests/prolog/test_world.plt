@@ -131,6 +131,16 @@ test(unbound_action, [Line-Msg == 4-"precondition/2 left the action go(_) unboun
             KB, Path),
     world_problems(KB, [problem(Path, Line, Msg)]).
 
+test(precondition_for_open_templates_only, [Line == 4]) :-
+    % right for an open template (go(a, b), go(c, b)), but asked with go(_, b) it also
+    % gives go(b, b): the learner would take an action that is not legal
+    text_kb(["initial_state(_, [p(a), p(c), q(b)]).", "task(t).", "action(go(_, _)).",
+             "precondition(go(X, Y), S) :- ( nonvar(Y) -> member(F, S), arg(1, F, X) ; member(p(X), S), member(q(Y), S) ).",
+             "effect(go(_, _), _, [], []).", "goal(t, _) :- fail."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]),
+    once(sub_string(Msg, _, _, _, "precondition/2 called with go(_,b) gives [go(a,b),go(b,b),go(c,b)]")).
+
 test(effect_not_a_list, [Line == 5]) :-
     text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
              "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, none, [])."
