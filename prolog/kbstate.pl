@@ -63,7 +63,10 @@ new_record(KB, Record) :-
 
 %!  kb_record(+KB, -Record) is det.
 %
-%   Record is KB's record (the stored term itself), made empty at KB's first use.
+%   Record is KB's record (the stored term itself), made empty at KB's first use; for a
+%   key kb_nest/3 made, the record kept inside its owner's.
+%
+%   @error existence_error(kb_record, KB) if KB's owner no longer keeps its record.
 
 kb_record(KB, Record) :-
     (   key_(KB, Key)
