@@ -273,7 +273,7 @@ relrl_engine:learner_choose(contingency, KB, Code, N, Allowed, _Mode, Action) :-
     engine_params(KB, Params),
     contingency_choose(KB, Code, N, Allowed, Params, Action).
 
-relrl_engine:learner_update(contingency, KB, transition(Code0, A0, N0, _, Reinforced, _, _, _)) :-
+relrl_engine:learner_update(contingency, KB, transition(Code0, A0, N0, _, _, Reinforced, _, _, _)) :-
     engine_params(KB, Params),
     contingency_update(KB, Code0, A0, N0, Reinforced, Params).
 

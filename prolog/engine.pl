@@ -64,7 +64,7 @@ touches its own file and one line of learners.pl.
   | learner_init(Name, KB, Params)                  | start afresh                           |
   | learner_state(Name, KB, Code, State)            | the learner's view of the state now (default: Code) |
   | learner_choose(Name, KB, State, N, Allowed, Mode, Action) | Mode: learn, explore or greedy |
-  | learner_update(Name, KB, Transition)            | transition(S0, A0, N0, R, Reinforced, S1, N1, Allowed1); S1 = terminal: the episode ended in the goal (target R alone; worlds, world.pl) |
+  | learner_update(Name, KB, Transition)            | transition(S0, A0, N0, Allowed0, R, Reinforced, S1, N1, Allowed1); S1 = terminal: the episode ended in the goal (target R alone; worlds, world.pl) |
   | learner_explain(Name, KB, State, N, Explanation)| why it would choose what it chooses    |
   | learner_size(Name, KB, size(Positions, Details))| memory in the paper's positions        |
   | learner_save(Name, KB, Stream)                  | write the learned knowledge as clauses |
@@ -137,7 +137,7 @@ gateway can name the rule.
 %               learner that reads the relational view only (the plan then only tells
 %               whether a reinforcer is sensed); Caps the learner's capabilities
 %               (learner_property/2), checked when the run was configured
-%     Prev    prev(State, Necessity) of the last step, or none
+%     Prev    prev(State, Necessity, Allowed) of the last step, or none
 %     Random  the KB's random state, while the generator does not hold it (see
 %             random_owner/1: while it does, the generator's state is the KB's)
 %   Prev is replaced in place (nb_setarg/3) every step; eng(Prev, Random) is how the rest
@@ -570,7 +570,7 @@ engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
 step(KB, Record, run(Learner, Params, _, Responses, Units, _, Constraints, _, Plan, Caps),
      Prev, Percepts, EmittedIx, Mode, Want,
      step(Code, Active, Ys, Reward, Reinforced, AllowedMask, ActionIx, Extras),
-     prev(State, Active)) :-
+     prev(State, Active, Allowed)) :-
     (   EmittedIx >= 0
     ->  nth0(EmittedIx, Responses, Emitted),
         wm_insert(KB, Record, [emitted(Emitted)|Percepts])
@@ -586,9 +586,9 @@ step(KB, Record, run(Learner, Params, _, Responses, Units, _, Constraints, _, Pl
     allowed(KB, Constraints, Responses, Allowed, AllowedMask),
     (   Mode == learn,
         EmittedIx >= 0,
-        Prev = prev(S0, N0)
-    ->  (   learner_update(Learner, KB, transition(S0, Emitted, N0, Reward, Reinforced,
-                                                   State, Active, Allowed))
+        Prev = prev(S0, N0, Allowed0)
+    ->  (   learner_update(Learner, KB, transition(S0, Emitted, N0, Allowed0, Reward,
+                                                   Reinforced, State, Active, Allowed))
         ->  true
         ;   hook_failed(Learner, learner_update/3)
         )
@@ -692,7 +692,7 @@ engine_explain(KB, When, Explanation) :-
     must_be(oneof([last, now]), When),
     run(KB, run(Learner, _, _, _, Units, _, _, _, Plan, Caps)),
     (   When == last,
-        engine(KB, engine(_, prev(State, N), _))
+        engine(KB, engine(_, prev(State, N, _), _))
     ->  true
     ;   kb_record(KB, Record),
         view_code(KB, Record, Plan, Code, _),

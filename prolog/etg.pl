@@ -316,7 +316,7 @@ relrl_engine:learner_choose(etg, KB, D, N, Allowed, Mode, Action) :-
         etg_choose(KB, D, N, Allowed, Params, Action, _)
     ).
 
-relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, R, _, D1, N1, Allowed1)) :-
+relrl_engine:learner_update(etg, KB, transition(D0, A0, N0, _, R, _, D1, N1, Allowed1)) :-
     config(KB, etg(_, _, Numbers), Tree),
     (   Numbers = numbers(Alpha, Gamma, _, Qinit, Threshold)
     ->  update(Tree, D0, A0, N0, R, D1, N1, Allowed1, Alpha, Gamma, Qinit, Threshold)

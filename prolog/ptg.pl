@@ -152,7 +152,7 @@ ptg_choose(KB, Facts, N, Allowed, Mode, Action) :-
 
 ptg_update(KB, T) :-
     tg_update(KB, T),
-    T = transition(_, _, _, _, _, S1, N1, Actions),
+    T = transition(_, _, _, _, _, _, S1, N1, Actions),
     (   S1 == terminal
     ->  true
     ;   ptg_params(KB, pp(Margin, Pairs)),

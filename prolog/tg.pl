@@ -99,9 +99,9 @@ tg_init(Key, KB, Params) :-
     must_be(list, Params),
     maplist(param(Params), [alpha, gamma, epsilon, temperature, q_init, significance,
                             min_examples, stale_bonus, half_life, novelty_bonus,
-                            novelty_confidence, keep_examples],
+                            novelty_confidence, keep_examples, action_gap],
             [Alpha, Gamma, Epsilon, Tau, Qinit, Level, MinEx0, Kappa, Half0, Beta, Conf,
-             Keep0]),
+             Keep0, Gap]),
     Keep is max(0, round(Keep0)),
     MinEx is max(2, round(MinEx0)),
     tg_bias(KB, Bias),
@@ -115,7 +115,7 @@ tg_init(Key, KB, Params) :-
     setarg(1, Leaves0, L),
     Half is max(0, round(Half0)),
     tg_put_data(Key, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
-                          novelty(Beta, Conf), Keep), Leaves0, none, 0, 0, Index)),
+                          novelty(Beta, Conf), Keep, Gap), Leaves0, none, 0, 0, Index)),
     tg_put_tree(Key, tree(Root, 2, Bias, Responses)),
     tg_forget_leaves(Key),
     tg_compile_leaf(Key, Root),
@@ -177,7 +177,7 @@ tg_q(KB, Facts, Action, N, Q) :-
 
 tg_choose(KB, Facts, N, Allowed, Mode, Action) :-
     tg_data(KB, D),
-    D = tg(p(_, _, _, _, _, _, _, _, novelty(Beta, _), _), _, _, _, _, _),
+    D = tg(p(_, _, _, _, _, _, _, _, novelty(Beta, _), _, _), _, _, _, _, _),
     (   Allowed = actions(_, _),                % a world's legal actions (world.pl)
         \+ ( Mode == learn, Beta > 0 )
     ->  world_choose(D, KB, Facts, N, Allowed, Mode, Action)
@@ -191,7 +191,7 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
     ->  true
     ;   Allowed = [_|_]
     ),
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _), Leaves, Cache,
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _, _), Leaves, Cache,
            Version, Clock, Index),
     (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
         A1 == Allowed
@@ -242,7 +242,7 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
 %   (temperature 0), a class uniformly. Exploring over the leaves instead would draw
 %   exploration to the regions the tree already splits finely (docs/tg.md).
 world_choose(D, KB, Facts, N, Actions, Mode, Action) :-
-    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _), Leaves, _, _, Clock, Index),
+    D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, _, _, _, _), Leaves, _, _, Clock, Index),
     tg_leaf_search(KB, Facts, N, Actions, Search),
     tg_leaves_(KB, Ids, _),
     (   Mode == learn, Kappa > 0
@@ -462,7 +462,7 @@ novel_q(KB, Facts, N, Leaves, b(Kappa, Beta, Conf, Half, Clock), Class, Id, Q,
 %   (tg_choose/6; 0 when novelty_bonus is 0).
 
 tg_bonus(KB, Facts, A, N, Bonus) :-
-    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf), _), Leaves, _, _, Clock,
+    tg_data(KB, tg(p(_, _, _, _, _, _, _, Half, novelty(Beta, Conf), _, _), Leaves, _, _, Clock,
                    _)),
     (   Beta > 0
     ->  tg_sort_(KB, Facts, A, N, Id),
@@ -534,37 +534,51 @@ pick([W|Ws], [A|As], X, Action) :-
 
 %!  tg_update(+KB, +Transition) is det.
 %
-%   Learn from transition(S0, A0, N0, Reward, Reinforced, S1, N1, Allowed1): insert the
-%   example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the responses
-%   Allowed1 (over every response when none is allowed); S1 = terminal (the episode ended
-%   in a world's goal): Q-target Reward alone. The max is taken over one
+%   Learn from transition(S0, A0, N0, Allowed0, Reward, Reinforced, S1, N1, Allowed1):
+%   insert the example (S0, A0, N0) with Q-target Reward + gamma * max Q(S1, a, N1) over the
+%   responses Allowed1 (over every response when none is allowed); S1 = terminal (the
+%   episode ended in a world's goal): Q-target Reward alone. The max is taken over one
 %   representative of each class of responses (tg_classes.pl): the members of a class have
-%   the same Q.
+%   the same Q. With action_gap G > 0 the target is lowered by G * (V(S0) - Q(S0, A0)),
+%   V(S0) the largest Q of the responses Allowed0 (advantage learning, docs/tg.md).
 
-tg_update(KB, transition(S0, A0, N0, Reward, _, terminal, _, _)) :-
-    !,                                          % the episode ended (a world's goal)
-    tg_insert(KB, S0, A0, N0, Reward).
-tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
+tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _), Leaves, Cache0, Version, _, Index),
-    (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
-        M0 == N0, B0 == A0
-    ->  Known = sorted(Leaf0, Hits0)            % the choice sorted this example already
-    ;   Known = none
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _, Gap), _, Cache0, Version, _, _),
+    (   S1 == terminal                          % the episode ended (a world's goal)
+    ->  Known = none,
+        Target = Reward
+    ;   (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
+            M0 == N0, B0 == A0
+        ->  Known = sorted(Leaf0, Hits0)        % the choice sorted this example already
+        ;   Known = none
+        ),
+        best_q(KB, D, S1, N1, Allowed1, Next, Classes, Ids, Max),
+        Target is Reward + Gamma * Max,
+        (   Next = actions(_, _)                % a world's: only the best classes were
+        ->  nb_setarg(3, D, none)               % found, not what a choice needs
+        ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
+        )
     ),
-    (   Allowed1 == []
+    (   Gap > 0
+    ->  best_q(KB, D, S0, N0, Allowed0, _, _, _, V0),
+        Gapped = gap(Gap, V0)
+    ;   Gapped = none
+    ),
+    insert(KB, D, S0, A0, N0, Known, Target, Gapped).
+
+%   Max is the largest Q of the responses Allowed in the state Facts (of every response
+%   when Allowed is []), found over the classes of largest Q (Classes, their leaves Ids);
+%   Next is what was searched.
+best_q(KB, D, Facts, N, Allowed, Next, Classes, Ids, Max) :-
+    D = tg(_, Leaves, _, _, _, Index),
+    (   Allowed == []
     ->  tg_get_tree(KB, tree(_, _, _, Next))
-    ;   Next = Allowed1
+    ;   Next = Allowed
     ),
-    classes(KB, Index, S1, N1, Next, best, Classes, Ids),
+    classes(KB, Index, Facts, N, Next, best, Classes, Ids),
     maplist(leaf_q(Leaves), Ids, Qs),
-    max_list(Qs, Max),
-    Target is Reward + Gamma * Max,
-    (   Next = actions(_, _)                    % a world's: only the best classes were
-    ->  nb_setarg(3, D, none)                   % found, not what a choice needs
-    ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
-    ),
-    insert(KB, D, S0, A0, N0, Known, Target).
+    max_list(Qs, Max).
 
 %!  tg_insert(+KB, +Facts, +Action, +Necessity, +Target:number) is det.
 %
@@ -575,12 +589,13 @@ tg_update(KB, transition(S0, A0, N0, Reward, _, S1, N1, Allowed1)) :-
 
 tg_insert(KB, Facts, A, N, Target) :-
     tg_data(KB, D),
-    insert(KB, D, Facts, A, N, none, Target).
+    insert(KB, D, Facts, A, N, none, Target, none).
 
 %   Known is sorted(Leaf, Hits) when the choice of this example's action found its leaf and
-%   candidate hits (note_choice/5), else none.
-insert(KB, D, Facts, A, N, Known, Target) :-
-    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _), Leaves, _, _, Clock0, _),
+%   candidate hits (note_choice/5), else none. Gapped is gap(G, V) (advantage learning: the
+%   target lowered by G times V, the state's largest Q, less the leaf's Q) or none.
+insert(KB, D, Facts, A, N, Known, Target0, Gapped) :-
+    D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
     (   Known = sorted(Leaf, Hits)
@@ -590,6 +605,10 @@ insert(KB, D, Facts, A, N, Known, Target) :-
     ),
     arg(Leaf, Leaves, L),
     L = l(Q0, N0, _, _, _, C, _, _, Ring),
+    (   Gapped = gap(Gap, V)
+    ->  Target is Target0 - Gap * (V - Q0)
+    ;   Target = Target0
+    ),
     N1 is N0 + 1,
     Q is Q0 + max(1 / N1, Alpha) * (Target - Q0),
     nb_setarg(1, L, Q), nb_setarg(2, L, N1), nb_setarg(7, L, Clock),
@@ -885,8 +904,10 @@ relrl_engine:learner_parameter(tg, half_life, 1000.0, nonneg).
 relrl_engine:learner_parameter(tg, novelty_bonus, 20.0, nonneg).
 relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
 relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
+relrl_engine:learner_parameter(tg, action_gap, 0.0, unit).
 relrl_engine:learner_serves(tg, domains, []).
-relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0]).
+relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
+                                         action_gap=0.5]).
 
 relrl_engine:learner_forget(tg, KB) :-
     tg_forget(KB).

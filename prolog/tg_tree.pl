@@ -62,7 +62,8 @@ explains, draws, saves and restores them.
 %                  TDError, Clock) or `none` (a split sorts them into its children); the
 %                  numbers are updated with nb_setarg/3. Params = p(Alpha, Gamma, Epsilon,
 %                  Tau, Level, MinExamples, Kappa, HalfLife, novelty(Beta, Confidence),
-%                  Keep) (Kappa the stale bonus, Beta the novelty bonus). Cache =
+%                  Keep, Gap) (Kappa the stale bonus, Beta the novelty bonus, Gap the
+%                  action gap). Cache =
 %                  last(Facts, N, Allowed, Classes, LeafIds, Version, Chose): the classes
 %                  of the next state's allowed responses (tg_classes.pl) and their leaves,
 %                  found by the last update and reused by the choice that follows in the

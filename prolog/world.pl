@@ -365,7 +365,7 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
             ;   Next = V1
             )
         ),
-        Tr = transition(V, A, none, R, Done, Next, none, Legal1),
+        Tr = transition(V, A, none, Legal, R, Done, Next, none, Legal1),
         (   Mode == learn, Updates == online
         ->  learner_update(Learner, KB, Tr), Ex1 = Ex0
         ;   Mode == learn

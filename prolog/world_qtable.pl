@@ -120,11 +120,11 @@ listed(Allowed, List) :-
     ;   List = Allowed
     ).
 
-update(KB, transition(S0, A0, N0, R, _, S1, N1, Allowed0)) :-
+update(KB, transition(S0, A0, N0, _, R, _, S1, N1, Next)) :-
     params(KB, p(Alpha, Gamma, _, _, Qinit)),
     (   S1 == terminal
     ->  Allowed1 = []
-    ;   listed(Allowed0, Allowed1)
+    ;   listed(Next, Allowed1)
     ),
     (   ( S1 == terminal ; Allowed1 == [] )
     ->  Target = R

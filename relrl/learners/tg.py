@@ -41,7 +41,10 @@ class TGLearner(Learner):
     leaf that succeeds on it — capped at novelty_bonus, which is also the bound of a region
     fewer than two examples reached; novelty_bonus 0 turns it off), keep_examples (each
     leaf keeps its last examples so that a split's children start with statistics; 0: they
-    start empty). Explore and greedy choices and the Q-targets never include the bonuses.
+    start empty), action_gap (advantage learning: each Q-target is lowered by action_gap
+    times the gap between the best Q of the example's state and the example's own Q, so
+    that a leaf's value ranks moves within a state rather than states; 0 in the domains,
+    0.5 in worlds). Explore and greedy choices and the Q-targets never include the bonuses.
     Choices are over classes of responses no test of the bias tells apart in the state
     (scored by one representative, uniform within a class). This class reads its
     explanations.

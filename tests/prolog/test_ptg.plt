@@ -25,7 +25,7 @@ blocks_kb(KB) :-
 params(P) :-
     P = [alpha=0.2, gamma=0.9, epsilon=0.05, temperature=1, q_init=0, significance=0.001,
          min_examples=5, stale_bonus=0, half_life=1000, novelty_bonus=0,
-         novelty_confidence=2, keep_examples=0, reward_positive=10, reward_negative= -1,
+         novelty_confidence=2, keep_examples=0, action_gap=0, reward_positive=10, reward_negative= -1,
          p_margin=0, p_alpha=0.02, p_pairs=1].
 
 %   Towers bottom first: [[b1, b2], [b3]] is b2 on b1 on the floor, b3 on the floor.
@@ -91,8 +91,9 @@ test(terminal_transition_adds_no_p_example, [N == 0]) :-
     relrl_engine:engine_configure(KB, ptg, P, 0),
     towers([[b1, b2], [b3]], S),
     world_view(KB, unstack, S, V),
-    once(relrl_engine:learner_update(ptg, KB, transition(V, move(b2, floor), none, 1, true,
-                                                         terminal, none, []))),
+    world_actions(KB, S, Legal),
+    once(relrl_engine:learner_update(ptg, KB, transition(V, move(b2, floor), none, Legal, 1,
+                                                         true, terminal, none, []))),
     ptg_size(KB, size(_, Details)),
     memberchk(p_leaves=1, Details),
     ptg_key(KB, PK),
@@ -108,14 +109,15 @@ test(a_step_labels_a_pair, [N == 2]) :-
     towers([[b1, b2], [b3]], S1),
     world_view(KB, unstack, S0, V0),
     world_view(KB, unstack, S1, V1),
+    world_actions(KB, S0, Allowed0),
     world_actions(KB, S1, Allowed),
     relrl_tg:tg_size(PK, size(_, D0)),
     memberchk(leaves=L, D0),
     findall(Id-C, ( between(1, 1000, Id), relrl_tg_tree:tg_leaf(PK, Id, l(_, C, _, _, _, _,
                                                                          _, _, _)) ), Before),
     % (tg_update/2 may leave a choice point: once/1)
-    once(relrl_engine:learner_update(ptg, KB, transition(V0, move(b3, floor), none, 0, false,
-                                                         V1, none, Allowed))),
+    once(relrl_engine:learner_update(ptg, KB, transition(V0, move(b3, floor), none, Allowed0,
+                                                         0, false, V1, none, Allowed))),
     relrl_tg:tg_size(PK, size(_, D1)),
     assertion(memberchk(leaves=L, D1)),
     findall(Id-C, ( member(Id-_, Before), relrl_tg_tree:tg_leaf(PK, Id, l(_, C, _, _, _, _,

@@ -25,7 +25,7 @@ gaze_kb(KB) :-
 params(Level, MinEx,
        [alpha=0, gamma=0.9, epsilon=0, temperature=0, q_init=0, significance=Level,
         min_examples=MinEx, stale_bonus=0, half_life=0, novelty_bonus=0,
-        novelty_confidence=2, keep_examples=0]).
+        novelty_confidence=2, keep_examples=0, action_gap=0]).
 
 fresh_learner(KB, Level, MinEx) :-
     gaze_kb(KB),
@@ -294,17 +294,62 @@ test(forgetting_rescales, [true(abs(Today - Expected) < 1.0e-9)]) :-
 
 today_weight(KB, Today) :-
     relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base, _)),
-    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _, _), _, _, _, Clock, _)),
+    relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _, _, _), _, _, _, Clock, _)),
     Today is M / 2 ** ((Clock - Base) / H).
 
 test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-
     % one leaf; Q(s', .) = 10 after the first example; target = 10 + 0.9 * 10
     fresh_learner(KB, 0.001, 1000),
     tg_insert(KB, [gaze(face, p1)], look(p1), curiosity, 10),
-    tg_update(KB, transition([gaze(face, p1)], look(p2), curiosity, 10, true,
+    tg_update(KB, transition([gaze(face, p1)], look(p2), curiosity, [look(p2)], 10, true,
                              [gaze(face, p2)], curiosity, [look(p1)])),
     tg_q(KB, [gaze(face, p1)], look(p1), curiosity, Q0),
     Q is 2 * Q0 - 10.                    % the leaf's mean of 10 and the target
+
+test(action_gap_lowers_the_target_by_the_gap, [true(abs(Q - Expected) < 1.0e-9)]) :-
+    % a split tree: following the gaze (Q near 10), not (near 0). A look away from the gaze
+    % with reward 0 in a terminal step: its target 0 is lowered by 0.5 times the gap
+    % between the state's best allowed response (look(p1)) and its own leaf's Q
+    gap_learner(KB, 0.5),
+    S0 = [gaze(face, p1)],
+    tg_q(KB, S0, look(p1), curiosity, Best),
+    tg_q(KB, S0, look(p2), curiosity, Q0),
+    relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
+    tg_update(KB, transition(S0, look(p2), curiosity, [look(p1), look(p2)], 0, false,
+                             terminal, curiosity, [])),
+    tg_q(KB, S0, look(p2), curiosity, Q),
+    Target is 0 - 0.5 * (Best - Q0),
+    Expected is Q0 + (Target - Q0) / (N0 + 1).      % alpha 0: the running mean
+
+test(action_gap_is_over_the_allowed_responses, [true(abs(Q - Expected) < 1.0e-9)]) :-
+    % the same step when only looks away from the gaze were allowed: no gap, target 0
+    gap_learner(KB, 0.5),
+    S0 = [gaze(face, p1)],
+    tg_q(KB, S0, look(p2), curiosity, Q0),
+    relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
+    tg_update(KB, transition(S0, look(p2), curiosity, [look(p2), look(p3)], 0, false,
+                             terminal, curiosity, [])),
+    tg_q(KB, S0, look(p2), curiosity, Q),
+    Expected is Q0 + (0 - Q0) / (N0 + 1).
+
+test(no_action_gap_no_change, [true(abs(Q - Expected) < 1.0e-9)]) :-
+    gap_learner(KB, 0),
+    S0 = [gaze(face, p1)],
+    tg_q(KB, S0, look(p2), curiosity, Q0),
+    relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
+    tg_update(KB, transition(S0, look(p2), curiosity, [look(p1), look(p2)], 0, false,
+                             terminal, curiosity, [])),
+    tg_q(KB, S0, look(p2), curiosity, Q),
+    Expected is Q0 + (0 - Q0) / (N0 + 1).
+
+%   A tree split on following the gaze (targets 10 and 0 with a wobble), action_gap Gap.
+gap_learner(KB, Gap) :-
+    plunit_tg_split:learner_with(KB, [action_gap=Gap]),
+    feed(KB, [p1, p2, p3], 6),
+    root(KB, node(_, _, _, _, _)).
 
 test(explain_shows_bindings, [Path == [test(1, "gaze(face, P), action(look(P))", true,
                                             ['P'-p4])]]) :-

@@ -26,7 +26,7 @@ places_kb(KB) :-
 params(Extra, Params) :-
     Params0 = [alpha=0, gamma=0.9, epsilon=0, temperature=1, q_init=0, significance=0.001,
                min_examples=5, stale_bonus=0, half_life=0, novelty_bonus=0,
-               novelty_confidence=2, keep_examples=0, reward_positive=10,
+               novelty_confidence=2, keep_examples=0, action_gap=0, reward_positive=10,
                reward_negative= -1],
     foldl([K=V, P0, P]>>selectchk(K=_, P0, K=V, P), Extra, Params0, Params).
 
@@ -183,7 +183,7 @@ sum_counts([M, _, _|Xs], S) :-
     S is S0 + M.
 
 test(children_start_empty_without_kept_examples, [Counts == [0-0, 0-0]]) :-
-    learner(KB, [keep_examples=0]),
+    learner(KB, [keep_examples=0, action_gap=0]),
     split_stream(KB),
     child_counts(KB, Counts).
 

@@ -242,7 +242,7 @@ test(a_domain_keeps_its_rmodes) :-
 params(P) :-
     P = [alpha=0.2, gamma=1, epsilon=0.05, temperature=1, q_init=0, significance=0.001,
          min_examples=5, stale_bonus=0, half_life=1000, novelty_bonus=1,
-         novelty_confidence=2, keep_examples=32, reward_positive=10, reward_negative= -1].
+         novelty_confidence=2, keep_examples=32, action_gap=0, reward_positive=10, reward_negative= -1].
 
 test(terminal_target_is_the_reward, [Q =:= 0]) :-
     % one leaf; a goal-reaching example with reward 0 moves Q (from q_init 0) towards 0
@@ -251,8 +251,9 @@ test(terminal_target_is_the_reward, [Q =:= 0]) :-
     relrl_engine:engine_configure(KB, tg, P, 0),
     towers([[b1, b2], [b3]], S),
     world_view(KB, stack, S, V),
-    relrl_engine:learner_update(tg, KB, transition(V, move(b3, b2), none, 0, true, terminal,
-                                                   none, [])),
+    world_actions(KB, S, Legal),
+    relrl_engine:learner_update(tg, KB, transition(V, move(b3, b2), none, Legal, 0, true,
+                                                   terminal, none, [])),
     relrl_tg:tg_q(KB, V, move(b3, b2), none, Q).
 
 test(same_seed_same_episodes, [A == B]) :-
@@ -293,7 +294,7 @@ learned_tg(KB) :-
     world_for_task(KB, unstack),
     P = [alpha=0.2, gamma=1, epsilon=0.05, temperature=0, q_init=0, significance=0.001,
          min_examples=5, stale_bonus=0, half_life=1000, novelty_bonus=0,
-         novelty_confidence=2, keep_examples=0],
+         novelty_confidence=2, keep_examples=0, action_gap=0],
     relrl_engine:engine_configure(KB, tg, P, 3),
     world_episodes(KB, episodes(unstack, [3, 4, 5], 150, learn, []), _).
 
@@ -333,7 +334,7 @@ test(the_classes_are_found_without_listing_the_moves, [Asked == 1]) :-
     world_for_task(KB, unstack),
     relrl_engine:engine_configure(KB, tg, [alpha=0.2, gamma=1, epsilon=0.05,
         temperature=0, q_init=0, significance=0.001, min_examples=5, stale_bonus=0,
-        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0], 0),
+        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0, action_gap=0], 0),
     all_floor(10, S),
     world_legal(KB, S, Moves),
     length(Moves, 90),
@@ -388,7 +389,7 @@ test(boltzmann_draw_is_boltzmann_over_the_moves) :-
     world_for_task(KB, stack),
     relrl_engine:engine_configure(KB, tg, [alpha=0.2, gamma=1, epsilon=0.05,
         temperature=1.0, q_init=0, significance=0.001, min_examples=5, stale_bonus=0,
-        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0], 1),
+        half_life=1000, novelty_bonus=0, novelty_confidence=2, keep_examples=0, action_gap=0], 1),
     world_episodes(KB, episodes(stack, [3, 4, 5], 300, learn, []), _),
     towers([[b1, b2, b3], [b4], [b5, b6]], S),
     world_view(KB, stack, S, V),
