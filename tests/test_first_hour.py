@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, default_signals
 
 URL = re.compile(r"(http://127\.0\.0\.1:\d+/\S*)")
 
@@ -60,9 +60,11 @@ def _get(url: str) -> str:
 def _serve_and_read(line: str, cwd: Path, *, interrupt: bool) -> str:
     """Run a command that prints its page's address; fetch the page while it serves; stop
     it with Ctrl-C (``interrupt``) or let it end. Returns its whole output."""
+    # Ctrl-C as at a terminal: a suite started in the background (`make test &`) runs with
+    # SIGINT ignored, and an ignored signal is inherited
     proc = subprocess.Popen(["bash", "-c", f"exec {line}"], cwd=cwd, text=True,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=default_signals)
     assert proc.stdout is not None
     out = []
     try:
