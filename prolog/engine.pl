@@ -520,6 +520,10 @@ prolog:error_message(learner_hooks(Learner, Problems)) -->
     hook_problems(Problems).
 prolog:error_message(learner_capability(Learner, Cap)) -->
     [ 'learner ~q has no capability ~q (learner_property/2)'-[Learner, Cap] ].
+prolog:error_message(learner_hook_failed(Learner, learner_update/3)) --> !,
+    [ 'learner ~q: its hook learner_update/3 failed (a hook must succeed; it is given '-
+      [Learner],
+      'transition(S0, A0, N0, Allowed0, R, Reinforced, S1, N1, Allowed1))' ].
 prolog:error_message(learner_hook_failed(Learner, Hook)) -->
     [ 'learner ~q: its hook ~q failed (a hook must succeed)'-[Learner, Hook] ].
 

@@ -605,8 +605,8 @@ insert(KB, D, Facts, A, N, Known, Target0, Gapped) :-
     ),
     arg(Leaf, Leaves, L),
     L = l(Q0, N0, _, _, _, C, _, _, Ring),
-    (   Gapped = gap(Gap, V)
-    ->  Target is Target0 - Gap * (V - Q0)
+    (   Gapped = gap(Gap, V)                       % (an action emitted outside the
+    ->  Target is Target0 - Gap * max(0, V - Q0)   % allowed ones: no gap)
     ;   Target = Target0
     ),
     N1 is N0 + 1,

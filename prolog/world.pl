@@ -352,7 +352,7 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
     ->  Steps = T, Return = Ret0, Reached = false, Ex = Ex0,
         end_trace(Run, S, Trace)
     ;   Run = run(KB, Learner, Mode, Updates, _, KeepTrace),
-        relrl_engine:learner_choose(Learner, KB, V, none, Legal, Mode, A),
+        relrl_engine:hook(learner_choose(Learner, KB, V, none, Legal, Mode, A)),
         world_next(KB, Goal, S, A, S1, outcome(R, Done)),
         Ret1 is Ret0 + R,
         T1 is T + 1,
@@ -393,8 +393,9 @@ end_trace(run(_, _, _, _, _, KeepTrace), S, Trace) :-
     ;   Trace = []
     ).
 
+%   A hook that fails is an error naming it, as in a control step (engine.pl).
 learner_update(Learner, KB, Transition) :-
-    relrl_engine:learner_update(Learner, KB, Transition).
+    relrl_engine:hook(learner_update(Learner, KB, Transition)).
 
 % ---- optimal steps -------------------------------------------------------------------------
 

@@ -334,6 +334,19 @@ test(action_gap_is_over_the_allowed_responses, [true(abs(Q - Expected) < 1.0e-9)
     tg_q(KB, S0, look(p2), curiosity, Q),
     Expected is Q0 + (0 - Q0) / (N0 + 1).
 
+test(action_gap_never_raises_a_target, [true(abs(Q - Expected) < 1.0e-9)]) :-
+    % a response emitted outside the allowed ones (an agent may emit any): its own Q is
+    % above the best allowed one, and the target stays 0 rather than going up
+    gap_learner(KB, 0.5),
+    S0 = [gaze(face, p1)],
+    tg_q(KB, S0, look(p1), curiosity, Q0),
+    relrl_tg_tree:tg_sort_(KB, S0, look(p1), curiosity, Leaf),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
+    once(tg_update(KB, transition(S0, look(p1), curiosity, [look(p2), look(p3)], 0, false,
+                                  terminal, curiosity, []))),
+    tg_q(KB, S0, look(p1), curiosity, Q),
+    Expected is Q0 + (0 - Q0) / (N0 + 1).
+
 test(no_action_gap_no_change, [true(abs(Q - Expected) < 1.0e-9)]) :-
     gap_learner(KB, 0),
     S0 = [gaze(face, p1)],

@@ -284,7 +284,64 @@ test(trace_ends_with_the_last_state) :-
     assertion(L =:= Steps + 1),
     last(Trace, end(_)).
 
+test(world_gap_target_is_below_the_plain_one, [true(Gapped < Plain)]) :-
+    % advantage learning in a world, a step that is not terminal: a move whose leaf is not
+    % the best of its state is learned towards a target lowered by the gap between the
+    % state's best leaf and its own, so the same update without the gap leaves it higher
+    gap_update(0.5, Gapped),
+    gap_update(0, Plain).
+
+%   A tg learner of unstack trained on 300 episodes (seed 3), then one learning update of the
+%   move of lowest Q in a state with three legal moves; Q is that move's value after it.
+gap_update(Gap, Q) :-
+    world_kb('examples/worlds/blocks.pl', KB),
+    params(P0),
+    selectchk(action_gap=_, P0, action_gap=Gap, P1),
+    selectchk(gamma=_, P1, gamma=0.9, P),       % discounted: right and wrong moves differ
+    relrl_engine:engine_configure(KB, tg, P, 3),
+    once(world_episodes(KB, episodes(unstack, [3, 4], 300, learn, []), _)),
+    towers([[b1, b2], [b3]], S0),
+    world_view(KB, unstack, S0, V0),
+    world_actions(KB, S0, Legal0),
+    world_action_list(Legal0, Moves),
+    maplist(scored(KB, V0), Moves, Scored),
+    msort(Scored, Sorted),
+    Sorted = [Qw-Worst|_],
+    last(Sorted, Qb-_),
+    assertion(Qb > Qw),                         % the learned tree tells them apart
+    world_next(KB, unstack, S0, Worst, S1, _),
+    world_view(KB, unstack, S1, V1),
+    world_actions(KB, S1, Legal1),
+    once(relrl_engine:learner_update(tg, KB, transition(V0, Worst, none, Legal0, 0, false,
+                                                        V1, none, Legal1))),
+    relrl_tg:tg_q(KB, V0, Worst, none, Q).
+
+scored(KB, V, Move, Q-Move) :-
+    relrl_tg:tg_q(KB, V, Move, none, Q).
+
+test(a_failing_update_names_the_hook,
+     [error(learner_hook_failed(failing_update, learner_update/3), _)]) :-
+    % a learner whose update fails (one written for another transition term, say): the
+    % episodes raise an error naming it rather than failing
+    world_kb('examples/worlds/blocks.pl', KB),
+    relrl_engine:engine_configure(KB, failing_update, [reward_positive=1,
+                                                       reward_negative=0], 0),
+    world_episodes(KB, episodes(unstack, [3], 2, learn, []), _).
+
 :- end_tests(world_episodes).
+
+% A learner of worlds for the test above: it acts and its update fails.
+:- multifile relrl_engine:learner/1, relrl_engine:learner_init/3,
+   relrl_engine:learner_forget/2, relrl_engine:learner_choose/7,
+   relrl_engine:learner_update/3, relrl_engine:learner_explain/5,
+   relrl_engine:learner_serves/3.
+relrl_engine:learner(failing_update).
+relrl_engine:learner_init(failing_update, _, _).
+relrl_engine:learner_forget(failing_update, _).
+relrl_engine:learner_choose(failing_update, _, _, _, actions(A, G), _, A) :- once(G).
+relrl_engine:learner_update(failing_update, _, _) :- fail.
+relrl_engine:learner_explain(failing_update, _, _, _, none).
+relrl_engine:learner_serves(failing_update, worlds, []).
 
 :- begin_tests(world_leaf_classes).
 
