@@ -193,11 +193,7 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
     ),
     D = tg(p(_, _, Epsilon, Tau, _, _, Kappa, Half, novelty(Beta, Conf), _, _), Leaves, Cache,
            Version, Clock, Index),
-    (   Cache = last(F1, N1, A1, Classes0, Ids0, Version, _), F1 == Facts, N1 == N,
-        A1 == Allowed
-    ->  Classes = Classes0, Ids = Ids0
-    ;   classes(KB, Index, Facts, N, Allowed, all, Classes, Ids)
-    ),
+    look_up(KB, D, Facts, N, Allowed, all, _, Classes, Ids),
     (   Mode \== greedy, Tau =:= 0,
         random_float < Epsilon
     ->  random_member(Class, Classes),
@@ -355,10 +351,19 @@ reached(Search, Id) :-
 %   the tree are not searched; a domain's classes are all found either way). The last
 %   update's look-up of the same state is reused while the tree is unchanged.
 
-tg_class_values(KB, Facts, N, Allowed0, Scope, Classes, Qs) :-
+tg_class_values(KB, Facts, N, Allowed, Scope, Classes, Qs) :-
     must_be(oneof([all, best]), Scope),
     tg_data(KB, D),
-    D = tg(_, Leaves, Cache, Version, _, Index),
+    look_up(KB, D, Facts, N, Allowed, Scope, _, Classes, Ids),
+    arg(2, D, Leaves),
+    maplist(leaf_q(Leaves), Ids, Qs).
+
+%   Classes are the classes of the Allowed responses in the state Facts (every response
+%   when Allowed0 is [], Allowed what was looked up) and Ids the leaves their
+%   representatives sort to: the last update's look-up when it was of the same state,
+%   necessity, responses and tree, else found (classes/8).
+look_up(KB, D, Facts, N, Allowed0, Scope, Allowed, Classes, Ids) :-
+    D = tg(_, _, Cache, Version, _, Index),
     (   Allowed0 == []
     ->  tg_get_tree(KB, tree(_, _, _, Allowed))
     ;   Allowed = Allowed0
@@ -367,8 +372,7 @@ tg_class_values(KB, Facts, N, Allowed0, Scope, Classes, Qs) :-
         A1 == Allowed
     ->  Classes = Classes0, Ids = Ids0
     ;   classes(KB, Index, Facts, N, Allowed, Scope, Classes, Ids)
-    ),
-    maplist(leaf_q(Leaves), Ids, Qs).
+    ).
 
 %   The chosen action with the leaf and candidate hits of its class, found for its bonus,
 %   noted in the cache the update of this step made (Cache, for the same state and tree):
@@ -544,39 +548,31 @@ pick([W|Ws], [A|As], X, Action) :-
 
 tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
-    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _, Gap), _, Cache0, Version, _, _),
+    D = tg(p(_, Gamma, _, _, _, _, _, _, _, _, Gap), Leaves, Cache0, Version, _, _),
+    (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
+        M0 == N0, B0 == A0
+    ->  Known = sorted(Leaf0, Hits0)            % the choice sorted this example already
+    ;   Known = none
+    ),
+    (   Gap > 0                                 % (S0's look-up, before S1's replaces it)
+    ->  look_up(KB, D, S0, N0, Allowed0, best, _, _, Ids0),
+        max_q(Leaves, Ids0, V0),
+        Gapped = gap(Gap, V0)
+    ;   Gapped = none
+    ),
     (   S1 == terminal                          % the episode ended (a world's goal)
-    ->  Known = none,
-        Target = Reward
-    ;   (   Cache0 = last(F0, M0, _, _, _, Version, chose(B0, Leaf0, Hits0)), F0 == S0,
-            M0 == N0, B0 == A0
-        ->  Known = sorted(Leaf0, Hits0)        % the choice sorted this example already
-        ;   Known = none
-        ),
-        best_q(KB, D, S1, N1, Allowed1, Next, Classes, Ids, Max),
+    ->  Target = Reward
+    ;   look_up(KB, D, S1, N1, Allowed1, best, Next, Classes, Ids),
+        max_q(Leaves, Ids, Max),
         Target is Reward + Gamma * Max,
         (   Next = actions(_, _)                % a world's: only the best classes were
         ->  nb_setarg(3, D, none)               % found, not what a choice needs
         ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
         )
     ),
-    (   Gap > 0
-    ->  best_q(KB, D, S0, N0, Allowed0, _, _, _, V0),
-        Gapped = gap(Gap, V0)
-    ;   Gapped = none
-    ),
     insert(KB, D, S0, A0, N0, Known, Target, Gapped).
 
-%   Max is the largest Q of the responses Allowed in the state Facts (of every response
-%   when Allowed is []), found over the classes of largest Q (Classes, their leaves Ids);
-%   Next is what was searched.
-best_q(KB, D, Facts, N, Allowed, Next, Classes, Ids, Max) :-
-    D = tg(_, Leaves, _, _, _, Index),
-    (   Allowed == []
-    ->  tg_get_tree(KB, tree(_, _, _, Next))
-    ;   Next = Allowed
-    ),
-    classes(KB, Index, Facts, N, Next, best, Classes, Ids),
+max_q(Leaves, Ids, Max) :-
     maplist(leaf_q(Leaves), Ids, Qs),
     max_list(Qs, Max).
 
