@@ -36,6 +36,10 @@ def add_session_arguments(parser: argparse.ArgumentParser) -> None:
                    help="serve the session live to Foxglove over its WebSocket protocol "
                         "(default 127.0.0.1:8765; off localhost a token is required; needs "
                         "the mcap and foxglove extras)")
+    g.add_argument("--foxglove-origin", action="append", default=[], metavar="ORIGIN",
+                   help="let the pages of this web origin connect to --foxglove (a browser's "
+                        "connection from any other page is refused), e.g. "
+                        "https://app.foxglove.dev for Foxglove's web app; repeatable")
     g.add_argument("--record", action="store_true",
                    help="record the session into --out DIR/session.mcap (MCAP: Foxglove "
                         "opens it, `relrl replay` scrubs it; needs the mcap extra)")
@@ -124,6 +128,13 @@ def _check(args: argparse.Namespace) -> None:
         raise ConfigError(f"--record-quality must be in 1..100, not {args.record_quality}")
     if args.monitor_hold and args.monitor is None:
         raise ConfigError("--monitor-hold needs --monitor")
+    if args.foxglove_origin:
+        from relrl.monitor.server import parse_origin
+
+        if args.foxglove is None:
+            raise ConfigError("--foxglove-origin needs --foxglove")
+        for origin in args.foxglove_origin:
+            parse_origin(origin)
     if args.record or args.foxglove is not None:
         missing = [name for name in ("mcap", "mcap_ros2")
                    + (("websockets",) if args.foxglove is not None else ())
@@ -156,7 +167,8 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
         if args.foxglove is not None:
             from relrl.recording.recorder import Recorder
 
-            opts.recorder = Recorder(foxglove=args.foxglove)
+            opts.recorder = Recorder(foxglove=args.foxglove,
+                                     origins=tuple(args.foxglove_origin))
             opts.live_rate = args.monitor_rate
             session.closers.append(opts.recorder)
             note = " (token required: not bound to localhost)" if opts.recorder.token else ""

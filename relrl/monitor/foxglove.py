@@ -12,7 +12,11 @@ channel is sent at once on subscribing, so a late client sees the tree and the l
 The rules of ``--monitor``: **read-only** (no capability is offered; a client's advertise,
 publish, parameter or service request is answered with an error status and ignored);
 **localhost by default** with the Host header checked; bound elsewhere, a token printed at
-start is required (``?token=`` in the address or ``Authorization: Bearer``); **at most**
+start is required (``?token=`` in the address or ``Authorization: Bearer``); **no web page
+but the allowed**: a handshake with an ``Origin`` header (a browser sends one with every
+WebSocket) is refused unless the user allowed that origin (``--foxglove-origin
+https://app.foxglove.dev`` for Foxglove's web app), so a page open in the user's browser
+cannot watch the session; a client that sends none (a program) is served; **at most**
 :data:`MAX_CLIENTS` clients; and it **never stalls the session**: messages are handed over by
 appending to a bounded deque; the server's own thread (asyncio, the
 ``websockets`` package) sends them, each client from a bounded queue of its own, so a slow
@@ -32,16 +36,18 @@ import time
 from collections import deque
 from typing import Any
 
-from relrl.monitor.server import is_loopback, listen, parse_address
+from relrl.monitor.server import check_origin, host_of, is_loopback, listen, parse_address
 from relrl.recording.channels import CHANNELS, Channel
 
-__all__ = ["MAX_CLIENTS", "SUBPROTOCOL", "FoxgloveServer"]
+__all__ = ["FOXGLOVE_APP", "MAX_CLIENTS", "SUBPROTOCOL", "FoxgloveServer"]
 
 SUBPROTOCOL = "foxglove.websocket.v1"
 #: clients served at once; more are refused (503) until one leaves.
 MAX_CLIENTS = 8
 #: messages waiting to be sent, for the server and for each client (older ones are dropped).
 BACKLOG = 1024
+#: Foxglove's web app, the origin a user allows to watch in a browser.
+FOXGLOVE_APP = "https://app.foxglove.dev"
 #: seconds between two hand-overs from the session to the clients.
 PERIOD = 0.02
 _MESSAGE_DATA = 1
@@ -66,10 +72,16 @@ class FoxgloveServer:
         address: ``HOST:PORT`` (default 127.0.0.1:8765; port 0: a free one).
         token: the token to require (default: a fresh one when not bound to loopback).
         channels: the channels to advertise.
+        origins: the web origins whose pages may connect (checked with
+            :func:`~relrl.monitor.server.parse_origin`); none by default.
     """
 
     def __init__(self, address: str | None = None, *, token: str | None = None,
-                 channels: tuple[Channel, ...] = CHANNELS) -> None:
+                 channels: tuple[Channel, ...] = CHANNELS,
+                 origins: tuple[str, ...] = ()) -> None:
+        from relrl.monitor.server import parse_origin
+
+        self.origins = frozenset(parse_origin(o) for o in origins)
         self.host, self.port = parse_address(address or "127.0.0.1:8765")
         self.loopback = is_loopback(self.host)
         self.token = token if token is not None else \
@@ -163,9 +175,17 @@ class FoxgloveServer:
                     client.ws.transport.abort()
 
     def _check(self, connection: Any, request: Any) -> Any:
-        """Refuse a wrong Host (loopback), a missing token (elsewhere), too many clients."""
+        """Refuse a web page's origin not allowed, a wrong Host (loopback), a missing token
+        (elsewhere), too many clients."""
         from urllib.parse import parse_qs, urlsplit
 
+        origins = request.headers.get_all("Origin")
+        why = check_origin(origins[0] if len(origins) == 1 else
+                           (None if not origins else "(several)"), "", self.origins)
+        if why is not None:
+            self.refused += 1
+            return connection.respond(403, f"{why}: the server serves the pages of the "
+                                           "origins given with --foxglove-origin only\n")
         if self.token is not None:
             query = parse_qs(urlsplit(request.path).query)
             given = (query.get("token") or [""])[-1]
@@ -178,7 +198,7 @@ class FoxgloveServer:
                                                "printed when the server started\n")
         else:
             hosts = request.headers.get_all("Host")
-            host = hosts[0].rsplit(":", 1)[0].strip("[]") if len(hosts) == 1 else ""
+            host = host_of(hosts[0]) if len(hosts) == 1 else ""
             if host not in {"127.0.0.1", "localhost", "::1", self.host}:
                 self.refused += 1
                 return connection.respond(403, f"unexpected Host {host!r}\n")

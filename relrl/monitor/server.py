@@ -12,7 +12,11 @@ Read-only by construction: every route answers GET (and HEAD) only, anything els
 and no handler touches the robot or the knowledge base (they read the hub or the recording).
 Bound to a loopback address, the server checks the Host header (no DNS rebinding); bound
 elsewhere, every request must carry the token printed at start (``?token=``, a
-``Authorization: Bearer`` header, or the cookie the page sets).
+``Authorization: Bearer`` header, or the cookie the page sets). Either way a request another
+web site's page makes is refused (403): an ``Origin`` header other than the monitor's own
+(:func:`same_origin`), or a browser's ``Sec-Fetch-Site: cross-site`` on anything but the
+user opening a page (``Sec-Fetch-Mode: navigate``); so a page open in the user's browser can
+neither read the session nor embed its frames. Only HTTP is served: a WebSocket is refused.
 
 Hostile clients: connections, request time and send time are bounded
 (:mod:`relrl.monitor.bounds`); numbers in paths and queries are ASCII digits, at most 15 of
@@ -41,8 +45,8 @@ from relrl.monitor.bounds import Limits, bounded_protocol
 from relrl.monitor.graph import LEAF_LEGENDS, Picture
 from relrl.monitor.schema import finite
 
-__all__ = ["Endpoint", "LiveSource", "MonitorServer", "build_app", "host_of", "is_loopback",
-           "listen", "parse_address", "whole"]
+__all__ = ["Endpoint", "LiveSource", "MonitorServer", "build_app", "check_origin", "host_of",
+           "is_loopback", "listen", "parse_address", "parse_origin", "same_origin", "whole"]
 
 log = logging.getLogger(__name__)
 
@@ -111,6 +115,53 @@ def host_of(header: str) -> str:
     return value  # a name, an IPv4 address, or an IPv6 address given without brackets
 
 
+def same_origin(origin: str, host: str) -> bool:
+    """Whether a request's ``Origin`` header names the server it was sent to: ``http://``
+    and the request's ``Host`` header, letter for letter (case aside)."""
+    return origin.strip().lower() == "http://" + host.strip().lower()
+
+
+def check_origin(origin: str | None, host: str, allowed: frozenset[str] = frozenset()
+                 ) -> str | None:
+    """Why a request with this ``Origin`` header is refused, or ``None`` when it is served.
+
+    Browsers send ``Origin`` with every WebSocket handshake and every cross-origin request,
+    so a request without one comes from a program, not from a web page; one with it is
+    served when it is the server's own origin (:func:`same_origin`) or one of ``allowed``.
+
+    Args:
+        origin: the ``Origin`` header (``None``: none was sent).
+        host: the request's ``Host`` header.
+        allowed: origins the user allowed (``https://app.foxglove.dev``), lower-case.
+    """
+    if origin is None or same_origin(origin, host) or origin.strip().lower() in allowed:
+        return None
+    return f"a request from the web page origin {origin[:100]!r} is refused"
+
+
+def parse_origin(text: str) -> str:
+    """An origin a user allows, checked and in lower case: ``SCHEME://HOST[:PORT]`` with
+    ``http`` or ``https`` and nothing after (``https://app.foxglove.dev``).
+
+    Raises:
+        ConfigError: anything else (a path, a wildcard, ``null``).
+    """
+    from urllib.parse import urlsplit
+
+    value = text.strip().lower()
+    try:
+        parts = urlsplit(value)
+        ok = (parts.port is None or parts.port > 0) and parts.scheme in ("http", "https") \
+            and bool(parts.hostname) and value == f"{parts.scheme}://{parts.netloc}" \
+            and "@" not in value and "*" not in value
+    except ValueError:  # a port that is not a number
+        ok = False
+    if not ok:
+        raise ConfigError(f"bad origin {text[:100]!r}: give SCHEME://HOST[:PORT] as a browser "
+                          "sends it, e.g. https://app.foxglove.dev")
+    return value
+
+
 def whole(text: str | None) -> int | None:
     """``text`` as an integer when it is ASCII digits (at most 15, an optional minus), else
     ``None`` (no ``'²'``, no 5,000-digit numbers)."""
@@ -165,6 +216,9 @@ class _Guard:
         return None
 
     async def __call__(self, scope: dict[str, Any], receive: Any, send: Any) -> None:
+        if scope["type"] == "websocket":  # the monitor serves HTTP only
+            await send({"type": "websocket.close", "code": 1008})
+            return
         if scope["type"] != "http":
             await self.app(scope, receive, send)
             return
@@ -183,9 +237,14 @@ class _Guard:
                     (b"content-security-policy", csp.encode())]}
             await send(message)
 
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1")
+                   for k, v in scope.get("headers", [])}
+        refused = _cross_site(headers)
         if scope["method"] not in _READ_METHODS:
             response = PlainTextResponse("the monitor is read-only\n", status_code=405,
                                          headers={"Allow": "GET, HEAD"})
+        elif refused is not None:
+            response = PlainTextResponse(refused + "\n", status_code=403)
         elif self.token is not None:
             given = self._token_of(scope) or ""
             if secrets.compare_digest(given.encode(), self.token.encode()):
@@ -194,8 +253,7 @@ class _Guard:
             response = PlainTextResponse("a token is required: use the address printed "
                                          "when the monitor started\n", status_code=401)
         else:
-            headers = dict(scope.get("headers", []))
-            host = host_of(headers.get(b"host", b"").decode("latin-1"))
+            host = host_of(headers.get("host", ""))
             if host in self.hosts:
                 await self._answer(scope, receive, secured, lambda: started)
                 return
@@ -213,6 +271,18 @@ class _Guard:
             if not started():
                 await _text("the monitor could not answer this request", 500)(
                     scope, receive, send)
+
+
+def _cross_site(headers: dict[str, str]) -> str | None:
+    """Why a request another site's page made is refused, or ``None``: an ``Origin`` that is
+    not the monitor's, or ``Sec-Fetch-Site: cross-site`` on anything but opening a page."""
+    why = check_origin(headers.get("origin"), headers.get("host", ""))
+    if why is not None:
+        return why
+    if headers.get("sec-fetch-site") == "cross-site" \
+            and headers.get("sec-fetch-mode") != "navigate":
+        return "a request another web site's page makes is refused"
+    return None
 
 
 def build_app(source: Any, *, token: str | None = None, hosts: set[str] | None = None) -> Any:

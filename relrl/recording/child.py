@@ -1,4 +1,5 @@
-"""The recording's writer process: ``python -m relrl.recording.child [--foxglove ADDRESS]``.
+"""The recording's writer process: ``python -m relrl.recording.child [--foxglove ADDRESS
+[--origin ORIGIN ...]]``.
 
 The session (:class:`~relrl.recording.recorder.Recorder`) hands over, through this process's
 standard input, what each time unit produced -- the trace line it wrote anyway and the frame's
@@ -74,13 +75,15 @@ def main(argv: list[str] | None = None) -> int:
 
     parser = argparse.ArgumentParser(prog="relrl.recording.child")
     parser.add_argument("--foxglove", default=None, metavar="HOST:PORT")
+    parser.add_argument("--origin", action="append", default=[], metavar="ORIGIN")
     args = parser.parse_args(argv)
     server = None
     if args.foxglove is not None:
         from relrl.monitor.foxglove import FoxgloveServer
 
         try:
-            server = FoxgloveServer(args.foxglove or None).start()
+            server = FoxgloveServer(args.foxglove or None,
+                                    origins=tuple(args.origin)).start()
         except UserError as exc:
             _reply(error=str(exc))
             return 2

@@ -63,6 +63,7 @@ class Recorder:
     Args:
         foxglove: serve the channels live at ``HOST:PORT`` (``""``: 127.0.0.1:8765), or
             ``None``.
+        origins: web origins whose pages may connect to the live server (none by default).
 
     Attributes:
         url: where Foxglove connects (``None`` without ``foxglove``).
@@ -73,10 +74,11 @@ class Recorder:
         OutputError: the writer process cannot start.
     """
 
-    def __init__(self, foxglove: str | None = None) -> None:
+    def __init__(self, foxglove: str | None = None, origins: tuple[str, ...] = ()) -> None:
         cmd = [sys.executable, "-m", "relrl.recording.child"]
         if foxglove is not None:
             cmd += ["--foxglove", foxglove]
+            cmd += [f"--origin={origin}" for origin in origins]
         self._err = tempfile.TemporaryFile()  # noqa: SIM115 - read when the writer fails
         self._proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                       stderr=self._err, start_new_session=True,

@@ -242,6 +242,42 @@ def test_every_answer_carries_the_security_headers(tmp_path) -> None:
         assert status == 403
 
 
+@pytest.mark.parametrize("headers, status", [
+    ({"Origin": "https://evil.example.com"}, 403),
+    ({"Origin": "null"}, 403),
+    ({"Origin": "http://127.0.0.1:1"}, 403),
+    ({"Sec-Fetch-Site": "cross-site", "Sec-Fetch-Mode": "no-cors"}, 403),  # <img>, <script>
+    ({"Sec-Fetch-Site": "cross-site", "Sec-Fetch-Mode": "cors"}, 403),
+    ({"Origin": "http://{here}", "Sec-Fetch-Site": "same-origin"}, 200),
+    ({"Sec-Fetch-Site": "cross-site", "Sec-Fetch-Mode": "navigate"}, 200),  # a link followed
+    ({"Sec-Fetch-Site": "none"}, 200), ({}, 200)])
+def test_a_web_pages_request_from_another_origin_is_refused(tmp_path, headers: dict,
+                                                            status: int) -> None:
+    folder = write_recording(tmp_path / "rec")
+    with start_replay(folder) as server:
+        sent = {k: v.format(here=f"127.0.0.1:{server.port}") for k, v in headers.items()}
+        for path in ("/api/info", "/frames/1.jpg", "/api/series"):
+            assert _get(server.port, path, sent)[0] == status, path
+
+
+def test_a_live_session_refuses_another_origin(live_server) -> None:
+    evil = {"Origin": "https://evil.example.com"}
+    for path in ("/api/events", "/frame.jpg", "/api/info"):
+        assert _get(live_server.port, path, evil)[0] == 403, path
+    assert _get(live_server.port, "/frame.jpg")[0] == 200
+
+
+def test_a_websocket_to_the_monitor_is_refused(live_server) -> None:
+    import socket
+
+    with socket.create_connection(("127.0.0.1", live_server.port), timeout=5) as sock:
+        sock.sendall(f"GET /api/events HTTP/1.1\r\nHost: 127.0.0.1:{live_server.port}\r\n"
+                     "Upgrade: websocket\r\nConnection: Upgrade\r\n"
+                     "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                     "Sec-WebSocket-Version: 13\r\n\r\n".encode())
+        assert not sock.recv(200).startswith(b"HTTP/1.1 101")
+
+
 def test_the_xss_label_does_not_run_in_a_browser(page, tmp_path) -> None:
     """The issue's exploit: a branch label of HTML-like form became a javascript: link in
     /tree.svg, and clicking it in Chromium ran script. Now the label is text, and the SVG's

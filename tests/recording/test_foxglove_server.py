@@ -13,7 +13,7 @@ import pytest
 from websockets.asyncio.client import connect
 from websockets.exceptions import InvalidStatus
 
-from relrl.monitor.foxglove import MAX_CLIENTS, SUBPROTOCOL, FoxgloveServer
+from relrl.monitor.foxglove import FOXGLOVE_APP, MAX_CLIENTS, SUBPROTOCOL, FoxgloveServer
 from relrl.recording.channels import CHANNELS, IMAGE, ROW_CHANNELS, TREE
 from relrl.recording.encoder import Encoder
 
@@ -124,12 +124,14 @@ def test_read_only_and_bad_requests_answered_with_status() -> None:
     assert "read-only" in answers[0]["message"]
 
 
-def _raw_upgrade(port: int, host: str) -> bytes:
-    """A WebSocket upgrade request with a chosen Host header (DNS rebinding's)."""
+def _raw_upgrade(port: int, host: str, *origins: str) -> bytes:
+    """A WebSocket upgrade request with a chosen Host header (DNS rebinding's) and Origin
+    headers (a web page's)."""
     import socket
 
+    extra = "".join(f"Origin: {o}\r\n" for o in origins)
     with socket.create_connection(("127.0.0.1", port), timeout=5) as sock:
-        sock.sendall(f"GET / HTTP/1.1\r\nHost: {host}\r\nUpgrade: websocket\r\n"
+        sock.sendall(f"GET / HTTP/1.1\r\nHost: {host}\r\n{extra}Upgrade: websocket\r\n"
                      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
                      f"Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: {SUBPROTOCOL}"
                      "\r\n\r\n".encode())
@@ -161,6 +163,39 @@ def test_host_token_and_client_bound() -> None:
             await ws.close()
 
         _run(tokens())
+
+
+def test_a_web_pages_origin_is_refused_unless_allowed() -> None:
+    """A page open in the user's browser (any site) cannot watch the session: a handshake
+    with an Origin is refused unless that origin was allowed; programs send none."""
+    with FoxgloveServer("127.0.0.1:0") as server:
+        here = f"127.0.0.1:{server.port}"
+        for origin in ("https://evil.example.com", "null", f"http://{here}",
+                       "https://app.foxglove.dev"):
+            assert _raw_upgrade(server.port, here, origin).startswith(b"HTTP/1.1 403"), origin
+        assert _raw_upgrade(server.port, here).startswith(b"HTTP/1.1 101")  # a program
+    with FoxgloveServer("127.0.0.1:0", origins=(FOXGLOVE_APP,)) as server:
+        here = f"127.0.0.1:{server.port}"
+        assert _raw_upgrade(server.port, here, "https://app.foxglove.dev").startswith(
+            b"HTTP/1.1 101")
+        assert _raw_upgrade(server.port, here, "HTTPS://APP.FOXGLOVE.DEV").startswith(
+            b"HTTP/1.1 101")
+        for origins in (("https://evil.example.com",), ("https://app.foxglove.dev.evil.com",),
+                        ("https://app.foxglove.dev", "https://evil.example.com")):
+            assert _raw_upgrade(server.port, here, *origins).startswith(b"HTTP/1.1 403")
+    with FoxgloveServer("127.0.0.1:0", token="s3cret") as server:  # a token is not an origin
+        assert _raw_upgrade(server.port, f"127.0.0.1:{server.port}",
+                            "https://evil.example.com").startswith(b"HTTP/1.1 403")
+
+
+@pytest.mark.parametrize("origin", ["*", "null", "https://app.foxglove.dev/", "app.foxglove.dev",
+                                    "ftp://x.org", "https://a.org/path", "https://u@a.org",
+                                    "https://a.org:99999", "https://a.org:x"])
+def test_a_bad_allowed_origin_is_one_line(origin: str) -> None:
+    from relrl.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="bad origin"):
+        FoxgloveServer("127.0.0.1:0", origins=(origin,))
 
 
 def test_a_stalled_client_never_holds_the_writer() -> None:
@@ -279,3 +314,17 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
     assert "percepts" in got["/relrl/percepts"][0]
     assert len(got["/head/joint_states"][0].name) >= 2
     assert not Path(tmp_path / "session.mcap").exists()  # live only: nothing written
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--foxglove", "--foxglove-origin", "https://*.evil.example"], "*.evil.example"),
+    (["--foxglove", "--foxglove-origin", "null"], "null"),
+    (["--foxglove-origin", "https://app.foxglove.dev"], "needs --foxglove"),
+])
+def test_a_bad_foxglove_origin_flag_is_one_line(tmp_path, capsys, argv: list[str],
+                                                needle: str) -> None:
+    from tests.cli.conftest import one_line_exit_2
+    from tests.monitor.conftest import episode
+
+    one_line_exit_2(capsys, ["run", str(episode(tmp_path, steps=40)), "--no-plots", *argv],
+                    needle)
