@@ -80,15 +80,19 @@ import sys
 import head, perception, relrl
 from relrl.resources import examples_dir, prolog_dir
 from head.calibration import DEFAULT_CALIBRATION
+from head.urdf import DEFAULT_URDF
+from relrl.recording.layout import LAYOUT
 for m in (head, perception, relrl):
     print(m.__file__)
 print(prolog_dir() / "gateway.pl")
 print(examples_dir() / "domains" / "sis.pl")
 print(DEFAULT_CALIBRATION)
+print(DEFAULT_URDF)
+print(LAYOUT)
 """], installed)
     assert proc.returncode == 0, proc.stderr
     paths = [Path(p) for p in proc.stdout.split()]
-    assert len(paths) == 6
+    assert len(paths) == 8
     for p in paths:
         assert p.is_relative_to(installed["site"]), p
         assert p.is_file() and not p.is_symlink(), p

@@ -136,7 +136,7 @@ def _check(args: argparse.Namespace) -> None:
         for origin in args.foxglove_origin:
             parse_origin(origin)
     if args.record or args.foxglove is not None:
-        missing = [name for name in ("mcap", "mcap_ros2")
+        missing = [name for name in ("mcap", "mcap_ros2", "foxglove")
                    + (("websockets",) if args.foxglove is not None else ())
                    if importlib.util.find_spec(name) is None]
         if missing:

@@ -223,7 +223,7 @@ class FoxgloveServer:
 
     def _advertise(self) -> str:
         chans = [{"id": i, "topic": ch.topic, "encoding": ch.encoding,
-                  "schemaName": ch.schema, "schema": ch.schema_data.decode(),
+                  "schemaName": ch.schema, "schema": _schema_text(ch),
                   "schemaEncoding": ch.schema_encoding} for i, ch in self.channels.items()]
         return json.dumps({"op": "advertise", "channels": chans})
 
@@ -281,6 +281,16 @@ class FoxgloveServer:
             while client.queue:
                 await client.ws.send(client.queue.popleft())
                 self.sent += 1
+
+
+def _schema_text(channel: Channel) -> str:
+    """A channel's schema as the protocol carries it: text, or base64 for a binary one
+    (protobuf's ``FileDescriptorSet``)."""
+    if channel.encoding == "protobuf":
+        import base64
+
+        return base64.b64encode(channel.schema_data).decode()
+    return channel.schema_data.decode()
 
 
 def _frame(sub: int, ns: int, data: bytes) -> bytes:

@@ -12,7 +12,13 @@ topic                                 schema                                    
 ``/camera/annotations``               ``foxglove.ImageAnnotations`` (Foxglove)           json
 ``/head/joint_states``                ``sensor_msgs/msg/JointState`` (ROS 2)             cdr
 ``/relrl/percepts`` ...               ``relrl.Percepts`` ... (JSON Schema, below)        json
+``/tf``                               ``foxglove.FrameTransforms`` (Foxglove)            proto
+``/head/scene``                       ``foxglove.SceneUpdate`` (Foxglove)                proto
+``/robot_description``                ``std_msgs/msg/String`` (ROS 2): the head's URDF   cdr
 ====================================  =================================================  =====
+
+Foxglove's protobuf schemas are foxglove-sdk's own (:mod:`foxglove.messages`), read from it
+when a file or the live server needs them (:mod:`relrl.recording.scene` builds the messages).
 
 Every message of one time unit carries the same log time (the session's wall clock when the
 unit ended, in nanoseconds) and every JSON message its time unit ``t``: all channels are on
@@ -26,8 +32,9 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CHANNELS", "ROW_CHANNELS", "Channel", "annotations_of", "cdr_encoders",
-           "encode_row", "join_row", "joint_state_of", "split_row", "to_json"]
+__all__ = ["CHANNELS", "DESCRIPTION", "ROW_CHANNELS", "SCENE", "TRANSFORMS", "Channel",
+           "annotations_of", "cdr_encoders", "encode_row", "join_row", "joint_state_of",
+           "split_row", "to_json"]
 
 _TIME = """================================================================================
 MSG: builtin_interfaces/Time
@@ -50,6 +57,7 @@ ROS2_MSGDEFS = {
     "sensor_msgs/msg/JointState":
         "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
         "float64[] effort\n" + _HEADER,
+    "std_msgs/msg/String": "string data\n",
 }
 
 _ANY = {}
@@ -150,8 +158,9 @@ class Channel:
 
     Attributes:
         topic: the topic name.
-        schema: the schema's name (a ROS 2 type or a JSON Schema title).
-        encoding: the message encoding (``cdr`` or ``json``).
+        schema: the schema's name (a ROS 2 type, a JSON Schema title or a Foxglove
+            protobuf message).
+        encoding: the message encoding (``cdr``, ``json`` or ``protobuf``).
         keys: the fields of a trace row this channel carries (per-unit channels).
     """
 
@@ -162,14 +171,20 @@ class Channel:
 
     @property
     def schema_encoding(self) -> str:
-        """``ros2msg`` for CDR channels, ``jsonschema`` for JSON ones."""
-        return "ros2msg" if self.encoding == "cdr" else "jsonschema"
+        """``ros2msg`` for CDR channels, ``jsonschema`` for JSON ones, ``protobuf`` for
+        Foxglove's."""
+        return {"cdr": "ros2msg", "protobuf": "protobuf"}.get(self.encoding, "jsonschema")
 
     @property
     def schema_data(self) -> bytes:
-        """The schema's text: a ROS 2 message definition or a JSON Schema."""
+        """The schema: a ROS 2 message definition, a JSON Schema, or foxglove-sdk's
+        protobuf ``FileDescriptorSet`` (binary)."""
         if self.encoding == "cdr":
             return ROS2_MSGDEFS[self.schema].encode()
+        if self.encoding == "protobuf":
+            from foxglove import messages
+
+            return bytes(getattr(messages, self.schema.split(".", 1)[1]).get_schema().data)
         return json.dumps(JSON_SCHEMAS[self.schema], sort_keys=True).encode()
 
 
@@ -179,6 +194,9 @@ JOINTS = Channel("/head/joint_states", "sensor_msgs/msg/JointState", "cdr")
 SESSION = Channel("/relrl/session", "relrl.Session", "json")
 TREE = Channel("/relrl/tree", "relrl.Tree", "json")
 EVENTS = Channel("/relrl/events", "relrl.Event", "json")
+TRANSFORMS = Channel("/tf", "foxglove.FrameTransforms", "protobuf")
+SCENE = Channel("/head/scene", "foxglove.SceneUpdate", "protobuf")
+DESCRIPTION = Channel("/robot_description", "std_msgs/msg/String", "cdr")
 
 #: the per-time-unit channels and the trace-row fields each carries (``t`` goes in all).
 ROW_CHANNELS: tuple[Channel, ...] = (
@@ -201,7 +219,7 @@ _KNOWN = {"t"} | {k for ch in ROW_CHANNELS for k in ch.keys}
 
 #: every channel, in the order they are registered.
 CHANNELS: tuple[Channel, ...] = (SESSION, *ROW_CHANNELS, IMAGE, ANNOTATIONS, JOINTS, TREE,
-                                 EVENTS)
+                                 EVENTS, TRANSFORMS, SCENE, DESCRIPTION)
 
 
 def split_row(row: dict[str, Any]) -> list[tuple[Channel, dict[str, Any]]]:

@@ -255,6 +255,7 @@ def test_bad_address_is_one_line() -> None:
 def test_a_live_session_in_foxglove(tmp_path) -> None:
     """relrl run --foxglove: a client subscribes to the camera, its annotations, the
     percepts and the joint states, and decodes each with the advertised schema."""
+    import base64
     import subprocess
     import sys
     from pathlib import Path
@@ -264,6 +265,7 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
 
     from tests.conftest import ROOT
     from tests.monitor.conftest import episode
+    from tests.recording.foxglove_proto import protobuf_decoder
 
     script = episode(tmp_path, steps=400)
     proc = subprocess.Popen([sys.executable, "-m", "relrl", "-q", "run", str(script),
@@ -282,7 +284,7 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
             ws, _, adv = await _hello(url)
             chans = {c["topic"]: c for c in adv["channels"]}
             wanted = ["/camera/image/compressed", "/camera/annotations", "/relrl/percepts",
-                      "/head/joint_states"]
+                      "/head/joint_states", "/tf", "/head/scene"]
             await ws.send(json.dumps({"op": "subscribe", "subscriptions": [
                 {"id": i, "channelId": chans[t]["id"]} for i, t in enumerate(wanted)]}))
             got: dict[str, list] = {}
@@ -293,7 +295,11 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
                     sub, ns = struct.unpack_from("<IQ", raw, 1)
                     topic = wanted[sub]
                     ch = chans[topic]
-                    if ch["encoding"] == "cdr":
+                    if ch["encoding"] == "protobuf":  # the schema in base64
+                        schema = Schema(id=ch["id"], name=ch["schemaName"], encoding="protobuf",
+                                        data=base64.b64decode(ch["schema"]))
+                        msg = protobuf_decoder(schema)(raw[13:])
+                    elif ch["encoding"] == "cdr":
                         schema = Schema(id=ch["id"], name=ch["schemaName"], encoding="ros2msg",
                                         data=ch["schema"].encode())
                         msg = DecoderFactory().decoder_for("cdr", schema)(raw[13:])
@@ -308,7 +314,9 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
         proc.kill()
         proc.wait(30)
     assert set(got) == {"/camera/image/compressed", "/camera/annotations", "/relrl/percepts",
-                        "/head/joint_states"}
+                        "/head/joint_states", "/tf", "/head/scene"}
+    assert {tf.child_frame_id for tf in got["/tf"][0].transforms} >= {"neck_pan_link", "camera"}
+    assert "gaze" in {e.id for e in got["/head/scene"][0].entities}
     assert got["/camera/image/compressed"][0].format == "jpeg"
     assert bytes(got["/camera/image/compressed"][0].data[:2]) == b"\xff\xd8"  # a JPEG
     assert "percepts" in got["/relrl/percepts"][0]

@@ -25,6 +25,7 @@ from relrl.cli import main
 from relrl.recording.channels import CHANNELS
 from relrl.recording.reader import McapRecording
 from tests.monitor.conftest import episode
+from tests.recording.foxglove_proto import protobuf_decoder
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -52,6 +53,9 @@ def test_every_channel_reads_back_with_its_schema(recorded: Path) -> None:
             if channel.message_encoding == "json":
                 msg = json.loads(message.data)
                 jsonschema.validate(msg, json.loads(schema.data))
+            elif channel.message_encoding == "protobuf":  # Foxglove's, by protobuf's reader
+                assert schema.encoding == "protobuf"
+                msg = protobuf_decoder(schema)(message.data)
             else:
                 assert channel.message_encoding == "cdr" and schema.encoding == "ros2msg"
                 msg = DecoderFactory().decoder_for("cdr", schema)(message.data)
