@@ -9,7 +9,7 @@ the same row (:func:`split_row`, :func:`join_row`). Standard schemas where robot
 topic                                 schema                                             enc.
 ====================================  =================================================  =====
 ``/camera/image/compressed``          ``sensor_msgs/msg/CompressedImage`` (ROS 2)        cdr
-``/camera/annotations``               ``foxglove.ImageAnnotations`` (Foxglove)           json
+``/camera/annotations``               ``foxglove.ImageAnnotations`` (Foxglove)           proto
 ``/head/joint_states``                ``sensor_msgs/msg/JointState`` (ROS 2)             cdr
 ``/relrl/percepts`` ...               ``relrl.Percepts`` ... (JSON Schema, below)        json
 ``/tf``                               ``foxglove.FrameTransforms`` (Foxglove)            proto
@@ -60,7 +60,6 @@ ROS2_MSGDEFS = {
     "std_msgs/msg/String": "string data\n",
 }
 
-_ANY = {}
 _STR_LIST = {"type": "array", "items": {"type": "string"}}
 _T = {"type": "integer", "minimum": 0, "description": "the session's time unit"}
 
@@ -72,28 +71,8 @@ def _object(title: str, description: str, props: dict[str, Any],
             "required": list(required)}
 
 
-_COLOR = {"type": "object", "properties": {k: {"type": "number", "minimum": 0, "maximum": 1}
-                                           for k in "rgba"}}
-_TIMESTAMP = {"type": "object", "properties": {"sec": {"type": "integer"},
-                                               "nsec": {"type": "integer"}}}
-_POINT2 = {"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}}}
-
-#: JSON Schemas of the JSON channels (Foxglove's for the annotations, relrl's otherwise).
+#: JSON Schemas of the JSON channels (relrl's own messages).
 JSON_SCHEMAS: dict[str, dict[str, Any]] = {
-    "foxglove.ImageAnnotations": _object(
-        "foxglove.ImageAnnotations", "Array of annotations for a 2D image (Foxglove schema)",
-        {"circles": {"type": "array", "items": _ANY},
-         "points": {"type": "array", "items": {"type": "object", "properties": {
-             "timestamp": _TIMESTAMP,
-             "type": {"type": "integer", "description": "0 unknown, 1 points, 2 line loop, "
-                                                        "3 line strip, 4 line list"},
-             "points": {"type": "array", "items": _POINT2}, "outline_color": _COLOR,
-             "outline_colors": {"type": "array", "items": _COLOR}, "fill_color": _COLOR,
-             "thickness": {"type": "number"}}}},
-         "texts": {"type": "array", "items": {"type": "object", "properties": {
-             "timestamp": _TIMESTAMP, "position": _POINT2, "text": {"type": "string"},
-             "font_size": {"type": "number"}, "text_color": _COLOR,
-             "background_color": _COLOR}}}}, required=()),
     "relrl.Session": _object(
         "relrl.Session", "What the session runs: episode, learner, seed, necessities, "
         "responses, where each part runs (sent once, at the start)",
@@ -189,7 +168,7 @@ class Channel:
 
 
 IMAGE = Channel("/camera/image/compressed", "sensor_msgs/msg/CompressedImage", "cdr")
-ANNOTATIONS = Channel("/camera/annotations", "foxglove.ImageAnnotations", "json")
+ANNOTATIONS = Channel("/camera/annotations", "foxglove.ImageAnnotations", "protobuf")
 JOINTS = Channel("/head/joint_states", "sensor_msgs/msg/JointState", "cdr")
 SESSION = Channel("/relrl/session", "relrl.Session", "json")
 TREE = Channel("/relrl/tree", "relrl.Tree", "json")
@@ -299,9 +278,10 @@ def _label(x: float, y: float, text: str, stamp: dict[str, int],
 
 
 def annotations_of(overlay: dict[str, Any] | None, ns: int) -> dict[str, Any]:
-    """What perception found in a frame as a ``foxglove.ImageAnnotations`` message: the face
-    box with its pose, the most salient area's box with its colour and place, and a cross on
-    its saliency peak (the same drawing as the monitor's page)."""
+    """What perception found in a frame as the fields of a ``foxglove.ImageAnnotations``
+    message (:func:`relrl.recording.scene.encode_annotations` encodes them): the face box with
+    its pose, the most salient area's box with its colour and place, and a cross on its
+    saliency peak (the same drawing as the monitor's page)."""
     stamp = {"sec": ns // 1_000_000_000, "nsec": ns % 1_000_000_000}
     points: list[dict[str, Any]] = []
     texts: list[dict[str, Any]] = []

@@ -31,6 +31,7 @@ from relrl.recording.channels import (
     joint_state_of,
     to_json,
 )
+from relrl.recording.scene import SceneEncoder, encode_annotations
 
 __all__ = ["Encoder", "Message"]
 
@@ -47,7 +48,6 @@ class Encoder:
     """
 
     def __init__(self, urdf: str | None = None) -> None:
-        from relrl.recording.scene import SceneEncoder
 
         self._cdr = cdr_encoders()
         self._scene = SceneEncoder(urdf)
@@ -72,7 +72,7 @@ class Encoder:
         return [(IMAGE, ns, self._cdr[IMAGE.topic](
                     {"header": {"stamp": stamp, "frame_id": "camera"}, "format": "jpeg",
                      "data": jpeg})),
-                (ANNOTATIONS, ns, to_json(annotations_of(overlay, ns)))]
+                (ANNOTATIONS, ns, encode_annotations(annotations_of(overlay, ns)))]
 
     def last_frame(self, ns: int, msg: dict[str, Any], jpeg: bytes) -> list[Message]:
         """A frame after the last unit: ``msg`` is its perception message (``t``,

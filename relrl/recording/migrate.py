@@ -19,10 +19,13 @@ from typing import Any
 from relrl.errors import UserError
 from relrl.recording.channels import (
     ANNOTATIONS,
+    DESCRIPTION,
     EVENTS,
     IMAGE,
     PERCEPTION,
+    SCENE,
     SESSION,
+    TRANSFORMS,
     TREE,
     annotations_of,
     cdr_encoders,
@@ -70,21 +73,30 @@ def migrate_folder(folder: str | Path) -> Path:
     def at(t: int) -> int:  # the session's clock, units spread evenly over its duration
         return start + (int(t) - first) * per_unit
 
+    from relrl.recording.scene import SceneEncoder, encode_annotations
+
     cdr = cdr_encoders()
+    scene = SceneEncoder()
     by_frame = {int(f["index"]): f for f in frames}
     out = McapFile(target, library="relrl migrate")
     try:
         out.write(SESSION, start, to_json({k: manifest.get(k) for k in (
             "episode", "seed", "steps", "necessities", "responses", "where", "perception")}
             | {"learner": (manifest.get("learner") or {}).get("name")}))
+        out.write(DESCRIPTION, start, cdr[DESCRIPTION.topic]({"data": scene.description}))
         messages: list[tuple[int, int, Any, bytes]] = []  # (ns, order, channel, data)
         for row in rows:
             ns = at(row["t"])
             for ch, msg in split_row(row):
                 messages.append((ns, len(messages), ch, to_json(msg)))
             if row.get("head"):
+                joints = joint_state_of(row["head"], ns)
                 messages.append((ns, len(messages), JOINT_STATES,
-                                 cdr[JOINT_STATES.topic](joint_state_of(row["head"], ns))))
+                                 cdr[JOINT_STATES.topic](joints)))
+                positions = dict(zip(joints["name"], joints["position"], strict=True))
+                messages.append((ns, len(messages), TRANSFORMS,
+                                 scene.transforms(ns, positions)))
+                messages.append((ns, len(messages), SCENE, scene.scene(ns, row.get("overlay"))))
         seen = {r.get("frame"): r for r in rows if r.get("frame")}
         for index, entry in sorted(by_frame.items()):
             jpeg = old.frame_bytes(index)
@@ -102,7 +114,7 @@ def migrate_folder(folder: str | Path) -> Path:
                  "data": jpeg})))
             overlay = (seen.get(index) or {}).get("overlay")
             messages.append((ns, len(messages), ANNOTATIONS,
-                             to_json(annotations_of(overlay, ns))))
+                             encode_annotations(annotations_of(overlay, ns))))
         for tree in old.trees:
             messages.append((at(tree["t"]), len(messages), TREE,
                              to_json({"t": tree["t"], "graph": tree.get("graph")})))

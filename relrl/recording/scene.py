@@ -22,7 +22,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["FACE_WIDTH_M", "HORIZONTAL_FOV_DEG", "SceneEncoder", "face_position"]
+__all__ = ["FACE_WIDTH_M", "HORIZONTAL_FOV_DEG", "SceneEncoder", "encode_annotations",
+           "face_position"]
 
 #: the width of a face, metres (for the distance of the caregiver's face).
 FACE_WIDTH_M = 0.15
@@ -126,3 +127,40 @@ class SceneEncoder:
                                      color=Color(r=0.2, g=0.9, b=0.3, a=1.0),
                                      text=f"caregiver: face {face.get('pose')}")]))
         return SceneUpdate(deletions=deletions, entities=entities).encode()
+
+
+def encode_annotations(msg: dict[str, Any]) -> bytes:
+    """A :func:`~relrl.recording.channels.annotations_of` message (the face box and label,
+    the salient area's box, cross and label) as foxglove-sdk's ``foxglove.ImageAnnotations``.
+    """
+    from foxglove.messages import (
+        Color,
+        ImageAnnotations,
+        Point2,
+        PointsAnnotation,
+        PointsAnnotationType,
+        TextAnnotation,
+        Timestamp,
+    )
+
+    def color(c: dict[str, float]) -> Any:
+        return Color(r=c["r"], g=c["g"], b=c["b"], a=c["a"])
+
+    def stamp(s: dict[str, int]) -> Any:
+        return Timestamp(s["sec"], s["nsec"])
+
+    kinds = (PointsAnnotationType.Unknown, PointsAnnotationType.Points,
+             PointsAnnotationType.LineLoop, PointsAnnotationType.LineStrip,
+             PointsAnnotationType.LineList)  # by the message's number
+    points = [PointsAnnotation(
+        timestamp=stamp(p["timestamp"]), type=kinds[p["type"]],
+        points=[Point2(x=q["x"], y=q["y"]) for q in p["points"]],
+        outline_color=color(p["outline_color"]), fill_color=color(p["fill_color"]),
+        outline_colors=[color(c) for c in p["outline_colors"]], thickness=p["thickness"])
+        for p in msg["points"]]
+    texts = [TextAnnotation(
+        timestamp=stamp(t["timestamp"]), position=Point2(x=t["position"]["x"],
+                                                         y=t["position"]["y"]),
+        text=t["text"], font_size=t["font_size"], text_color=color(t["text_color"]),
+        background_color=color(t["background_color"])) for t in msg["texts"]]
+    return ImageAnnotations(points=points, texts=texts).encode()

@@ -51,9 +51,10 @@ def messages(tmp_path_factory) -> dict[str, list]:
 
 
 def test_the_schemas_are_foxglove_sdks(messages) -> None:
-    from foxglove.messages import FrameTransforms, SceneUpdate
+    from foxglove.messages import FrameTransforms, ImageAnnotations, SceneUpdate
 
-    for topic, cls in (("/tf", FrameTransforms), ("/head/scene", SceneUpdate)):
+    for topic, cls in (("/tf", FrameTransforms), ("/head/scene", SceneUpdate),
+                       ("/camera/annotations", ImageAnnotations)):
         schema = messages[topic][0][2]
         sdk = cls.get_schema()
         assert (schema.name, schema.encoding) == (sdk.name, sdk.encoding) == \

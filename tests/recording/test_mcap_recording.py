@@ -87,7 +87,9 @@ def test_every_channel_reads_back_with_its_schema(recorded: Path) -> None:
         assert frame.shape == (240, 320, 3)
     assert [ns for ns, _, _ in images[:n]] == units
     ann = by_topic["/camera/annotations"]
-    assert len(ann) == len(images) and any(a["points"] and a["texts"] for _, a, _ in ann)
+    assert len(ann) == len(images) and any(a.points and a.texts for _, a, _ in ann)
+    ns, drawn = next((ns, a) for ns, a, _ in ann if a.points)  # on its image's time
+    assert drawn.points[0].timestamp.seconds * 10**9 + drawn.points[0].timestamp.nanos == ns
     joints = by_topic["/head/joint_states"][0][1]
     assert list(joints.name) == sorted(trace[0]["head"]["servos"])
     assert by_topic["/relrl/tree"][-1][1]["graph"]["nodes"]
