@@ -172,8 +172,10 @@ def session_options(args: argparse.Namespace, episode: Any, opts: Any):
             opts.live_rate = args.monitor_rate
             session.closers.append(opts.recorder)
             note = " (token required: not bound to localhost)" if opts.recorder.token else ""
+            web = "" if args.foxglove_origin else \
+                "; its web app needs --foxglove-origin https://app.foxglove.dev"
             print(f"foxglove: {opts.recorder.url}{note} (in Foxglove: Open connection, "
-                  "Foxglove WebSocket)", flush=True)
+                  f"Foxglove WebSocket{web})", flush=True)
         yield session
     finally:
         for thing in reversed(session.closers):

@@ -269,7 +269,8 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
 
     script = episode(tmp_path, steps=400)
     proc = subprocess.Popen([sys.executable, "-m", "relrl", "-q", "run", str(script),
-                             "--head", "sim", "--foxglove", "127.0.0.1:0", "--step-seconds",
+                             "--head", "sim", "--foxglove", "127.0.0.1:0",
+                             "--foxglove-origin", "https://app.foxglove.dev", "--step-seconds",
                              "0.02", "--no-plots"], cwd=ROOT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
     try:
@@ -279,6 +280,11 @@ def test_a_live_session_in_foxglove(tmp_path) -> None:
                 url = line.split()[1]
                 break
         assert url and url.startswith("ws://127.0.0.1:")
+        here = url.split("//")[1].rstrip("/")
+        port = int(here.split(":")[1])
+        # the origin allowed on the command line reaches the server; no other page does
+        assert _raw_upgrade(port, here, "https://app.foxglove.dev").startswith(b"HTTP/1.1 101")
+        assert _raw_upgrade(port, here, "https://evil.example.com").startswith(b"HTTP/1.1 403")
 
         async def client() -> dict:
             ws, _, adv = await _hello(url)
