@@ -117,8 +117,10 @@ def host_of(header: str) -> str:
 
 def same_origin(origin: str, host: str) -> bool:
     """Whether a request's ``Origin`` header names the server it was sent to: ``http://``
-    and the request's ``Host`` header, letter for letter (case aside)."""
-    return origin.strip().lower() == "http://" + host.strip().lower()
+    (or ``https://``, behind a proxy that adds TLS) and the request's ``Host`` header, letter
+    for letter (case aside)."""
+    value, host = origin.strip().lower(), host.strip().lower()
+    return bool(host) and value in ("http://" + host, "https://" + host)
 
 
 def check_origin(origin: str | None, host: str, allowed: frozenset[str] = frozenset()
