@@ -74,6 +74,8 @@ def run(args: argparse.Namespace) -> int:
         with stop.installed():
             summary = _claim_and_run(args, episode, opts, stop, session)
         print(_report(summary))
+        if "recording_ended" in summary:
+            print(_recording_ended(summary))
         if args.out:
             print(_wrote(args.out, summary.get("written", [])))
         if "policy_error" in summary:  # the run's product is missing: not a success
@@ -126,6 +128,16 @@ def _run(episode, opts, stop) -> dict:
         if kept is None:
             raise
         raise UserError(f"{exc}; {kept}") from None
+
+
+def _recording_ended(s: dict) -> str:
+    """The line of a session whose camera was a recording that ended (a normal end)."""
+    end = s["recording_ended"]
+    line = f"the recording ended at t = {end['t']} ({end['seconds']:.2f} s into it)"
+    if end["t"] < s["planned_steps"]:
+        line += (f": the episode asked for {s['planned_steps']} time units, the recording held "
+                 f"{end['t']} at the robot's pace")
+    return line
 
 
 def _report(s: dict) -> str:
