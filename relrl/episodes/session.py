@@ -390,7 +390,8 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                 bar.update(1)
             bar.close()
         _status(opts, "stopped" if stop() else "finished",
-                (f"stopped by {_signal_name(stop)}" if stop() else "the session ended")
+                (f"stopped by {_signal_name(stop)}" if stop() else
+                 "the recording (the camera) ended" if ended else "the session ended")
                 + f" after {run.units} of {episode.steps} {unit_name}"
                 + (f"; writing the summary and the policy to {out}" if out is not None
                    else ""))
