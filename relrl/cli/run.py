@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calibration", default=None, metavar="FILE",
                         help="the head's calibration TOML (default: examples/heads/wha8030.toml)")
     parser.add_argument("--camera", default=None, metavar="SRC",
-                        help="perceive from a camera: 0, video, folder, synthetic://...")
+                        help="perceive from a camera: 0, video, folder, a bag (BAG.mcap, "
+                             "BAG.db3, a rosbag2 folder; [:TOPIC]), synthetic://...")
     parser.add_argument("--live", action="store_true",
                         help="print what the robot perceives, wants and does; type words "
                              "to be heard as hear(Word)")
