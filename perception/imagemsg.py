@@ -144,10 +144,12 @@ def _raw(fields: dict[str, Any], what: str) -> np.ndarray:
     check_frame_size(width, height, f"a frame on {what}")
     size = 2 if enc in _WIDE else 1
     data = np.frombuffer(_as_bytes(fields["data"], what), np.uint8)
-    if step < width * depth * size or data.size < step * height:
-        raise CameraError(f"{what}: a {width}x{height} {encoding} frame with {data.size} "
-                          f"bytes (step {step}; it needs a step of at least "
-                          f"{width * depth * size} and {step * height} bytes)")
+    if step < width * depth * size:
+        raise CameraError(f"{what}: a {width}x{height} {encoding} frame with rows of step "
+                          f"{step} bytes (a row of it is {width * depth * size} bytes)")
+    if data.size < step * height:
+        raise CameraError(f"{what}: a {width}x{height} {encoding} frame of {data.size} bytes "
+                          f"({height} rows of step {step} are {step * height} bytes)")
     rows = data[:step * height].reshape(height, step)[:, :width * depth * size]
     if size == 2:
         dtype = ">u2" if fields.get("is_bigendian") else "<u2"

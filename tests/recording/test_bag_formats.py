@@ -361,6 +361,18 @@ def _bad_bag(tmp_path: Path, case: str) -> Path:
     if case == "bad_protobuf":
         bag = write_foxglove(tmp_path / "bad.mcap", [_png(frame)], encoding="protobuf")
         return _replace_message(bag, b"\x0a\xff\xff\xff\xff\x0f" + b"\x01" * 40)
+    if case == "short_data":
+        h, w = frame.shape[:2]
+        return write_foxglove(tmp_path / "bad.mcap", [], kind="raw", encoding="json",
+                              messages=[{"width": w, "height": h, "encoding": "bgr8",
+                                         "step": w * 3, "data": base64.b64encode(
+                                             frame.tobytes()[:1000]).decode()}])
+    if case == "ros_type_as_json":
+        bag = write_foxglove(tmp_path / "bad.mcap", [_png(frame)], encoding="json")
+        return _replace_message(bag, None, schema_name="sensor_msgs/msg/CompressedImage")
+    if case == "protobuf_schema_not_descriptors":
+        bag = write_foxglove(tmp_path / "bad.mcap", [_png(frame)], encoding="protobuf")
+        return _replace_message(bag, None, schema_data=b"\xff" * 64)
     if case == "truncated_db3":
         db3 = write_rosbag(tmp_path / "bag", scenes(3))
         db3.write_bytes(db3.read_bytes()[:3000])
@@ -380,9 +392,10 @@ def _cdr_compressed(frame: np.ndarray) -> bytes:
     return store.serialize_cdr(msg, "sensor_msgs/msg/CompressedImage")
 
 
-def _replace_message(bag: Path, data: bytes) -> Path:
-    """The same MCAP file with its one message's bytes replaced (rewritten with mcap's own
-    writer, the schema and channel kept)."""
+def _replace_message(bag: Path, data: bytes | None, *, schema_name: str | None = None,
+                     schema_data: bytes | None = None) -> Path:
+    """The same MCAP file with its one message's bytes (or its schema's name or data)
+    replaced: rewritten with mcap's own writer, everything else kept."""
     from mcap.reader import make_reader
     from mcap.writer import Writer
 
@@ -392,9 +405,11 @@ def _replace_message(bag: Path, data: bytes) -> Path:
     with open(out, "wb") as fh:
         w = Writer(fh)
         w.start()
-        sid = w.register_schema(schema.name, schema.encoding, schema.data)
+        sid = w.register_schema(schema_name or schema.name, schema.encoding,
+                                schema.data if schema_data is None else schema_data)
         cid = w.register_channel(channel.topic, channel.message_encoding, sid)
-        w.add_message(cid, message.log_time, data, message.publish_time)
+        w.add_message(cid, message.log_time, message.data if data is None else data,
+                      message.publish_time)
         w.finish()
     return out
 
@@ -403,7 +418,10 @@ def _replace_message(bag: Path, data: bytes) -> Path:
     ("image_named_compressed_defined", "no field 'width'"),
     ("db3_image_named_compressed_defined", "no field 'width'"),
     ("zero_size", "0x0 pixels"),
-    ("step_short", "step 320"),
+    ("step_short", "rows of step 320 bytes (a row of it is 960 bytes)"),
+    ("short_data", "frame of 1000 bytes (240 rows of step 960 are 230400 bytes)"),
+    ("ros_type_as_json", "is encoded as 'json', not cdr"),
+    ("protobuf_schema_not_descriptors", "protobuf schema does not define"),
     ("format", "unknown image format 'tiff'"),
     ("not_base64", "not base64"),
     ("png_said_jpeg_cut", "cannot be decoded"),
