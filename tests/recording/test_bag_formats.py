@@ -436,3 +436,12 @@ def test_a_bag_that_contradicts_itself_is_one_line(tmp_path: Path, case: str, sa
         out = relrl("run", "examples/episodes/hello.toml", "--camera", str(bag), "--out",
                     str(tmp_path / "out"), "--no-plots")
         one_line(out, says, bag.name)
+
+
+def test_the_bag_reading_figures_run() -> None:
+    from perception.bagbench import bench
+
+    figures = bench(frames=3, rounds=1)
+    assert figures["frames"] == 3
+    assert all(figures[k] > 0 for k in ("mcap_ros2", "rosbags_mcap", "bag_camera_mcap",
+                                        "bag_camera_db3"))
