@@ -230,7 +230,7 @@ def test_hello_runs_on_a_bag_to_its_end(tmp_path: Path, kind: str) -> None:
            write_foxglove(tmp_path / "fox.mcap", frames, encoding=kind.split("_")[1],
                           hz=2.0))
     out = relrl("run", "examples/episodes/hello.toml", "--camera", str(bag), "--out",
-                str(tmp_path / "out"), "--no-plots")
+                str(tmp_path / "out"), "--no-plots", "--record")
     assert out.returncode == 0, out.stderr
     ended = [x for x in out.stdout.splitlines() if x.startswith("the recording ended at t = ")]
     assert len(ended) == 1, out.stdout
@@ -244,6 +244,11 @@ def test_hello_runs_on_a_bag_to_its_end(tmp_path: Path, kind: str) -> None:
     assert len(trace) == summary["steps"] and any("see(face)" in x for x in trace)
     record = json.loads((tmp_path / "out" / ".relrl-run.json").read_text())
     assert record["status"] == "complete"
+    from relrl.recording.reader import McapRecording
+
+    recorded = McapRecording(tmp_path / "out" / "session.mcap")  # the session's own, whole
+    assert recorded.cut is None and len(recorded.rows) == summary["steps"]
+    assert recorded.summary["recording_ended"] == summary["recording_ended"]
 
 
 def test_the_policy_is_evaluated_where_the_recording_ended(tmp_path: Path) -> None:
