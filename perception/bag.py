@@ -273,13 +273,17 @@ class BagCamera(Camera):
                 raise self._fail(f"topic {chosen[0]}: its {c.msgtype} definition cannot be "
                                  f"read ({type(exc).__name__}: {exc})") from None
         what = f"{self.path}:{chosen[0]}"
+        hint = ""
+        if self.path.is_file() and (self.path.parent / "metadata.yaml").is_file():
+            hint = (f"; if the bag compresses each message, give its folder "
+                    f"{self.path.parent} (its metadata.yaml says so)")
 
         def fields(data: bytes) -> dict[str, Any]:
             try:
                 msg = store.deserialize_cdr(data, chosen[1])
             except Exception as exc:  # noqa: BLE001 - the bytes do not fit the definition
                 raise CameraError(f"{what}: a message that cannot be decoded as {chosen[1]} "
-                                  f"({type(exc).__name__}: {exc})") from None
+                                  f"({type(exc).__name__}: {exc}){hint}") from None
             return fields_of(msg, chosen[1], what)
 
         self._db3_decode = fields

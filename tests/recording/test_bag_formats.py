@@ -110,7 +110,7 @@ def write_foxglove(path: Path, frames: list, *, encoding: str = "protobuf",
 
 def write_rosbag(folder: Path, frames: list, *, kind: str = "compressed",
                  msgtype: str | None = None, msgdef: str | None = None, hz: float = 20.0,
-                 raw_messages: list[bytes] | None = None) -> Path:
+                 raw_messages: list[bytes] | None = None, compressed: bool = False) -> Path:
     """A SQLite ROS 2 bag written by rosbags (a folder: metadata.yaml and one .db3 file);
     returns the .db3 file. ``frames`` are BGR arrays (or PNG bytes, compressed)."""
     from rosbags.rosbag2 import StoragePlugin, Writer
@@ -120,7 +120,12 @@ def write_rosbag(folder: Path, frames: list, *, kind: str = "compressed",
     real = ("sensor_msgs/msg/CompressedImage" if kind == "compressed"
             else "sensor_msgs/msg/Image")
     msgtype = msgtype or real
-    with Writer(folder, version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+    writer = Writer(folder, version=9, storage_plugin=StoragePlugin.SQLITE3)
+    if compressed:  # each message compressed with zstd (said in metadata.yaml only)
+        from rosbags.rosbag2 import CompressionFormat, CompressionMode
+
+        writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    with writer:
         if msgdef is not None:  # a definition of the bag's own (perhaps not its type's)
             named = get_typestore(Stores.EMPTY)
             named.register(get_types_from_msg(msgdef, msgtype))
@@ -192,6 +197,16 @@ def test_db3_bags_and_rosbag2_folders_read_back_exactly(tmp_path: Path, kind: st
         assert len(got) == 4
         for a, b in zip(frames, got, strict=True):
             assert np.array_equal(a, b)
+
+
+def test_a_message_compressed_bag_is_read_through_its_folder(tmp_path: Path) -> None:
+    frames = scenes(3)
+    db3 = write_rosbag(tmp_path / "bag", frames, kind="raw", compressed=True)
+    with BagCamera(tmp_path / "bag", paced=False) as cam:
+        got = list(cam)
+    assert len(got) == 3 and all(np.array_equal(a, b) for a, b in zip(frames, got, strict=True))
+    one_line(relrl("perceive", str(db3)), f"give its folder {tmp_path / 'bag'}",
+             db3.name)  # the .db3 alone does not say its messages are compressed
 
 
 def test_db3_paced_at_recorded_times(tmp_path: Path) -> None:
