@@ -465,3 +465,21 @@ def test_the_bag_reading_figures_run() -> None:
     assert figures["frames"] == 3
     assert all(figures[k] > 0 for k in ("mcap_ros2", "rosbags_mcap", "bag_camera_mcap",
                                         "bag_camera_db3"))
+
+
+def test_a_jpeg_frame_claiming_a_huge_size_is_refused_from_its_header(tmp_path: Path) -> None:
+    """The JPEG's frame header (SOF) read from the message's bytes: a real 320x240 JPEG reads
+    as such; the same with its SOF saying 16000x16000 is refused before decoding."""
+    import cv2
+
+    from perception.imagesize import header_size_of
+
+    jpeg = bytearray(cv2.imencode(".jpg", scenes(1)[0])[1].tobytes())
+    assert header_size_of(bytes(jpeg), "a frame") == (320, 240, "JPEG")
+    sof = jpeg.index(b"\xff\xc0")
+    jpeg[sof + 5:sof + 9] = struct.pack(">HH", 16000, 16000)  # height, width
+    bag = write_foxglove(tmp_path / "huge.mcap", [], messages=[
+        {"timestamp": {"sec": 1, "nsec": 0}, "frame_id": "", "format": "jpeg",
+         "data": bytes(jpeg)}])
+    with pytest.raises(CameraError, match="16000x16000"), BagCamera(bag, paced=False) as cam:
+        cam.read()
