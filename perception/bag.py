@@ -108,8 +108,12 @@ class BagCamera(Camera):
         self._fh: Any = None
         self._rosbag: Any = None
         self._db3_decode: Callable[[bytes], dict[str, Any]] | None = None
-        if not (self.path.is_file() or (self.path.is_dir()
-                                        and (self.path / "metadata.yaml").is_file())):
+        if self.path.is_dir() and not (self.path / "metadata.yaml").is_file():
+            raise CameraError(f"{str(path)!r} is a folder without a metadata.yaml, not a "
+                              "rosbag2 bag")
+        if self.path.exists() and not (self.path.is_file() or self.path.is_dir()):
+            raise CameraError(f"{str(path)!r} is not a regular file (a device or a pipe?)")
+        if not self.path.exists():
             raise CameraError(f"no such bag file: {str(path)!r}")
         try:
             if self.path.is_file() and self.path.suffix.lower() != ".db3":

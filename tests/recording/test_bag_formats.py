@@ -483,3 +483,13 @@ def test_a_jpeg_frame_claiming_a_huge_size_is_refused_from_its_header(tmp_path: 
          "data": bytes(jpeg)}])
     with pytest.raises(CameraError, match="16000x16000"), BagCamera(bag, paced=False) as cam:
         cam.read()
+
+
+@pytest.mark.parametrize("source, says", [
+    ("bag:///dev/zero", "not a regular file"),
+    ("bag://{tmp}", "a folder without a metadata.yaml"),
+    ("{tmp}/none.db3", "no such bag file"),
+])
+def test_what_is_not_a_bag_is_named(tmp_path: Path, source: str, says: str) -> None:
+    with pytest.raises(CameraError, match=says):
+        open_camera(source.format(tmp=tmp_path))
