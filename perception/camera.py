@@ -9,8 +9,9 @@ source                     meaning
 ``session/``               a session recorded by relrl (``recording://session``): every frame of
                            its ``session.mcap``, in order
 ``photo.png``              one image, read once (``image://photo.png``)
-``bag.mcap[:TOPIC]``       a ROS 2 bag's images at their recorded times (``mcap://bag.mcap``;
-                           :mod:`perception.bag`; the ``mcap`` extra)
+``bag.mcap[:TOPIC]``       a bag's images at their recorded times (``bag://bag.mcap``): an
+``bag.db3[:TOPIC]``        MCAP file, a SQLite ROS 2 bag or a rosbag2 folder; ROS 2 and
+``rosbag2/[:TOPIC]``       Foxglove images (:mod:`perception.bag`; the ``mcap`` extra)
 ``synthetic://``           :func:`perception.render.render` of a :class:`SceneView`
 =========================  ==========================================================
 
@@ -31,7 +32,7 @@ from urllib.parse import parse_qs, urlsplit
 
 import numpy as np
 
-from perception.bag import BagCamera, parse_bag_source
+from perception.bag import BagCamera, is_bag, parse_bag_source
 from perception.errors import CameraError, ImageError
 from perception.imagesize import check_frame_size, header_size
 from perception.render import SceneView, render
@@ -233,6 +234,7 @@ SOURCES: dict[str, Callable[[str], Camera]] = {
     "dir": _Folder,
     "image": _Image,
     "recording": _recording,
+    "bag": _bag,
     "mcap": _bag,
     "synthetic": lambda rest: _synthetic("synthetic://" + rest),
 }
@@ -249,13 +251,13 @@ def open_camera(source: str | int) -> Camera:
         scheme, rest = src.split("://", 1)
     elif src.isdigit():
         scheme, rest = "cam", src
+    elif is_bag(src):
+        scheme, rest = "bag", src
     elif Path(src).is_dir():
         recorded = any((Path(src) / name).is_file() for name in ("session.mcap",
                                                                   "frames.jsonl"))
         scheme = "recording" if recorded else "dir"
         rest = src
-    elif src.lower().endswith(".mcap") or ".mcap:" in src:
-        scheme, rest = "mcap", src
     elif Path(src).suffix.lower() in _IMAGE_EXT:
         scheme, rest = "image", src
     else:

@@ -12,6 +12,7 @@ in any other format is refused rather than handed to a decoder whose memory use 
 
 from __future__ import annotations
 
+import io
 import struct
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +20,8 @@ from typing import BinaryIO
 
 from perception.errors import ImageError
 
-__all__ = ["FORMATS", "LIMITS", "FrameLimits", "check_frame_size", "header_size"]
+__all__ = ["FORMATS", "LIMITS", "FrameLimits", "check_frame_size", "header_size",
+           "header_size_of"]
 
 #: the formats :func:`header_size` reads.
 FORMATS = ("PNG", "JPEG", "BMP", "GIF", "WebP", "TIFF", "PNM")
@@ -183,23 +185,40 @@ def header_size(path: str | Path) -> tuple[int, int, str]:
         ImageError: the file cannot be read, is in a format not in :data:`FORMATS`, or its
             header is cut short or inconsistent.
     """
-    p = Path(path)
     try:
-        with open(p, "rb") as fh:
-            head = fh.read(512)
-            if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
-                found = [("WebP", _webp)]
-            else:
-                found = [(name, f) for magic, name, f in _MAGIC if head.startswith(magic)]
-            if not found:
-                raise ImageError(f"cannot decode {str(path)!r}: not an image in a format "
-                                 f"perception reads ({', '.join(FORMATS)})")
-            name, reader = found[0]
-            try:
-                width, height = reader(fh, head)
-            except (ValueError, KeyError, IndexError, struct.error) as exc:
-                raise ImageError(f"cannot decode {str(path)!r}: damaged {name} header "
-                                 f"({exc or 'cut short'})") from None
+        with open(Path(path), "rb") as fh:
+            return _read_header(fh, repr(str(path)))
     except OSError as exc:
         raise ImageError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
+
+
+def header_size_of(data: bytes, what: str) -> tuple[int, int, str]:
+    """The ``(width, height, format)`` the header of an image held in memory declares (a
+    compressed frame in a bag or a recording), without decoding it.
+
+    Args:
+        data: the encoded image (PNG, JPEG, ...).
+        what: names the image in the message.
+
+    Raises:
+        ImageError: a format not in :data:`FORMATS`, or a header cut short or inconsistent.
+    """
+    return _read_header(io.BytesIO(data), what)
+
+
+def _read_header(fh: BinaryIO, what: str) -> tuple[int, int, str]:
+    head = fh.read(512)
+    if head[:4] == b"RIFF" and head[8:12] == b"WEBP":
+        found = [("WebP", _webp)]
+    else:
+        found = [(name, f) for magic, name, f in _MAGIC if head.startswith(magic)]
+    if not found:
+        raise ImageError(f"cannot decode {what}: not an image in a format perception reads "
+                         f"({', '.join(FORMATS)})")
+    name, reader = found[0]
+    try:
+        width, height = reader(fh, head)
+    except (ValueError, KeyError, IndexError, struct.error) as exc:
+        raise ImageError(f"cannot decode {what}: damaged {name} header "
+                         f"({exc or 'cut short'})") from None
     return int(width), int(height), name

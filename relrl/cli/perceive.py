@@ -12,8 +12,9 @@ IMAGE_OUT = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Declare the options of ``relrl perceive``."""
-    parser.add_argument("image", nargs="?", help="an image file (PNG, JPEG, ...), or a ROS 2 "
-                                                 "bag BAG.mcap[:TOPIC]: every frame's facts")
+    parser.add_argument("image", nargs="?", help="an image file (PNG, JPEG, ...), or a bag "
+                                                 "(BAG.mcap, BAG.db3 or a rosbag2 folder, "
+                                                 "[:TOPIC]): every frame's facts")
     parser.add_argument("--camera", metavar="SRC",
                         help="a camera source instead: 0, cam://0, video.mp4, a folder, "
                              "synthetic://?looking_at=left&objects=left:apple")
@@ -54,8 +55,9 @@ def run(args: argparse.Namespace) -> int:
         if args.annotate else None  # before reading a single frame
     perceiver = Perceiver(threads=args.threads)
 
-    bag = args.image is not None and (args.image.lower().endswith(".mcap")
-                                      or ".mcap:" in args.image)
+    from perception.bag import is_bag
+
+    bag = args.image is not None and is_bag(args.image)
 
     def frames():  # one at a time: --frames 1000000 holds one frame, not a million
         if bag:  # every frame of the bag, in order, with its recorded time

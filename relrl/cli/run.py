@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--calibration", default=None, metavar="FILE",
                         help="the head's calibration TOML (default: examples/heads/wha8030.toml)")
     parser.add_argument("--camera", default=None, metavar="SRC",
-                        help="perceive from a camera: 0, video, folder, synthetic://...")
+                        help="perceive from a camera: 0, video, folder, a bag (BAG.mcap, "
+                             "BAG.db3, a rosbag2 folder; [:TOPIC]), synthetic://...")
     parser.add_argument("--live", action="store_true",
                         help="print what the robot perceives, wants and does; type words "
                              "to be heard as hear(Word)")
@@ -74,6 +75,8 @@ def run(args: argparse.Namespace) -> int:
         with stop.installed():
             summary = _claim_and_run(args, episode, opts, stop, session)
         print(_report(summary))
+        if "recording_ended" in summary:
+            print(_recording_ended(summary))
         if args.out:
             print(_wrote(args.out, summary.get("written", [])))
         if "policy_error" in summary:  # the run's product is missing: not a success
@@ -126,6 +129,16 @@ def _run(episode, opts, stop) -> dict:
         if kept is None:
             raise
         raise UserError(f"{exc}; {kept}") from None
+
+
+def _recording_ended(s: dict) -> str:
+    """The line of a session whose camera was a recording that ended (a normal end)."""
+    end = s["recording_ended"]
+    line = f"the recording ended at t = {end['t']} ({end['seconds']:.2f} s into it)"
+    if end["t"] < s["planned_steps"]:
+        line += (f": the episode asked for {s['planned_steps']} time units, the recording held "
+                 f"{end['t']} at the robot's pace")
+    return line
 
 
 def _report(s: dict) -> str:

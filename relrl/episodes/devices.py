@@ -23,9 +23,22 @@ from relrl.interfaces import Actuator, Environment
 from relrl.sim.metrics import StepRecord
 from relrl.terms import Term, format_term
 
-__all__ = ["DeviceWorld", "HeadActuator"]
+__all__ = ["DeviceWorld", "HeadActuator", "RecordingEnded"]
 
 _POSE_GAZE = {pose: place for place, pose in GAZE_POSE.items()}
+
+
+class RecordingEnded(UserError):
+    """The camera is a recording (a bag) and it has no more frames: the session's normal end
+    (:func:`relrl.episodes.session.run_episode` ends there, with everything written).
+
+    Attributes:
+        seconds: how much of the recording was played (from its first frame to its last).
+    """
+
+    def __init__(self, seconds: float) -> None:
+        super().__init__(f"the recording ended after {seconds:.2f} s")
+        self.seconds = seconds
 
 
 class HeadActuator(Actuator):
@@ -98,6 +111,10 @@ class DeviceWorld(Environment):
 
         frame = self.camera.read()
         if frame is None:
+            if getattr(self.camera, "ended", False):  # a bag: the end of the recording
+                if self.t == 0:
+                    raise UserError(f"{self.camera.name}: no frame in it")
+                raise RecordingEnded(float(getattr(self.camera, "seconds", 0.0)))
             raise UserError("the camera gave no more frames (end of the video or folder)")
         if self.head is not None:
             self.focus = self.head.looking_at() or self.focus

@@ -256,6 +256,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     Raises:
         UserError: a bad device, domain or policy.
     """
+    from relrl.episodes.devices import RecordingEnded
     from relrl.errors import ConfigError
     from relrl.experiments import fruits
     from relrl.loop import Interaction
@@ -323,8 +324,9 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
         cycles = episode.time_unit == "interaction"
         bound = fruits.unit_bound(episode) if cycles else 1
         shown = None  # the phase the monitor's status line names
+        ended: dict[str, Any] | None = None  # where a bag as the camera ended
         for unit in range(1, episode.steps + 1):
-            if stop():
+            if stop() or ended:
                 break
             if ev and (unit - 1) % ev["every"] == 0:
                 evaluate()
@@ -342,16 +344,25 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                     break
                 _pull_words(run, env)
                 run.t += 1
-                interaction.run(1, learning=phase.learning, keep=False, want=run.tap.want())
+                try:
+                    interaction.run(1, learning=phase.learning, keep=False,
+                                    want=run.tap.want())
+                except RecordingEnded as end:  # a bag as the camera: its end is the session's
+                    run.t, ended = run.done, {"t": run.units, "seconds": round(end.seconds, 3)}
+                    break
                 if opts.step_seconds:
                     time.sleep(opts.step_seconds)
                 if not cycles or env.units_done >= unit:
                     break
-            if not stop():
+            if not stop() and not ended:
                 run.units = unit
                 bar.update(1)
         bar.close()
-        if ev and not stop() and episode.steps % ev["every"] == 0:
+        if ended:  # the policy as learned when the recording ended, unless just evaluated
+            last = not (run.curve and run.curve[-1]["units"] == run.units)
+        else:
+            last = episode.steps % ev["every"] == 0 if ev else False
+        if ev and not stop() and last:
             evaluate()
         if episode.naming and not stop():
             bar = progress(episode.naming["executions"], "naming executions",
@@ -379,12 +390,13 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                 bar.update(1)
             bar.close()
         _status(opts, "stopped" if stop() else "finished",
-                (f"stopped by {_signal_name(stop)}" if stop() else "the session ended")
+                (f"stopped by {_signal_name(stop)}" if stop() else
+                 "the recording (the camera) ended" if ended else "the session ended")
                 + f" after {run.units} of {episode.steps} {unit_name}"
                 + (f"; writing the summary and the policy to {out}" if out is not None
                    else ""))
         recorded = run.tap.finish()
-        summary = _summary(run, stopped=stop(), why=_signal_name(stop))
+        summary = _summary(run, stopped=stop(), why=_signal_name(stop), ended=ended)
         summary["where"] = {k: v for k, v in where.items() if not k.endswith("_label")}
         timing = {"seconds": time.perf_counter() - t0, "learning_steps": run.t,
                   "evaluation_steps": sum(p["control_steps"] for p in run.curve),
@@ -484,7 +496,10 @@ def _flag_cut_short(point: dict[str, Any], runs_key: str, planned: int) -> None:
     point["interrupted"] = done < planned
 
 
-def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, Any]:
+def _summary(run: _Run, *, stopped: bool, why: str | None = None,
+             ended: dict[str, Any] | None = None) -> dict[str, Any]:
+    """The summary; ``ended`` is where a recording as the camera ended (``{"t", "seconds"}``):
+    the session's normal end, so the summary is not partial for the time units it lacked."""
     from relrl.experiments import fruits
 
     m = run.metrics
@@ -496,7 +511,7 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
         "learner": {"name": ep.learner, "params": run.learner.params},
         "time_unit": ep.time_unit, "units": run.units, "steps": run.t,
         "planned_steps": ep.steps, "stopped_early": stopped,
-        "partial": stopped or run.units < ep.steps, "stopped_by": why,
+        "partial": stopped or (run.units < ep.steps and not ended), "stopped_by": why,
         "cgi": _json_num(c.value), "correct_shifts": c.correct, "shifts": c.shifts,
         "eye_contacts": e.established, "opportunities": e.opportunities,
         "mutual_gaze_events": m.mutual_gaze_events,
@@ -506,6 +521,8 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None) -> dict[str, A
         "naming": {"outcomes": run.naming.counts(), "presentations": len(run.naming.outcomes)},
         "memory": _memory(run),
     }
+    if ended:
+        summary["recording_ended"] = ended
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
