@@ -291,7 +291,11 @@ contract(KB, Goal, Format, Args) :-
 %   `learn` (explore and learn), `explore` (explore, no learning) or `greedy` (neither).
 %   Options: updates(episode|online) (default episode), optimal(Limit) (compute each
 %   episode's optimal number of steps: optimal_steps/3, else a breadth-first search of at
-%   most Limit states; default 0: none), trace(true) (keep each step's state and action).
+%   most Limit states; default 0: none), trace(true) (keep each step's state and action),
+%   random(Seed) (draw from a stream of the batch's own, seeded with Seed, and leave KB's
+%   stream as it was: how often and how much a learner is evaluated then never changes
+%   what it learns, as Gymnasium's seeded reset; each episode's size and start state then
+%   depend on Seed and the episode's place in the batch alone; default `own`: KB's stream).
 %
 %   Episodes are ep(Size, Goal, Steps, Return, Reached, Optimal, Trace): Steps actions
 %   taken, Return the sum of rewards, Reached true/false, Optimal an integer or `none`,
@@ -315,10 +319,31 @@ world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(oneof([episode, online]), Updates),
     option_(optimal(Limit), Options, 0),
     option_(trace(Trace), Options, false),
+    option_(random(Seed), Options, own),
     Run = run(KB, Learner, Mode, Updates, Limit, Trace),
     engine_claim_random(KB),
     length(Episodes, Count),
-    maplist(episode(Run, Task, Sizes), Episodes).
+    (   Seed == own
+    ->  maplist(episode(Run, Task, Sizes), Episodes)
+    ;   must_be(nonneg, Seed),
+        random_property(state(Own)),
+        setup_call_cleanup(set_random(seed(Seed)),
+                           seeded_episodes(Run, Task, Sizes, Episodes),
+                           set_random(state(Own)))
+    ).
+
+%   Each episode from a stream of its own, seeded by a draw of the batch's stream: its size
+%   and start state depend on the batch's seed and its place in the batch alone, not on
+%   how the learner acted in the episodes before it.
+seeded_episodes(Run, Task, Sizes, Episodes) :-
+    length(Episodes, Count),
+    length(Seeds, Count),
+    maplist(random_between(0, 0xFFFFFFFFFFFF), Seeds),
+    maplist(seeded_episode(Run, Task, Sizes), Seeds, Episodes).
+
+seeded_episode(Run, Task, Sizes, Seed, Episode) :-
+    set_random(seed(Seed)),
+    episode(Run, Task, Sizes, Episode).
 
 option_(Opt, Options, Default) :-
     (   memberchk(Opt, Options)

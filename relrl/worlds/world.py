@@ -174,7 +174,7 @@ class World:
 
     def episodes(self, task: Term | str, sizes: Sequence[int], count: int, mode: str = "learn",
                  *, optimal: bool = False, trace: bool = False,
-                 updates: str = "episode") -> list[Episode]:
+                 updates: str = "episode", seed: int | None = None) -> list[Episode]:
         """Run ``count`` episodes in one crossing into Prolog.
 
         Args:
@@ -188,11 +188,16 @@ class World:
             trace: keep each step's state and action.
             updates: ``episode`` (the episode's examples given to the learner when it ends,
                 last first: RRL's) or ``online`` (each step's at once).
+            seed: draw the batch from a random stream of its own seeded with ``seed`` and
+                leave the learner's stream as it was (an evaluation that never moves
+                learning); None: the learner's stream.
         """
         if self.learner_name is None:
             raise ConfigError("attach a learner before running episodes")
         options = [("updates", updates), ("optimal", BFS_LIMIT if optimal else 0),
                    ("trace", "true" if trace else "false")]
+        if seed is not None:
+            options.append(("random", int(seed)))
         spec = ("episodes", self._task(task), [int(s) for s in sizes], int(count), mode,
                 options)
         raw = one(self.kb, "world_episodes", self.kb.module, spec)
