@@ -1,5 +1,6 @@
 :- module(relrl_world,
           [ world_episodes/3,     % +KB, +Spec, -Episodes
+            world_episodes_from/3, % +KB, +Spec, -Episodes
             world_start/5,        % +KB, +Task, +Size, -State, -Goal
             world_legal/3,        % +KB, +State, -Actions
             world_action/3,       % +KB, +State, ?Action
@@ -345,16 +346,68 @@ seeded_episode(Run, Task, Sizes, Seed, Episode) :-
     set_random(seed(Seed)),
     episode(Run, Task, Sizes, Episode).
 
+%!  world_episodes_from(+KB, +Spec, -Episodes:list) is det.
+%
+%   Run one episode from each given start state with KB's configured learner, as
+%   world_episodes/3 does from drawn ones. Spec is from(Task, Starts, Mode, Options): Starts
+%   a list of start(State, Instance), State a list of ground facts and Instance `none` or an
+%   instance of Task that is the episode's task (on(b1, b2)); each episode's goal is its
+%   task's (task_goal/3, drawn when the task leaves it open). Mode and Options as in
+%   world_episodes/3 (the option random(Seed) included). An episode's Size is `none`.
+
+world_episodes_from(KB, from(Task, Starts, Mode, Options), Episodes) :-
+    must_be(list, Starts),
+    must_be(oneof([learn, explore, greedy]), Mode),
+    must_be(list, Options),
+    engine_learner(KB, Learner),
+    (   relrl_engine:learner_serves(Learner, worlds, _)
+    ->  true
+    ;   domain_error(world_learner, Learner)
+    ),
+    option_(updates(Updates), Options, episode),
+    must_be(oneof([episode, online]), Updates),
+    option_(optimal(Limit), Options, 0),
+    option_(trace(Trace), Options, false),
+    option_(random(Seed), Options, own),
+    Run = run(KB, Learner, Mode, Updates, Limit, Trace),
+    engine_claim_random(KB),
+    (   Seed == own
+    ->  maplist(start_episode(Run, Task), Starts, Episodes)
+    ;   must_be(nonneg, Seed),
+        random_property(state(Own)),
+        setup_call_cleanup(set_random(seed(Seed)),
+                           maplist(start_episode(Run, Task), Starts, Episodes),
+                           set_random(state(Own)))
+    ).
+
+start_episode(Run, Task, start(State0, Instance), Episode) :-
+    Run = run(KB, _, _, _, _, _),
+    state_set(KB, initial_state(_, _), State0, State),
+    (   Instance == none
+    ->  T = Task
+    ;   T = Instance
+    ),
+    task_goal(KB, T, State, Goal),
+    (   holds_goal(KB, Goal, State)
+    ->  end_trace(Run, State, Trace),
+        Episode = ep(none, Goal, 0, 0, true, 0, Trace)
+    ;   run_episode(Run, none, State, Goal, Episode)
+    ).
+
 option_(Opt, Options, Default) :-
     (   memberchk(Opt, Options)
     ->  true
     ;   arg(1, Opt, Default)
     ).
 
-episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)) :-
-    Run = run(KB, _, _, _, Limit, _),
+episode(Run, Task, Sizes, Episode) :-
+    Run = run(KB, _, _, _, _, _),
     random_member(Size, Sizes),
     world_start(KB, Task, Size, S0, Goal),
+    run_episode(Run, Size, S0, Goal, Episode).
+
+run_episode(Run, Size, S0, Goal, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)) :-
+    Run = run(KB, _, _, _, Limit, _),
     bound(KB, Goal, S0, Bound),
     (   Limit > 0
     ->  world_optimal(KB, Goal, S0, Limit, Optimal)

@@ -38,7 +38,7 @@ BFS_LIMIT = 20_000
 class Episode:
     """One episode of a world (``relrl_world:world_episodes/3``)."""
 
-    size: int                  #: the number of objects
+    size: int | None           #: the number of objects (None: a given start state)
     goal: str                  #: the episode's goal, as Prolog text
     steps: int                 #: actions taken
     reward: float              #: the sum of rewards
@@ -203,6 +203,35 @@ class World:
         raw = one(self.kb, "world_episodes", self.kb.module, spec)
         return [_episode(e) for e in raw]
 
+    def episodes_from(self, task: Term | str, starts: Sequence[tuple[list[Term], Term | None]],
+                      mode: str = "greedy", *, optimal: bool = False, trace: bool = False,
+                      seed: int | None = None) -> list[Episode]:
+        """One episode from each start state, in one crossing (:meth:`episodes`' options).
+
+        Args:
+            task: a task (:meth:`task`, or its text).
+            starts: ``(facts, instance)`` pairs: a start state's facts, and the episode's task
+                (an instance of ``task``) or None for ``task`` itself (its goal drawn when
+                it leaves one open, task_goal/3).
+            mode: ``greedy``, ``explore`` or ``learn``.
+            optimal: compute each episode's optimal number of steps.
+            trace: keep each step's state and action.
+            seed: draw from a stream of the batch's own (see :meth:`episodes`).
+
+        An episode's ``size`` is None: the state gives it, not a draw.
+        """
+        if self.learner_name is None:
+            raise ConfigError("attach a learner before running episodes")
+        options: list[tuple[str, Any]] = [("optimal", BFS_LIMIT if optimal else 0),
+                                          ("trace", "true" if trace else "false")]
+        if seed is not None:
+            options.append(("random", int(seed)))
+        spec = ("from", self._task(task),
+                [("start", list(facts), "none" if inst is None else inst)
+                 for facts, inst in starts], mode, options)
+        raw = one(self.kb, "world_episodes_from", self.kb.module, spec)
+        return [_episode(e) for e in raw]
+
     def verify_optimal(self, task: Term | str, size: int, count: int
                        ) -> list[tuple[int | None, int | None]]:
         """``(declared, searched)`` optimal steps for ``count`` random start states: the
@@ -263,6 +292,7 @@ def _episode(raw: Term) -> Episode:
         else:
             steps_out.append({"state": [format_term(f) for f in item[1]], "action": None,
                               "reward": None})
-    return Episode(size=size, goal=format_term(goal), steps=steps, reward=float(reward),
-                   reached=reached == "true", optimal=_int(optimal), trace=tuple(steps_out))
+    return Episode(size=None if size == "none" else size, goal=format_term(goal),
+                   steps=steps, reward=float(reward), reached=reached == "true",
+                   optimal=_int(optimal), trace=tuple(steps_out))
 
