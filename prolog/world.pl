@@ -10,6 +10,8 @@
             world_view/4,         % +KB, +Goal, +State, -View
             world_optimal/5,      % +KB, +Goal, +State, +Limit, -Steps
             world_bfs/5,          % +KB, +Goal, +State, +Limit, -Steps
+            world_bound/4,        % +KB, +Goal, +State, -Steps
+            world_max_reward/1,   % -Max
             world_info/2,         % +KB, -Info
             world_predicate/2,    % ?Name/Arity, ?Required
             world_defines/2,      % +KB, ?Name/Arity
@@ -230,10 +232,23 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
     ;   Reached = false
     ),
     (   defines(KB, reward/5)
-    ->  (   rule_holds(KB, reward(Goal, S0, A, S, R0)), number(R0)
-        ->  R = R0
+    ->  (   rule_holds(KB, reward(Goal, S0, A, S, R0))
+        ->  (   reward_ok(R0)
+            ->  R = R0
+            ;   world_max_reward(Max),
+                (   integer(R0),
+                    number_codes(R0, Digits),
+                    length(Digits, D),
+                    D > 20
+                ->  format(string(Shown), "an integer of ~D digits", [D])
+                ;   format(string(Shown), "~q", [R0])
+                ),
+                contract(KB, reward(Goal, S0, A, S, _), "reward/5 gave ~w for the action ~q: \c
+                         a reward must be a finite number of magnitude at most ~g",
+                         [Shown, A, Max])
+            )
         ;   contract(KB, reward(Goal, S0, A, S, _), "reward/5 must give a number for every \c
-                     step", [])
+                     step (it failed for the action ~q)", [A])
         )
     ;   Reached == true
     ->  R = 1
@@ -266,12 +281,43 @@ world_view(KB, Goal, State, View) :-
                  ground", [])
     ).
 
+%!  world_max_reward(-Max:float) is det.
+%
+%   A reward (reward/5) is a finite number of magnitude at most Max: learned values then
+%   stay finite and within what a saved policy may hold (policy.pl).
+
+world_max_reward(1.0e6).
+
+reward_ok(R) :-
+    (   integer(R)
+    ->  world_max_reward(Max),
+        abs(R) =< Max
+    ;   float(R),
+        float_class(R, Class),
+        memberchk(Class, [zero, subnormal, normal]),
+        world_max_reward(Max),
+        abs(R) =< Max
+    ).
+
+%!  world_bound(+KB, +Goal, +State, -Steps:positive_integer) is det.
+%
+%   Steps is the step bound of an episode of Goal from State: the world's step_bound/3,
+%   else 100. Raises an error naming step_bound/3 when it fails or gives anything but a
+%   positive integer.
+
+world_bound(KB, Goal, State, Bound) :-
+    bound(KB, Goal, State, Bound).
+
 bound(KB, Goal, State, Bound) :-
     (   defines(KB, step_bound/3)
-    ->  (   rule_holds(KB, step_bound(Goal, State, B)), integer(B), B > 0
-        ->  Bound = B
-        ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 must give a positive \c
-                     integer", [])
+    ->  (   rule_holds(KB, step_bound(Goal, State, B))
+        ->  (   integer(B), B > 0
+            ->  Bound = B
+            ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 gave ~q for ~q: it \c
+                         must give a positive integer", [B, Goal])
+            )
+        ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 failed for ~q (it must \c
+                     give a positive integer)", [Goal])
         )
     ;   Bound = 100
     ).
@@ -481,7 +527,8 @@ learner_update(Learner, KB, Transition) :-
 %
 %   Steps is the least number of actions that take State to one satisfying Goal: the
 %   world's optimal_steps/3 when it defines it, else world_bfs/5 with at most Limit states;
-%   `none` when neither gives it.
+%   `unreachable` when the search proves no state satisfying Goal reachable, `none` when
+%   neither gives it (no search, or one stopped by its limit).
 
 world_optimal(KB, Goal, State, Limit, Steps) :-
     (   defines(KB, optimal_steps/3)
@@ -496,8 +543,9 @@ world_optimal(KB, Goal, State, Limit, Steps) :-
 %!  world_bfs(+KB, +Goal, +State, +Limit:integer, -Steps) is det.
 %
 %   Breadth-first search over the world's own dynamics (world_legal/3, world_next/6): Steps
-%   is the least number of actions from State to a state satisfying Goal, or `none` when
-%   no such state is found among the first Limit states visited (or none is reachable).
+%   is the least number of actions from State to a state satisfying Goal; `unreachable`
+%   when the search visited every state reachable from State (at most Limit) and none
+%   satisfies Goal; `none` when it stopped at Limit states without finding one.
 
 world_bfs(KB, Goal, State, Limit, Steps) :-
     must_be(nonneg, Limit),
@@ -510,7 +558,7 @@ world_bfs(KB, Goal, State, Limit, Steps) :-
 %   Frontier: the states at depth D; Next: those found at depth D + 1 so far.
 bfs([], Next, D, KB, Goal, Seen, N, Limit, Steps) :-
     (   Next == []
-    ->  Steps = none
+    ->  Steps = unreachable
     ;   D1 is D + 1,
         bfs(Next, [], D1, KB, Goal, Seen, N, Limit, Steps)
     ).

@@ -182,7 +182,8 @@ def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str,
         rows = step_rows({"goal": ep.goal, "steps": ep.steps, "optimal": ep.optimal,
                           "trace": ep.trace}, world=Path(config.world).name, size=ep.size,
                          label=f"greedy after {entry['episodes']} episodes "
-                               f"(of optimal {entry['optimality']:.3f})",
+                               + (f"(of optimal {entry['optimality']:.3f})"
+                                  if entry["optimality"] is not None else "(no optimum)"),
                          t0=entry["episodes"])
         if rows:
             hub.publish(rows[-1])

@@ -45,6 +45,7 @@ class Episode:
     reached: bool              #: the goal held at the end
     optimal: int | None        #: the least number of actions to the goal (when asked)
     trace: tuple[dict[str, Any], ...] = ()   #: each step's state and action (when asked)
+    unreachable: bool = False  #: a search proved the goal unreachable (optimal is None)
 
     @property
     def optimality(self) -> float | None:
@@ -59,11 +60,14 @@ class Episode:
 def score(episodes: Sequence[Episode]) -> dict[str, Any]:
     """Success rate, mean optimality (optimal / steps, 0 for a failure: RRL's "of optimal
     steps"), the share of episodes solved in exactly the optimal number of steps, mean steps
-    and mean optimal steps, over ``episodes``."""
+    and mean optimal steps, over ``episodes``. An episode whose optimum is unknown (a search
+    stopped by its limit) or that has none (``unreachable``: a search proved its goal
+    unreachable) counts in the success rate, not in the optimality; ``unreachable`` counts
+    the latter."""
     n = len(episodes)
     if not n:
         return {"episodes": 0, "success": None, "optimality": None, "exactly_optimal": None,
-                "steps": None, "optimal_steps": None}
+                "steps": None, "optimal_steps": None, "unreachable": 0}
     opt = [e.optimality for e in episodes]
     known = [o for o in opt if o is not None]
     return {"episodes": n,
@@ -73,7 +77,8 @@ def score(episodes: Sequence[Episode]) -> dict[str, Any]:
                                     and e.steps == e.optimal) / len(known)) if known else None,
             "steps": sum(e.steps for e in episodes) / n,
             "optimal_steps": (sum(e.optimal for e in episodes if e.optimal is not None)
-                              / len(known)) if known else None}
+                              / len(known)) if known else None,
+            "unreachable": sum(e.unreachable for e in episodes)}
 
 
 class World:
@@ -113,11 +118,22 @@ class World:
     def problems(self) -> list[str]:
         """One ``file:line: problem`` line per problem of the world (prolog/world_check.pl);
         empty when it is valid."""
-        lines = []
-        for _, path, line, message in one(self.kb, "world_check", self.kb.module):
-            where = f"{_display_path(path)}:{line}" if path else _display_path(str(self.path))
-            lines.append(f"{where}: {message}")
-        return lines
+        return self.check()[0]
+
+    def check(self) -> tuple[list[str], list[str]]:
+        """The world's problems and its warnings (a search stopped by its limit, an action
+        template never bound ...), one ``file:line: text`` line each
+        (prolog/world_check.pl)."""
+        problems: list[str] = []
+        warnings: list[str] = []
+        for kind, path, line, message in one(self.kb, "world_check", self.kb.module):
+            where = (f"{_display_path(path)}:{line}" if path
+                     else _display_path(str(self.path)))
+            if kind == "warning":
+                warnings.append(f"{where}: warning: {message}")
+            else:
+                problems.append(f"{where}: {message}")
+        return problems, warnings
 
     def task_names(self) -> list[str]:
         """The declared tasks as text (``stack``, ``on(_, _)``)."""
@@ -294,5 +310,6 @@ def _episode(raw: Term) -> Episode:
                               "reward": None})
     return Episode(size=None if size == "none" else size, goal=format_term(goal),
                    steps=steps, reward=float(reward), reached=reached == "true",
-                   optimal=_int(optimal), trace=tuple(steps_out))
+                   optimal=_int(optimal), trace=tuple(steps_out),
+                   unreachable=optimal == "unreachable")
 

@@ -138,7 +138,8 @@ test(precondition_for_open_templates_only, [Line == 4]) :-
              "precondition(go(X, Y), S) :- ( nonvar(Y) -> member(F, S), arg(1, F, X) ; member(p(X), S), member(q(Y), S) ).",
              "effect(go(_, _), _, [], []).", "goal(t, _) :- fail."],
             KB, Path),
-    world_problems(KB, [problem(Path, Line, Msg)]),
+    world_problems(KB, Ps),                 % and its goal is unreachable
+    member(problem(Path, Line, Msg), Ps),
     once(sub_string(Msg, _, _, _, "precondition/2 called with go(_,b) gives [go(a,b),go(b,b),go(c,b)]")).
 
 test(effect_not_a_list, [Line == 5]) :-
@@ -153,7 +154,8 @@ test(undeclared_relation, [Msg == "the learner's view holds q(a), but no relatio
              "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
              "goal(t, _) :- fail.", "relation(p(_))."],
             KB, _),
-    world_problems(KB, [problem(_, 7, Msg)]).
+    world_problems(KB, Ps),                 % and its goal is unreachable
+    memberchk(problem(_, 7, Msg), Ps).
 
 test(wrong_optimal_steps, [Line == 10]) :-
     text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(inc).",
@@ -186,6 +188,78 @@ test(own_bias_without_an_action_test, [Msg == "task_own_bias(t): its bias would 
              "task_own_bias(t)."],
             KB, _),
     world_problems(KB, [problem(_, 9, Msg)]).
+
+test(unreachable_goal, [Line-Msg == 2-"task t: the goal t is unreachable from the drawn start state [at(0)] (a breadth-first search over the world's actions visited every state reachable from it)"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(5), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]).
+
+test(search_stopped_by_its_limit, [Line-Limit == 2-20000]) :-
+    % the states at(0), at(1) ... never end: no search proves at(-1) unreachable
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(-1), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [warning(Path, Line, Msg)]),
+    relrl_world_check:check_limit(bfs, Limit),
+    once(sub_string(Msg, _, _, _, "stopped at its limit of 20,000 states")).
+
+test(action_never_bound, [Line-Msg == 4-"action(jump(_)): precondition/2 bound this template in no state of the checked episodes (a precondition that never holds?)"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "action(jump(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "precondition(jump(X), S) :- memberchk(at(99), S), X = 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "effect(jump(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [warning(Path, Line, Msg)]).
+
+test(one_problem_for_every_task, [Line == 206]) :-
+    % every task's goal raises the same error: one problem, and the run stops there
+    numlist(1, 200, Is),
+    findall(L, ( member(I, Is), format(atom(L), "task(t(~w)).", [I]) ), Tasks),
+    append([["initial_state(_, [at(0)])."], Tasks,
+            ["action(go(_)).", "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "relation(at(_)).", "goal(t(_), S) :- atom_length(S, _)."]], Lines),
+    text_kb(Lines, KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]),
+    once(sub_string(Msg, 0, _, _, "goal(t(1),[at(0)]) raised: atom_length/2: Type error")).
+
+test(at_most_ten_unreachable_tasks, [N == 11]) :-
+    numlist(1, 200, Is),
+    findall(L, ( member(I, Is), format(atom(L), "task(t(~w)).", [I]) ), Tasks),
+    append([["initial_state(_, [at(0)])."], Tasks,
+            ["action(go(_)).", "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "relation(at(_)).", "goal(t(_), S) :- memberchk(at(5), S)."]], Lines),
+    text_kb(Lines, KB, _),
+    world_problems(KB, Ps),
+    length(Ps, N),
+    last(Ps, warning('', 0, _)).
+
+test(reward_not_finite, [Msg == "reward/5 gave 1.5NaN for the action go(1): a reward must be a finite number of magnitude at most 1e+06"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_)).",
+             "reward(_, _, _, _, R) :- R is nan."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
+
+test(step_bound_not_a_positive_integer, [Msg == "step_bound/3 gave foo for t: it must give a positive integer"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_)).",
+             "step_bound(_, _, foo)."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
 
 :- end_tests(world_check).
 
