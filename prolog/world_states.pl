@@ -42,10 +42,10 @@ world_read_states(KB, File, Task, Answer) :-
     must_be(callable, Task),
     setup_call_cleanup(open(File, read, S, [encoding(utf8)]),
                        catch(read_states(KB, S, Task, States), states_problem(L, M),
-                             ( Answer = problem(L, M) )),
+                             Problem = problem(L, M)),
                        close(S)),
-    (   nonvar(Answer)
-    ->  true
+    (   nonvar(Problem)
+    ->  Answer = Problem
     ;   States == []
     ->  Answer = problem(1, "no state in the file (one term per state: a list of facts)")
     ;   Answer = states(States)
@@ -122,11 +122,12 @@ world_state_texts(KB, Texts, _Task, Answer) :-
     must_be(list, Texts),
     catch(( parse_texts(Texts, 1, Facts),
             (   facts_problem(KB, Facts, M)
-            ->  Answer = problem(0, M)
-            ;   Answer = facts(Facts)
+            ->  Answer0 = problem(0, M)
+            ;   Answer0 = facts(Facts)
             )
           ),
-          states_problem(I, M), Answer = problem(I, M)).
+          states_problem(I, M), Answer0 = problem(I, M)),
+    Answer = Answer0.
 
 parse_texts([], _, []).
 parse_texts([Text|Texts], I, [F|Fs]) :-

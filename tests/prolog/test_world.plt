@@ -10,6 +10,7 @@
 :- use_module('../../prolog/gateway').
 :- use_module('../../prolog/world').
 :- use_module('../../prolog/world_check').
+:- use_module('../../prolog/world_states').
 
 root_file(Relative, Path) :-
     module_property(relrl, file(RelrlFile)),
@@ -541,3 +542,75 @@ test(boltzmann_draw_is_boltzmann_over_the_moves) :-
     assertion(TV < 0.05).
 
 :- end_tests(world_exploration).
+
+:- begin_tests(world_given_states).
+
+qtable_kb(KB, Seed) :-
+    world_kb('examples/worlds/blocks.pl', KB),
+    relrl_engine:engine_configure(KB, qtable, [alpha=0.5, gamma=1, epsilon=0.1,
+                                               temperature=0, q_init=0], Seed).
+
+states_file(Lines, Path) :-
+    tmp_file_stream(text, Path, S),
+    forall(member(L, Lines), format(S, "~w~n", [L])),
+    close(S).
+
+test(seeded_batch_leaves_the_learners_stream, [A == B]) :-
+    qtable_kb(KB1, 3),
+    world_episodes(KB1, episodes(stack, [3, 4], 7, greedy, [random(11)]), _),
+    world_episodes(KB1, episodes(stack, [3, 4], 20, learn, []), A),
+    qtable_kb(KB2, 3),
+    world_episodes(KB2, episodes(stack, [3, 4], 20, learn, []), B).
+
+test(seeded_batch_same_start_states, [G1 == G2]) :-
+    qtable_kb(KB1, 3),
+    world_episodes(KB1, episodes(on(_, _), [4], 5, greedy, [random(11)]), E1),
+    qtable_kb(KB2, 8),
+    world_episodes(KB2, episodes(on(_, _), [4], 30, learn, []), _),
+    world_episodes(KB2, episodes(on(_, _), [4], 5, greedy, [random(11)]), E2),
+    findall(G, member(ep(_, G, _, _, _, _, _), E1), G1),
+    findall(G, member(ep(_, G, _, _, _, _, _), E2), G2).
+
+test(given_states_known_optima, [Optima-Goals == [1, 2, 0, 2]-[stack, stack, stack, on(b1, b2)]]) :-
+    qtable_kb(KB, 0),
+    towers([[b1], [b2]], S1),
+    towers([[b1], [b2], [b3]], S2),
+    towers([[b1, b2]], S3),
+    towers([[b1, b2]], S4),                             % b2 on b1: two moves to on(b1, b2)
+    world_episodes_from(KB, from(stack, [start(S1, none), start(S2, none), start(S3, none)],
+                                 greedy, [optimal(1000)]), Eps1),
+    world_episodes_from(KB, from(on(_, _), [start(S4, on(b1, b2))], greedy,
+                                 [optimal(1000)]), Eps2),
+    append(Eps1, Eps2, Eps),
+    findall(O, member(ep(none, _, _, _, _, O, _), Eps), Optima),
+    findall(G, member(ep(none, G, _, _, _, _, _), Eps), Goals).
+
+test(read_states, [States == [state(2, [on(b1, floor), clear(b1)], none),
+                              state(3, [on(b1, floor), on(b2, floor), clear(b1), clear(b2)],
+                                    on(b1, b2))]]) :-
+    blocks(KB),
+    states_file(["% two states", "[on(b1, floor), clear(b1)].",
+                 "state([on(b1, floor), on(b2, floor), clear(b1), clear(b2)], on(b1, b2))."],
+                Path),
+    world_read_states(KB, Path, on(_, _), states(States)).
+
+test(states_syntax_error, [Line == 2]) :-
+    blocks(KB),
+    states_file(["[on(b1, floor), clear(b1)].", "[on(b1 floor)]."], Path),
+    world_read_states(KB, Path, stack, problem(Line, _)).
+
+test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_on/2,highest/1,on/2])"]) :-
+    blocks(KB),
+    states_file(["[on(b1, floor), clear(b1)].", "", "[on(b1, floor), fly(b1)]."], Path),
+    world_read_states(KB, Path, stack, problem(Line, Msg)).
+
+test(states_directive_is_data, [Line == 1]) :-
+    blocks(KB),
+    states_file([":- throw(ran)."], Path),
+    world_read_states(KB, Path, stack, problem(Line, _)).
+
+test(state_texts, [Answer == facts([on(b1, floor), clear(b1)])]) :-
+    blocks(KB),
+    world_state_texts(KB, ["on(b1, floor)", "clear(b1)"], stack, Answer).
+
+:- end_tests(world_given_states).
