@@ -338,7 +338,8 @@ contract(KB, Goal, Format, Args) :-
 %   `learn` (explore and learn), `explore` (explore, no learning) or `greedy` (neither).
 %   Options: updates(episode|online) (default episode), optimal(Limit) (compute each
 %   episode's optimal number of steps: optimal_steps/3, else a breadth-first search of at
-%   most Limit states; default 0: none), trace(true) (keep each step's state and action),
+%   most Limit states; default 0: none), trace(true) (keep each step's state and action;
+%   trace(actions): its action alone, the state [], and no end state: small answers),
 %   random(Seed) (draw from a stream of the batch's own, seeded with Seed, and leave KB's
 %   stream as it was: how often and how much a learner is evaluated then never changes
 %   what it learns, as Gymnasium's seeded reset; each episode's size and start state then
@@ -498,6 +499,8 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
         ),
         (   KeepTrace == true
         ->  Trace = [step(S, A, R)|Trace1]
+        ;   KeepTrace == actions
+        ->  Trace = [step([], A, R)|Trace1]
         ;   Trace = Trace1
         ),
         (   Done == true

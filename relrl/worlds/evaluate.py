@@ -180,11 +180,12 @@ def evaluate_policy(world_path: str | Path, policy: str | Path, task_text: str, 
             t0 = time.process_time()
             if starts is not None:
                 eps = world.episodes_from(task, [(s.facts, s.task) for s in starts],
-                                          optimal=True, trace=actions,
+                                          optimal=True, actions=actions,
                                           seed=evaluation_seed(seed, "states"))
             else:
                 eps = world.episodes(task, [size], episodes, "greedy", optimal=True,
-                                     trace=actions, seed=evaluation_seed(seed, f"size {size}"))
+                                     actions=actions,
+                                     seed=evaluation_seed(seed, f"size {size}"))
             cpu = time.process_time() - t0
             summary[label] = {**score(eps), "cpu_seconds_per_episode": cpu / max(1, len(eps))}
             for i, e in enumerate(eps):

@@ -190,7 +190,8 @@ class World:
 
     def episodes(self, task: Term | str, sizes: Sequence[int], count: int, mode: str = "learn",
                  *, optimal: bool = False, trace: bool = False,
-                 updates: str = "episode", seed: int | None = None) -> list[Episode]:
+                 updates: str = "episode", seed: int | None = None,
+                 actions: bool = False) -> list[Episode]:
         """Run ``count`` episodes in one crossing into Prolog.
 
         Args:
@@ -207,11 +208,13 @@ class World:
             seed: draw the batch from a random stream of its own seeded with ``seed`` and
                 leave the learner's stream as it was (an evaluation that never moves
                 learning); None: the learner's stream.
+            actions: without ``trace``, keep each step's action alone (its state empty): an
+                answer a few bytes a step, whatever the size of the world.
         """
         if self.learner_name is None:
             raise ConfigError("attach a learner before running episodes")
         options = [("updates", updates), ("optimal", BFS_LIMIT if optimal else 0),
-                   ("trace", "true" if trace else "false")]
+                   ("trace", _trace(trace, actions))]
         if seed is not None:
             options.append(("random", int(seed)))
         spec = ("episodes", self._task(task), [int(s) for s in sizes], int(count), mode,
@@ -221,7 +224,7 @@ class World:
 
     def episodes_from(self, task: Term | str, starts: Sequence[tuple[list[Term], Term | None]],
                       mode: str = "greedy", *, optimal: bool = False, trace: bool = False,
-                      seed: int | None = None) -> list[Episode]:
+                      seed: int | None = None, actions: bool = False) -> list[Episode]:
         """One episode from each start state, in one crossing (:meth:`episodes`' options).
 
         Args:
@@ -233,13 +236,14 @@ class World:
             optimal: compute each episode's optimal number of steps.
             trace: keep each step's state and action.
             seed: draw from a stream of the batch's own (see :meth:`episodes`).
+            actions: keep each step's action alone (see :meth:`episodes`).
 
         An episode's ``size`` is None: the state gives it, not a draw.
         """
         if self.learner_name is None:
             raise ConfigError("attach a learner before running episodes")
         options: list[tuple[str, Any]] = [("optimal", BFS_LIMIT if optimal else 0),
-                                          ("trace", "true" if trace else "false")]
+                                          ("trace", _trace(trace, actions))]
         if seed is not None:
             options.append(("random", int(seed)))
         spec = ("from", self._task(task),
@@ -284,6 +288,10 @@ class World:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _trace(trace: bool, actions: bool) -> str:
+    return "true" if trace else "actions" if actions else "false"
 
 
 def _int(x: Term) -> int | None:

@@ -609,6 +609,16 @@ test(states_directive_is_data, [Line == 1]) :-
     states_file([":- throw(ran)."], Path),
     world_read_states(KB, Path, stack, problem(Line, _)).
 
+test(trace_of_actions_only, [States-Last == [[]]-[]]) :-
+    % the actions alone cross back: a few bytes a step, whatever the world's size
+    qtable_kb(KB, 1),
+    world_episodes(KB, episodes(unstack, [6], 1, greedy, [trace(actions)]),
+                   [ep(_, _, Steps, _, _, _, Trace)]),
+    length(Trace, Steps),
+    findall(S, member(step(S, _, _), Trace), States0),
+    sort(States0, States),
+    exclude([X]>>(X = step(_, _, _)), Trace, Last).
+
 test(state_texts, [Answer == facts([on(b1, floor), clear(b1)])]) :-
     blocks(KB),
     world_state_texts(KB, ["on(b1, floor)", "clear(b1)"], stack, Answer).
