@@ -355,43 +355,11 @@ contract(KB, Goal, Format, Args) :-
 world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(list(positive_integer), Sizes),
     must_be(nonneg, Count),
-    must_be(oneof([learn, explore, greedy]), Mode),
-    must_be(list, Options),
     Sizes = [_|_],
-    engine_learner(KB, Learner),
-    (   relrl_engine:learner_serves(Learner, worlds, _)   % learners.pl: reads the
-    ->  true                                              % relational view too
-    ;   domain_error(world_learner, Learner)
-    ),
-    option_(updates(Updates), Options, episode),
-    must_be(oneof([episode, online]), Updates),
-    option_(optimal(Limit), Options, 0),
-    option_(trace(Trace), Options, false),
-    option_(random(Seed), Options, own),
-    Run = run(KB, Learner, Mode, Updates, Limit, Trace),
-    engine_claim_random(KB),
-    length(Episodes, Count),
-    (   Seed == own
-    ->  maplist(episode(Run, Task, Sizes), Episodes)
-    ;   must_be(nonneg, Seed),
-        random_property(state(Own)),
-        setup_call_cleanup(set_random(seed(Seed)),
-                           seeded_episodes(Run, Task, Sizes, Episodes),
-                           set_random(state(Own)))
-    ).
-
-%   Each episode from a stream of its own, seeded by a draw of the batch's stream: its size
-%   and start state depend on the batch's seed and its place in the batch alone, not on
-%   how the learner acted in the episodes before it.
-seeded_episodes(Run, Task, Sizes, Episodes) :-
-    length(Episodes, Count),
-    length(Seeds, Count),
-    maplist(random_between(0, 0xFFFFFFFFFFFF), Seeds),
-    maplist(seeded_episode(Run, Task, Sizes), Seeds, Episodes).
-
-seeded_episode(Run, Task, Sizes, Seed, Episode) :-
-    set_random(seed(Seed)),
-    episode(Run, Task, Sizes, Episode).
+    batch(KB, Mode, Options, Run, Seed),
+    length(Draws, Count),
+    maplist(=(draw), Draws),
+    seeded(Seed, Draws, Episodes, episode(Run, Task, Sizes)).
 
 %!  world_episodes_from(+KB, +Spec, -Episodes:list) is det.
 %
@@ -404,11 +372,17 @@ seeded_episode(Run, Task, Sizes, Seed, Episode) :-
 
 world_episodes_from(KB, from(Task, Starts, Mode, Options), Episodes) :-
     must_be(list, Starts),
+    batch(KB, Mode, Options, Run, Seed),
+    seeded(Seed, Starts, Episodes, start_episode(Run, Task)).
+
+%   The run of a batch (Mode and Options checked, KB's learner a learner of worlds) and its
+%   random(Seed) option (`own`: KB's stream, claimed).
+batch(KB, Mode, Options, Run, Seed) :-
     must_be(oneof([learn, explore, greedy]), Mode),
     must_be(list, Options),
     engine_learner(KB, Learner),
-    (   relrl_engine:learner_serves(Learner, worlds, _)
-    ->  true
+    (   relrl_engine:learner_serves(Learner, worlds, _)   % learners.pl: reads the
+    ->  true                                              % relational view too
     ;   domain_error(world_learner, Learner)
     ),
     option_(updates(Updates), Options, episode),
@@ -417,15 +391,28 @@ world_episodes_from(KB, from(Task, Starts, Mode, Options), Episodes) :-
     option_(trace(Trace), Options, false),
     option_(random(Seed), Options, own),
     Run = run(KB, Learner, Mode, Updates, Limit, Trace),
-    engine_claim_random(KB),
-    (   Seed == own
-    ->  maplist(start_episode(Run, Task), Starts, Episodes)
-    ;   must_be(nonneg, Seed),
-        random_property(state(Own)),
-        setup_call_cleanup(set_random(seed(Seed)),
-                           maplist(start_episode(Run, Task), Starts, Episodes),
-                           set_random(state(Own)))
-    ).
+    engine_claim_random(KB).
+
+%   seeded(+Seed, +Inputs, -Episodes, :Goal): call(Goal, Input, Episode) for each input.
+%   With Seed `own`, from KB's stream; else each episode from a stream of its own, seeded by
+%   a draw of a stream seeded with Seed, and KB's stream is left as it was: an episode's
+%   size, start state and drawn goal depend on Seed and its place in the batch alone, not
+%   on how the learner acted in the episodes before it.
+seeded(own, Ins, Outs, Goal) :-
+    !,
+    maplist(Goal, Ins, Outs).
+seeded(Seed, Ins, Outs, Goal) :-
+    must_be(nonneg, Seed),
+    random_property(state(Own)),
+    setup_call_cleanup(set_random(seed(Seed)),
+                       ( same_length(Ins, Seeds),
+                         maplist(random_between(0, 0xFFFFFFFFFFFF), Seeds),
+                         maplist(seeded_episode(Goal), Seeds, Ins, Outs) ),
+                       set_random(state(Own))).
+
+seeded_episode(Goal, Seed, In, Out) :-
+    set_random(seed(Seed)),
+    call(Goal, In, Out).
 
 start_episode(Run, Task, start(State0, Instance), Episode) :-
     Run = run(KB, _, _, _, _, _),
@@ -447,7 +434,7 @@ option_(Opt, Options, Default) :-
     ;   arg(1, Opt, Default)
     ).
 
-episode(Run, Task, Sizes, Episode) :-
+episode(Run, Task, Sizes, draw, Episode) :-
     Run = run(KB, _, _, _, _, _),
     random_member(Size, Sizes),
     world_start(KB, Task, Size, S0, Goal),
