@@ -17,7 +17,7 @@
 
 world_problems/2 lists what is wrong with the world loaded into a knowledge base, as
 problem(File, Line, Message) terms, and what may be, as warning(File, Line, Message) terms,
-in file order (File '' for the world as a whole):
+in file order (File '' for the world as a whole; a note that the run stopped comes last):
 
   - a required predicate of the vocabulary that the world does not define (world.pl);
   - a clause that calls an undefined predicate;
@@ -26,11 +26,10 @@ in file order (File '' for the world as a whole):
   - what running the world shows: for every task, a few episodes of random legal actions
     from random start states of the smallest training size (seeded, so the same problems
     every time). A goal of the world that raises an error or breaks the vocabulary's
-    contract (an unbound action, an effect that is not two lists of ground facts, a reward
-    that is not a number ...) is a problem at that rule's file and line; so is a fact of the
+    contract (an unbound action, an effect that is not two lists of ground facts, a step
+    bound that is not a positive integer, a reward that is not a finite number within
+    world_max_reward/1 ...) is a problem at that rule's file and line; so is a fact of the
     learner's view that no relation/1 declares, and an action no action/1 template covers;
-    A step bound (step_bound/3) that is not a positive integer and a reward (reward/5)
-    that is not a finite number within world_max_reward/1 are problems there too;
   - whether each episode's goal can be reached: a breadth-first search from its start
     state that visits every reachable state without meeting the goal is a problem
     ("unreachable", at the task's declaration); one stopped by its limit of states is a
