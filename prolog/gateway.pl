@@ -138,6 +138,9 @@ python_api(world_task, relrl_world:world_task/3).
 python_api(world_verify, relrl_world:world_verify/5).
 python_api(world_for_task, relrl_world:world_for_task/2).
 python_api(world_check, relrl_world_check:world_problems/2).
+python_api(world_episodes_from, relrl_world:world_episodes_from/3).
+python_api(world_read_states, relrl_world_states:world_read_states/4).
+python_api(world_state_texts, relrl_world_states:world_state_texts/4).
 python_api(new_kb, relrl_gateway:gw_new_kb/1).
 python_api(drop_kb, relrl_gateway:gw_drop_kb/1).
 python_api(load, relrl_gateway:gw_load/3).

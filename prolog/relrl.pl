@@ -32,6 +32,7 @@
 :- use_module(policy).
 :- use_module(world).
 :- use_module(world_check).
+:- use_module(world_states).
 
 /** <module> relrl: the knowledge layer
 

@@ -1,5 +1,6 @@
 :- module(relrl_world,
           [ world_episodes/3,     % +KB, +Spec, -Episodes
+            world_episodes_from/3, % +KB, +Spec, -Episodes
             world_start/5,        % +KB, +Task, +Size, -State, -Goal
             world_legal/3,        % +KB, +State, -Actions
             world_action/3,       % +KB, +State, ?Action
@@ -9,6 +10,8 @@
             world_view/4,         % +KB, +Goal, +State, -View
             world_optimal/5,      % +KB, +Goal, +State, +Limit, -Steps
             world_bfs/5,          % +KB, +Goal, +State, +Limit, -Steps
+            world_bound/4,        % +KB, +Goal, +State, -Steps
+            world_max_reward/1,   % -Max
             world_info/2,         % +KB, -Info
             world_predicate/2,    % ?Name/Arity, ?Required
             world_defines/2,      % +KB, ?Name/Arity
@@ -229,10 +232,23 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
     ;   Reached = false
     ),
     (   defines(KB, reward/5)
-    ->  (   rule_holds(KB, reward(Goal, S0, A, S, R0)), number(R0)
-        ->  R = R0
+    ->  (   rule_holds(KB, reward(Goal, S0, A, S, R0))
+        ->  (   reward_ok(R0)
+            ->  R = R0
+            ;   world_max_reward(Max),
+                (   integer(R0),
+                    number_codes(R0, Digits),
+                    length(Digits, D),
+                    D > 20
+                ->  format(string(Shown), "an integer of ~D digits", [D])
+                ;   format(string(Shown), "~q", [R0])
+                ),
+                contract(KB, reward(Goal, S0, A, S, _), "reward/5 gave ~w for the action ~q: \c
+                         a reward must be a finite number of magnitude at most ~g",
+                         [Shown, A, Max])
+            )
         ;   contract(KB, reward(Goal, S0, A, S, _), "reward/5 must give a number for every \c
-                     step", [])
+                     step (it failed for the action ~q)", [A])
         )
     ;   Reached == true
     ->  R = 1
@@ -265,12 +281,43 @@ world_view(KB, Goal, State, View) :-
                  ground", [])
     ).
 
+%!  world_max_reward(-Max:float) is det.
+%
+%   A reward (reward/5) is a finite number of magnitude at most Max: learned values then
+%   stay finite and within what a saved policy may hold (policy.pl).
+
+world_max_reward(1.0e6).
+
+reward_ok(R) :-
+    (   integer(R)
+    ->  world_max_reward(Max),
+        abs(R) =< Max
+    ;   float(R),
+        float_class(R, Class),
+        memberchk(Class, [zero, subnormal, normal]),
+        world_max_reward(Max),
+        abs(R) =< Max
+    ).
+
+%!  world_bound(+KB, +Goal, +State, -Steps:positive_integer) is det.
+%
+%   Steps is the step bound of an episode of Goal from State: the world's step_bound/3,
+%   else 100. Raises an error naming step_bound/3 when it fails or gives anything but a
+%   positive integer.
+
+world_bound(KB, Goal, State, Bound) :-
+    bound(KB, Goal, State, Bound).
+
 bound(KB, Goal, State, Bound) :-
     (   defines(KB, step_bound/3)
-    ->  (   rule_holds(KB, step_bound(Goal, State, B)), integer(B), B > 0
-        ->  Bound = B
-        ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 must give a positive \c
-                     integer", [])
+    ->  (   rule_holds(KB, step_bound(Goal, State, B))
+        ->  (   integer(B), B > 0
+            ->  Bound = B
+            ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 gave ~q for ~q: it \c
+                         must give a positive integer", [B, Goal])
+            )
+        ;   contract(KB, step_bound(Goal, State, _), "step_bound/3 failed for ~q (it must \c
+                     give a positive integer)", [Goal])
         )
     ;   Bound = 100
     ).
@@ -291,7 +338,12 @@ contract(KB, Goal, Format, Args) :-
 %   `learn` (explore and learn), `explore` (explore, no learning) or `greedy` (neither).
 %   Options: updates(episode|online) (default episode), optimal(Limit) (compute each
 %   episode's optimal number of steps: optimal_steps/3, else a breadth-first search of at
-%   most Limit states; default 0: none), trace(true) (keep each step's state and action).
+%   most Limit states; default 0: none), trace(true) (keep each step's state and action;
+%   trace(actions): its action alone, the state [], and no end state: small answers),
+%   random(Seed) (draw from a stream of the batch's own, seeded with Seed, and leave KB's
+%   stream as it was: how often and how much a learner is evaluated then never changes
+%   what it learns, as Gymnasium's seeded reset; each episode's size and start state then
+%   depend on Seed and the episode's place in the batch alone; default `own`: KB's stream).
 %
 %   Episodes are ep(Size, Goal, Steps, Return, Reached, Optimal, Trace): Steps actions
 %   taken, Return the sum of rewards, Reached true/false, Optimal an integer or `none`,
@@ -303,9 +355,31 @@ contract(KB, Goal, Format, Args) :-
 world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(list(positive_integer), Sizes),
     must_be(nonneg, Count),
+    Sizes = [_|_],
+    batch(KB, Mode, Options, Run, Seed),
+    length(Draws, Count),
+    maplist(=(draw), Draws),
+    seeded(Seed, Draws, Episodes, episode(Run, Task, Sizes)).
+
+%!  world_episodes_from(+KB, +Spec, -Episodes:list) is det.
+%
+%   Run one episode from each given start state with KB's configured learner, as
+%   world_episodes/3 does from drawn ones. Spec is from(Task, Starts, Mode, Options): Starts
+%   a list of start(State, Instance), State a list of ground facts and Instance `none` or an
+%   instance of Task that is the episode's task (on(b1, b2)); each episode's goal is its
+%   task's (task_goal/3, drawn when the task leaves it open). Mode and Options as in
+%   world_episodes/3 (the option random(Seed) included). An episode's Size is `none`.
+
+world_episodes_from(KB, from(Task, Starts, Mode, Options), Episodes) :-
+    must_be(list, Starts),
+    batch(KB, Mode, Options, Run, Seed),
+    seeded(Seed, Starts, Episodes, start_episode(Run, Task)).
+
+%   The run of a batch (Mode and Options checked, KB's learner a learner of worlds) and its
+%   random(Seed) option (`own`: KB's stream, claimed).
+batch(KB, Mode, Options, Run, Seed) :-
     must_be(oneof([learn, explore, greedy]), Mode),
     must_be(list, Options),
-    Sizes = [_|_],
     engine_learner(KB, Learner),
     (   relrl_engine:learner_serves(Learner, worlds, _)   % learners.pl: reads the
     ->  true                                              % relational view too
@@ -315,10 +389,44 @@ world_episodes(KB, episodes(Task, Sizes, Count, Mode, Options), Episodes) :-
     must_be(oneof([episode, online]), Updates),
     option_(optimal(Limit), Options, 0),
     option_(trace(Trace), Options, false),
+    option_(random(Seed), Options, own),
     Run = run(KB, Learner, Mode, Updates, Limit, Trace),
-    engine_claim_random(KB),
-    length(Episodes, Count),
-    maplist(episode(Run, Task, Sizes), Episodes).
+    engine_claim_random(KB).
+
+%   seeded(+Seed, +Inputs, -Episodes, :Goal): call(Goal, Input, Episode) for each input.
+%   With Seed `own`, from KB's stream; else each episode from a stream of its own, seeded by
+%   a draw of a stream seeded with Seed, and KB's stream is left as it was: an episode's
+%   size, start state and drawn goal depend on Seed and its place in the batch alone, not
+%   on how the learner acted in the episodes before it.
+seeded(own, Ins, Outs, Goal) :-
+    !,
+    maplist(Goal, Ins, Outs).
+seeded(Seed, Ins, Outs, Goal) :-
+    must_be(nonneg, Seed),
+    random_property(state(Own)),
+    setup_call_cleanup(set_random(seed(Seed)),
+                       ( same_length(Ins, Seeds),
+                         maplist(random_between(0, 0xFFFFFFFFFFFF), Seeds),
+                         maplist(seeded_episode(Goal), Seeds, Ins, Outs) ),
+                       set_random(state(Own))).
+
+seeded_episode(Goal, Seed, In, Out) :-
+    set_random(seed(Seed)),
+    call(Goal, In, Out).
+
+start_episode(Run, Task, start(State0, Instance), Episode) :-
+    Run = run(KB, _, _, _, _, _),
+    state_set(KB, initial_state(_, _), State0, State),
+    (   Instance == none
+    ->  T = Task
+    ;   T = Instance
+    ),
+    task_goal(KB, T, State, Goal),
+    (   holds_goal(KB, Goal, State)
+    ->  end_trace(Run, State, Trace),
+        Episode = ep(none, Goal, 0, 0, true, 0, Trace)
+    ;   run_episode(Run, none, State, Goal, Episode)
+    ).
 
 option_(Opt, Options, Default) :-
     (   memberchk(Opt, Options)
@@ -326,10 +434,14 @@ option_(Opt, Options, Default) :-
     ;   arg(1, Opt, Default)
     ).
 
-episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)) :-
-    Run = run(KB, _, _, _, Limit, _),
+episode(Run, Task, Sizes, draw, Episode) :-
+    Run = run(KB, _, _, _, _, _),
     random_member(Size, Sizes),
     world_start(KB, Task, Size, S0, Goal),
+    run_episode(Run, Size, S0, Goal, Episode).
+
+run_episode(Run, Size, S0, Goal, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)) :-
+    Run = run(KB, _, _, _, Limit, _),
     bound(KB, Goal, S0, Bound),
     (   Limit > 0
     ->  world_optimal(KB, Goal, S0, Limit, Optimal)
@@ -374,6 +486,8 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
         ),
         (   KeepTrace == true
         ->  Trace = [step(S, A, R)|Trace1]
+        ;   KeepTrace == actions
+        ->  Trace = [step([], A, R)|Trace1]
         ;   Trace = Trace1
         ),
         (   Done == true
@@ -403,7 +517,8 @@ learner_update(Learner, KB, Transition) :-
 %
 %   Steps is the least number of actions that take State to one satisfying Goal: the
 %   world's optimal_steps/3 when it defines it, else world_bfs/5 with at most Limit states;
-%   `none` when neither gives it.
+%   `unreachable` when the search proves no state satisfying Goal reachable, `none` when
+%   neither gives it (no search, or one stopped by its limit).
 
 world_optimal(KB, Goal, State, Limit, Steps) :-
     (   defines(KB, optimal_steps/3)
@@ -418,8 +533,9 @@ world_optimal(KB, Goal, State, Limit, Steps) :-
 %!  world_bfs(+KB, +Goal, +State, +Limit:integer, -Steps) is det.
 %
 %   Breadth-first search over the world's own dynamics (world_legal/3, world_next/6): Steps
-%   is the least number of actions from State to a state satisfying Goal, or `none` when
-%   no such state is found among the first Limit states visited (or none is reachable).
+%   is the least number of actions from State to a state satisfying Goal; `unreachable`
+%   when the search visited every state reachable from State (at most Limit) and none
+%   satisfies Goal; `none` when it stopped at Limit states without finding one.
 
 world_bfs(KB, Goal, State, Limit, Steps) :-
     must_be(nonneg, Limit),
@@ -432,7 +548,7 @@ world_bfs(KB, Goal, State, Limit, Steps) :-
 %   Frontier: the states at depth D; Next: those found at depth D + 1 so far.
 bfs([], Next, D, KB, Goal, Seen, N, Limit, Steps) :-
     (   Next == []
-    ->  Steps = none
+    ->  Steps = unreachable
     ;   D1 is D + 1,
         bfs(Next, [], D1, KB, Goal, Seen, N, Limit, Steps)
     ).

@@ -16,7 +16,8 @@
 /** <module> Validating a world file
 
 world_problems/2 lists what is wrong with the world loaded into a knowledge base, as
-problem(File, Line, Message) terms in file order (File '' for the world as a whole):
+problem(File, Line, Message) terms, and what may be, as warning(File, Line, Message) terms,
+in file order (File '' for the world as a whole; a note that the run stopped comes last):
 
   - a required predicate of the vocabulary that the world does not define (world.pl);
   - a clause that calls an undefined predicate;
@@ -25,12 +26,23 @@ problem(File, Line, Message) terms in file order (File '' for the world as a who
   - what running the world shows: for every task, a few episodes of random legal actions
     from random start states of the smallest training size (seeded, so the same problems
     every time). A goal of the world that raises an error or breaks the vocabulary's
-    contract (an unbound action, an effect that is not two lists of ground facts, a reward
-    that is not a number ...) is a problem at that rule's file and line; so is a fact of the
+    contract (an unbound action, an effect that is not two lists of ground facts, a step
+    bound that is not a positive integer, a reward that is not a finite number within
+    world_max_reward/1 ...) is a problem at that rule's file and line; so is a fact of the
     learner's view that no relation/1 declares, and an action no action/1 template covers;
+  - whether each episode's goal can be reached: a breadth-first search from its start
+    state that visits every reachable state without meeting the goal is a problem
+    ("unreachable", at the task's declaration); one stopped by its limit of states is a
+    warning naming the limit;
+  - an action/1 template that no precondition/2 bound in any state of those episodes: a
+    warning at the template;
   - optimal_steps/3, when the world defines it, checked against a breadth-first search over
     the world's own dynamics (world_bfs/5) on random start states of the training sizes up
     to five objects: a different number is a problem at optimal_steps/3.
+
+A problem is reported once, at its place, not once per episode (a rule that fails the same
+way for every task is one line); the run stops at the first error a world goal raises, and
+after ten problems and warnings.
 
 A time limit, Ctrl-C or a resource error outside the world's own goals is not a problem of
 the world: it propagates.
@@ -38,23 +50,27 @@ the world: it propagates.
 
 %!  world_problems(+KB, -Problems:list) is det.
 %
-%   Problems lists every problem found in the world loaded into KB, in file order.
+%   Problems lists the problems (problem(File, Line, Message)) and warnings
+%   (warning(File, Line, Message)) found in the world loaded into KB, in file order.
 
 world_problems(KB, Problems) :-
     must_be(atom, KB),
     findall(P, static_problem(KB, P), Static),
     (   Static == [],
         \+ missing_required(KB, _)
-    ->  findall(P, run_problem(KB, P), Run)
-    ;   Run = []
+    ->  run_problems(KB, Run, Stopped)
+    ;   Run = [], Stopped = []
     ),
     append(Static, Run, All),
     sort(All, Problems0),
     map_list_to_pairs(problem_key, Problems0, Keyed),
     keysort(Keyed, Sorted),
-    pairs_values(Sorted, Problems).
+    pairs_values(Sorted, Problems1),
+    append(Problems1, Stopped, Problems).
 
-problem_key(problem(File, Line, _), File-Line).
+problem_key(Item, File-Line) :-
+    arg(1, Item, File),
+    arg(2, Item, Line).
 
 % ---- what the file says --------------------------------------------------------------------
 
@@ -139,23 +155,95 @@ undefined(KB, Goal, Name/Arity) :-
 
 % ---- what running it shows -----------------------------------------------------------------
 
+%!  check_limit(-Name, -Value) is det.
+%
+%   The run's limits: `items`, the problems and warnings found before it stops; `bfs`, the
+%   states a reachability search visits from a start state (as relrl learn's optimum).
+
+check_limit(items, 10).
+check_limit(bfs, 20000).
+
 %   Episodes of random legal actions, 3 per task, seeded; then optimal_steps/3 against the
-%   search. Each problem is reported once (the first episode that shows it).
-run_problem(KB, P) :-
+%   search. A problem is reported once, at its place (the first episode that shows it); the
+%   run stops at the first error a world goal raises (every later episode would meet it
+%   again) or once check_limit(items, _) problems are found. When every episode ran, an
+%   action template that no precondition bound in any of their states is a warning.
+run_problems(KB, Items, Stopped) :-
     engine_pause,
     set_random(seed(0)),
     sizes(KB, Sizes),
     Sizes = [Smallest|_],
     findall(T, declared(KB, task(T)), Tasks),
-    (   member(Task, Tasks),
-        between(1, 3, _),
-        once(episode_problem(KB, Task, Smallest, P))
-    ;   world_defines(KB, optimal_steps/3),
-        member(Task, Tasks),
-        member(Size, Sizes), Size =< 5,
-        between(1, 10, _),
-        once(optimal_problem(KB, Task, Size, P))
+    findall(episode(Task, Smallest), ( member(Task, Tasks), between(1, 3, _) ), Episodes),
+    (   world_defines(KB, optimal_steps/3)
+    ->  findall(optimal(Task, Size), ( member(Task, Tasks), member(Size, Sizes), Size =< 5,
+                                       between(1, 10, _) ), Optimal)
+    ;   Optimal = []
+    ),
+    append(Episodes, Optimal, Jobs),
+    run_jobs(Jobs, KB, acc([], [], go), acc(Items0, Seen0, Stop)),
+    (   Stop == go
+    ->  sort(Seen0, Seen),
+        findall(W, never_bound(KB, Seen, W), Ws),
+        Stopped = []
+    ;   Stop == limit
+    ->  check_limit(items, Max),
+        format(string(Msg), "the check stopped after ~D problems and warnings: fix them \c
+                             and check again", [Max]),
+        Ws = [], Stopped = [warning('', 0, Msg)]
+    ;   Ws = [], Stopped = []
+    ),
+    reverse(Items0, Items1),
+    append(Items1, Ws, Items).
+
+%   acc(Items, Seen, Stop): the items kept so far (newest first, one per kind and place),
+%   the legal actions met in the episodes, and go, raised or limit.
+run_jobs([], _, Acc, Acc).
+run_jobs([Job|Jobs], KB, Acc0, Acc) :-
+    Acc0 = acc(Items0, Seen0, Stop0),
+    (   Stop0 \== go
+    ->  Acc = Acc0
+    ;   (   catch(job(Job, KB, Found, Seen1), relrl_rule_error(Goal, Where, E),
+                  ( rule_problem(Goal, Where, E, found(P)), Found = [P], Seen1 = [],
+                    Raised = true ))
+        ->  true
+        ;   Found = [], Seen1 = []
+        ),
+        foldl(keep_item, Found, Items0, Items),
+        append(Seen1, Seen0, Seen),
+        length(Items, N),
+        check_limit(items, Max),
+        (   Raised == true
+        ->  Stop = raised
+        ;   N >= Max
+        ->  Stop = limit
+        ;   Stop = go
+        ),
+        run_jobs(Jobs, KB, acc(Items, Seen, Stop), Acc)
     ).
+
+%   A problem or warning is kept when none of its kind is kept at its place yet.
+keep_item(Item, Items, Out) :-
+    item_place(Item, Place),
+    (   member(Kept, Items),
+        item_place(Kept, Place)
+    ->  Out = Items
+    ;   Out = [Item|Items]
+    ).
+
+item_place(Item, Kind-File-Line) :-
+    functor(Item, Kind, 3),
+    arg(1, Item, File),
+    arg(2, Item, Line).
+
+job(episode(Task, Size), KB, Found, Seen) :-
+    random_episode(KB, Task, Size, Found, Seen).
+job(optimal(Task, Size), KB, Found, []) :-
+    optimal_mismatch(KB, Task, Size, F),
+    found_list(F, Found).
+
+found_list(none, []).
+found_list(found(P), [P]).
 
 sizes(KB, Sizes) :-
     (   declared(KB, sizes(train, S0)), is_list(S0), S0 = [_|_]
@@ -163,31 +251,70 @@ sizes(KB, Sizes) :-
     ;   Sizes = [3]
     ).
 
-%   A problem shown by one episode of random legal actions (fails when it shows none).
-episode_problem(KB, Task, Size, P) :-
-    shown(random_episode(KB, Task, Size), P).
-
-%   call(Check, Found) gives found(P) or none; an error of a world goal is found too.
-shown(Check, P) :-
-    catch(call(Check, Found), relrl_rule_error(Goal, Where, E),
-          rule_problem(Goal, Where, E, Found)),
-    Found = found(P).
-
-random_episode(KB, Task, Size, Found) :-
+%   One episode of random legal actions from a drawn start state: the episode's step bound,
+%   whether its goal is reachable (a breadth-first search), then a walk. Found lists what
+%   it shows; Seen the legal actions of the states it met.
+random_episode(KB, Task, Size, Found, Seen) :-
     world_start(KB, Task, Size, S0, Goal),
-    (   view_problem(KB, Goal, S0, Found)
-    ->  true
-    ;   walk(KB, Goal, S0, 30, Found)
+    world_bound(KB, Goal, S0, _),
+    reachable(KB, Task, Goal, S0, Reach),
+    (   view_problem(KB, Goal, S0, F)
+    ->  Seen = []
+    ;   walk(KB, Goal, S0, 30, [], Seen, F)
+    ),
+    found_list(F, Walked),
+    append(Reach, Walked, Found).
+
+%   An unreachable goal is a problem, a search stopped by its limit a warning, both at the
+%   task's declaration.
+reachable(KB, Task, Goal, S0, Found) :-
+    check_limit(bfs, Limit),
+    world_bfs(KB, Goal, S0, Limit, Steps),
+    (   integer(Steps)
+    ->  Found = []
+    ;   task_where(KB, Task, File, Line),
+        (   Steps == unreachable
+        ->  format(string(Msg), "task ~q: the goal ~q is unreachable from the drawn start \c
+                                 state ~q (a breadth-first search over the world's actions \c
+                                 visited every state reachable from it)", [Task, Goal, S0]),
+            Found = [problem(File, Line, Msg)]
+        ;   format(string(Msg), "task ~q: a breadth-first search stopped at its limit of ~D \c
+                                 states without reaching the goal ~q from the drawn start \c
+                                 state ~q (the goal may be unreachable; relrl learn gives \c
+                                 such an episode no optimum)", [Task, Limit, Goal, S0]),
+            Found = [warning(File, Line, Msg)]
+        )
     ).
 
-walk(KB, Goal, S, N, Found) :-
+task_where(KB, Task, File, Line) :-
+    (   world_clause(KB, task(T), true, Ref),
+        T =@= Task
+    ->  clause_location(Ref, File, Line)
+    ;   File = '', Line = 0
+    ).
+
+%   An action/1 template that no legal action of the checked episodes' states matched.
+never_bound(KB, Seen, warning(File, Line, Msg)) :-
+    world_clause(KB, action(T), true, Ref),
+    callable(T),
+    \+ ( member(A, Seen), subsumes_term(T, A) ),
+    clause_location(Ref, File, Line),
+    copy_term(T, Shown),
+    numbervars(Shown, 0, _, [singletons(true)]),
+    format(string(Msg), "action(~W): precondition/2 bound this template in no state of the \c
+                         checked episodes (a precondition that never holds?)",
+           [Shown, [quoted(true), numbervars(true)]]).
+
+%   Seen0/Seen: the legal actions met, accumulated.
+walk(KB, Goal, S, N, Seen0, Seen, Found) :-
     world_legal(KB, S, As),
+    append(As, Seen0, Seen1),
     (   member(A, As), \+ covered_action(KB, A)
     ->  rule_where(KB, action(_), Where),
         where_file_line(Where, File, Line),
         format(string(Msg), "precondition/2 gave the action ~q, which no action/1 template \c
                              covers", [A]),
-        Found = found(problem(File, Line, Msg))
+        Found = found(problem(File, Line, Msg)), Seen = Seen1
     ;   partial_mismatch(KB, S, As, T, Got, Expected)
     ->  rule_where(KB, precondition(_, _), Where),
         where_file_line(Where, File, Line),
@@ -197,19 +324,19 @@ walk(KB, Goal, S, N, Found) :-
                              it matches are ~q (learners ask with some arguments bound: the \c
                              answer must be the same actions)",
                [Shown, [quoted(true), numbervars(true)], Got, Expected]),
-        Found = found(problem(File, Line, Msg))
+        Found = found(problem(File, Line, Msg)), Seen = Seen1
     ;   N =:= 0
-    ->  Found = none
+    ->  Found = none, Seen = Seen1
     ;   As == []
-    ->  Found = none
+    ->  Found = none, Seen = Seen1
     ;   random_member(A, As),
         world_next(KB, Goal, S, A, S1, outcome(_, Reached)),
         (   view_problem(KB, Goal, S1, Found)
-        ->  true
+        ->  Seen = Seen1
         ;   Reached == true
-        ->  Found = none
+        ->  Found = none, Seen = Seen1
         ;   N1 is N - 1,
-            walk(KB, Goal, S1, N1, Found)
+            walk(KB, Goal, S1, N1, Seen1, Seen, Found)
         )
     ).
 
@@ -260,8 +387,20 @@ rule_problem(Goal, Where, E, found(problem(File, Line, Msg))) :-
     where_file_line(Where, File, Line),
     (   E = error(domain_error(world_vocabulary, Text), _)
     ->  Msg = Text
-    ;   message_to_codes(E, Text),
+    ;   E = error(resource_error(Resource), _)
+    ->  format(string(Msg), "~q ran out of ~w (a recursion without end?)", [Goal, Resource])
+    ;   message_to_codes(E, Codes),
+        first_line(Codes, Text),
         format(string(Msg), "~q raised: ~s", [Goal, Text])
+    ).
+
+%   A message's first line that holds text: a problem is one line.
+first_line(Codes, Line) :-
+    split_string(Codes, "\n", " \t", Lines),
+    (   member(Line, Lines),
+        Line \== ""
+    ->  true
+    ;   Line = ""
     ).
 
 message_to_codes(E, Codes) :-
@@ -275,14 +414,11 @@ where_file_line(Where, File, Line) :-
     ).
 
 %   optimal_steps/3 against a breadth-first search on one random start state.
-optimal_problem(KB, Task, Size, P) :-
-    shown(optimal_mismatch(KB, Task, Size), P).
-
 optimal_mismatch(KB, Task, Size, Found) :-
     world_start(KB, Task, Size, S, Goal),
     world_optimal(KB, Goal, S, 0, Declared),
     world_bfs(KB, Goal, S, 50000, Searched),
-    (   Searched \== none,
+    (   integer(Searched),
         Declared \== Searched
     ->  rule_where(KB, optimal_steps(_, _, _), Where),
         where_file_line(Where, File, Line),

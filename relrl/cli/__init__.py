@@ -37,6 +37,7 @@ SUBCOMMANDS: dict[str, str] = {
     "tree": "relrl.cli.tree",
     "report": "relrl.cli.report",
     "learn": "relrl.cli.learn",
+    "evaluate": "relrl.cli.evaluate",
 }
 
 

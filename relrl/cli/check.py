@@ -129,7 +129,7 @@ def _check_world(args: argparse.Namespace) -> int:
         _print_problems(_load_problems(exc))
         return 2
     with world:
-        problems = world.problems()
+        problems, warnings = world.check()
         if not args.quiet:
             print(f"tasks: {', '.join(world.task_names())}")
             print(f"actions: {', '.join(_text(a) for a in world.actions)}")
@@ -141,7 +141,7 @@ def _check_world(args: argparse.Namespace) -> int:
             print(f"optimal steps: {optimal}")
             if world.discount is not None:
                 print(f"discount: {world.discount:g}")
-        for warning in bias_warnings(world.kb):
+        for warning in [*bias_warnings(world.kb), *warnings]:
             print(warning, file=sys.stderr)
         if problems:
             _print_problems(problems)

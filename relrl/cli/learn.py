@@ -103,9 +103,10 @@ def run(args: argparse.Namespace) -> int:
     make_world_learner(args.learner, **dict(args.param))          # validate before loading
     with World(path) as world:
         problems = world.problems()
+        if len(problems) == 1:
+            raise ConfigError(f"{problems[0]} (relrl check --world {args.world})")
         if problems:
-            raise ConfigError("\n".join([*problems, f"{len(problems)} problem"
-                                         f"{'s' if len(problems) != 1 else ''} in the world "
+            raise ConfigError("\n".join([*problems, f"{len(problems)} problems in the world "
                                          f"(relrl check --world {args.world})"]))
         task_text = args.task or world.task_names()[0].split("(")[0]
         world.task(task_text)                                     # validate now
@@ -137,8 +138,8 @@ def run(args: argparse.Namespace) -> int:
     def show(event: dict) -> None:
         e = event["entry"]
         print(f"episodes {e['episodes']:6d}  steps {e['learning_steps']:7d}  of optimal "
-              f"{e['optimality']:.3f}  reached {e['success']:.3f}  positions "
-              f"{e['memory_positions']}", flush=True)
+              f"{_of(e['optimality'])}  reached {e['success']:.3f}  positions "
+              f"{e['memory_positions']}{_unreachable(e)}", flush=True)
 
     print(f"{args.learner} learns {task_text} on sizes {','.join(map(str, train))} "
           f"({args.episodes} episodes, seed {args.seed}); greedy evaluation of "
@@ -187,11 +188,25 @@ def _live_monitor(address: str | None, config: Any) -> Iterator[Any]:
         server.close()
 
 
+def _of(value: float | None, spec: str = ".3f") -> str:
+    """A figure, or ``-`` when there is none (no episode with a known optimum)."""
+    return "-" if value is None else format(value, spec)
+
+
+def _unreachable(score: dict) -> str:
+    """A note of the episodes whose goal a search proved unreachable (no optimum, not
+    scored), or nothing."""
+    n = score.get("unreachable") or 0
+    return f"  ({n} episode{'s' if n != 1 else ''} with an unreachable goal: no optimum)" \
+        if n else ""
+
+
 def _summary(result: dict, t: dict) -> None:
     print("evaluation, no further learning:")
     for size, s in result["test"].items():
-        print(f"  size {size:>3}: of optimal {s['optimality']:.3f}, reached {s['success']:.3f}, "
-              f"steps {s['steps']:.2f} (optimal {s['optimal_steps']:.2f})")
+        print(f"  size {size:>3}: of optimal {_of(s['optimality'])}, reached "
+              f"{s['success']:.3f}, steps {s['steps']:.2f} (optimal "
+              f"{_of(s['optimal_steps'], '.2f')}){_unreachable(s)}")
     if t.get("learning_steps_per_second"):
         print(f"learning: {t['learning_steps_per_second']:,.0f} steps/s (a batch of episodes "
               f"per crossing)")

@@ -4,7 +4,10 @@
 experiment worlds``: a learner learns ``episodes`` episodes of a task on the training sizes,
 in blocks of ``block`` episodes; after each block the greedy policy (no learning, no
 exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the end
-on each test size — where the policy acts with no further learning. Every evaluation
+on each test size — where the policy acts with no further learning. Evaluation draws its
+start states from a random stream of its own, seeded from the run's seed and the evaluation
+point (:func:`evaluation_seed`), and learning from the learner's stream alone: the learned
+policy is the same whatever ``eval_episodes``, the test sizes and ``block`` are. Every evaluation
 episode's optimal number of steps comes from the world (optimal_steps/3, else a
 breadth-first search), so a score is a fraction of optimal: optimal / steps per episode, 0
 for an episode that missed the goal within the step bound (RRL's "percentage of optimal").
@@ -18,6 +21,7 @@ per crossing against a batch per crossing (the shape: how much the crossings cos
 
 from __future__ import annotations
 
+import hashlib
 import tempfile
 import time
 from collections.abc import Callable, Sequence
@@ -27,7 +31,7 @@ from typing import Any
 
 from relrl.worlds.world import World, score
 
-__all__ = ["LearnConfig", "learn_task", "step_cost_by_size"]
+__all__ = ["LearnConfig", "evaluation_seed", "learn_task", "step_cost_by_size"]
 
 
 @dataclass
@@ -85,7 +89,8 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
 
         def evaluate() -> None:
             eps = world.episodes(task, config.train_sizes, config.eval_episodes, "greedy",
-                                 optimal=True, trace=monitor is not None)
+                                 optimal=True, trace=monitor is not None,
+                                 seed=evaluation_seed(config.seed, f"point {len(curve)}"))
             ev = score(eps)
             positions, details = world.size()
             entry = {"point": len(curve), **ev, "eval_episodes": ev["episodes"],
@@ -121,7 +126,8 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
                            + ", ".join(map(str, config.test_sizes)))
         for size in config.test_sizes:
             eps = world.episodes(task, [size], config.eval_episodes, "greedy", optimal=True,
-                                 trace=traces > 0)
+                                 trace=traces > 0,
+                                 seed=evaluation_seed(config.seed, f"size {size}"))
             test[str(size)] = score(eps)
             if traces:
                 kept[str(size)] = [{"goal": e.goal, "steps": e.steps, "optimal": e.optimal,
@@ -153,6 +159,15 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
         return out
 
 
+def evaluation_seed(seed: int, point: str) -> int:
+    """The seed of an evaluation's own random stream: a hash of the run's ``seed`` and the
+    evaluation ``point`` (``point 3``, ``size 50``), so every evaluation draws the same
+    start states whatever was learned or evaluated before it, and none draws from the
+    learner's stream (as Gymnasium's seeded ``reset``)."""
+    digest = hashlib.sha256(f"relrl evaluation {seed} {point}".encode()).digest()
+    return int.from_bytes(digest[:6], "big")
+
+
 def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str, Any],
                    eps: Sequence[Any]) -> None:
     """Give the live monitor one evaluation: a point of its plot (the fraction of optimal at
@@ -167,7 +182,8 @@ def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str,
         rows = step_rows({"goal": ep.goal, "steps": ep.steps, "optimal": ep.optimal,
                           "trace": ep.trace}, world=Path(config.world).name, size=ep.size,
                          label=f"greedy after {entry['episodes']} episodes "
-                               f"(of optimal {entry['optimality']:.3f})",
+                               + (f"(of optimal {entry['optimality']:.3f})"
+                                  if entry["optimality"] is not None else "(no optimum)"),
                          t0=entry["episodes"])
         if rows:
             hub.publish(rows[-1])

@@ -38,13 +38,14 @@ BFS_LIMIT = 20_000
 class Episode:
     """One episode of a world (``relrl_world:world_episodes/3``)."""
 
-    size: int                  #: the number of objects
+    size: int | None           #: the number of objects (None: a given start state)
     goal: str                  #: the episode's goal, as Prolog text
     steps: int                 #: actions taken
     reward: float              #: the sum of rewards
     reached: bool              #: the goal held at the end
     optimal: int | None        #: the least number of actions to the goal (when asked)
     trace: tuple[dict[str, Any], ...] = ()   #: each step's state and action (when asked)
+    unreachable: bool = False  #: a search proved the goal unreachable (optimal is None)
 
     @property
     def optimality(self) -> float | None:
@@ -59,11 +60,14 @@ class Episode:
 def score(episodes: Sequence[Episode]) -> dict[str, Any]:
     """Success rate, mean optimality (optimal / steps, 0 for a failure: RRL's "of optimal
     steps"), the share of episodes solved in exactly the optimal number of steps, mean steps
-    and mean optimal steps, over ``episodes``."""
+    and mean optimal steps, over ``episodes``. An episode whose optimum is unknown (a search
+    stopped by its limit) or that has none (``unreachable``: a search proved its goal
+    unreachable) counts in the success rate, not in the optimality; ``unreachable`` counts
+    the latter."""
     n = len(episodes)
     if not n:
         return {"episodes": 0, "success": None, "optimality": None, "exactly_optimal": None,
-                "steps": None, "optimal_steps": None}
+                "steps": None, "optimal_steps": None, "unreachable": 0}
     opt = [e.optimality for e in episodes]
     known = [o for o in opt if o is not None]
     return {"episodes": n,
@@ -73,7 +77,8 @@ def score(episodes: Sequence[Episode]) -> dict[str, Any]:
                                     and e.steps == e.optimal) / len(known)) if known else None,
             "steps": sum(e.steps for e in episodes) / n,
             "optimal_steps": (sum(e.optimal for e in episodes if e.optimal is not None)
-                              / len(known)) if known else None}
+                              / len(known)) if known else None,
+            "unreachable": sum(e.unreachable for e in episodes)}
 
 
 class World:
@@ -113,11 +118,22 @@ class World:
     def problems(self) -> list[str]:
         """One ``file:line: problem`` line per problem of the world (prolog/world_check.pl);
         empty when it is valid."""
-        lines = []
-        for _, path, line, message in one(self.kb, "world_check", self.kb.module):
-            where = f"{_display_path(path)}:{line}" if path else _display_path(str(self.path))
-            lines.append(f"{where}: {message}")
-        return lines
+        return self.check()[0]
+
+    def check(self) -> tuple[list[str], list[str]]:
+        """The world's problems and its warnings (a search stopped by its limit, an action
+        template never bound ...), one ``file:line: text`` line each
+        (prolog/world_check.pl)."""
+        problems: list[str] = []
+        warnings: list[str] = []
+        for kind, path, line, message in one(self.kb, "world_check", self.kb.module):
+            where = (f"{_display_path(path)}:{line}" if path
+                     else _display_path(str(self.path)))
+            if kind == "warning":
+                warnings.append(f"{where}: warning: {message}")
+            else:
+                problems.append(f"{where}: {message}")
+        return problems, warnings
 
     def task_names(self) -> list[str]:
         """The declared tasks as text (``stack``, ``on(_, _)``)."""
@@ -174,7 +190,8 @@ class World:
 
     def episodes(self, task: Term | str, sizes: Sequence[int], count: int, mode: str = "learn",
                  *, optimal: bool = False, trace: bool = False,
-                 updates: str = "episode") -> list[Episode]:
+                 updates: str = "episode", seed: int | None = None,
+                 actions: bool = False) -> list[Episode]:
         """Run ``count`` episodes in one crossing into Prolog.
 
         Args:
@@ -188,14 +205,51 @@ class World:
             trace: keep each step's state and action.
             updates: ``episode`` (the episode's examples given to the learner when it ends,
                 last first: RRL's) or ``online`` (each step's at once).
+            seed: draw the batch from a random stream of its own seeded with ``seed`` and
+                leave the learner's stream as it was (an evaluation that never moves
+                learning); None: the learner's stream.
+            actions: without ``trace``, keep each step's action alone (its state empty): an
+                answer a few bytes a step, whatever the size of the world.
         """
         if self.learner_name is None:
             raise ConfigError("attach a learner before running episodes")
         options = [("updates", updates), ("optimal", BFS_LIMIT if optimal else 0),
-                   ("trace", "true" if trace else "false")]
+                   ("trace", _trace(trace, actions))]
+        if seed is not None:
+            options.append(("random", int(seed)))
         spec = ("episodes", self._task(task), [int(s) for s in sizes], int(count), mode,
                 options)
         raw = one(self.kb, "world_episodes", self.kb.module, spec)
+        return [_episode(e) for e in raw]
+
+    def episodes_from(self, task: Term | str, starts: Sequence[tuple[list[Term], Term | None]],
+                      mode: str = "greedy", *, optimal: bool = False, trace: bool = False,
+                      seed: int | None = None, actions: bool = False) -> list[Episode]:
+        """One episode from each start state, in one crossing (:meth:`episodes`' options).
+
+        Args:
+            task: a task (:meth:`task`, or its text).
+            starts: ``(facts, instance)`` pairs: a start state's facts, and the episode's task
+                (an instance of ``task``) or None for ``task`` itself (its goal drawn when
+                it leaves one open, task_goal/3).
+            mode: ``greedy``, ``explore`` or ``learn``.
+            optimal: compute each episode's optimal number of steps.
+            trace: keep each step's state and action.
+            seed: draw from a stream of the batch's own (see :meth:`episodes`).
+            actions: keep each step's action alone (see :meth:`episodes`).
+
+        An episode's ``size`` is None: the state gives it, not a draw.
+        """
+        if self.learner_name is None:
+            raise ConfigError("attach a learner before running episodes")
+        options: list[tuple[str, Any]] = [("optimal", BFS_LIMIT if optimal else 0),
+                                          ("trace", _trace(trace, actions))]
+        if seed is not None:
+            options.append(("random", int(seed)))
+        spec = ("from", self._task(task),
+                [("start", list(facts), "none" if inst is None else inst)
+                 for facts, inst in starts], mode, options)
+        raw = one(self.kb, "world_episodes_from", self.kb.module, spec)
         return [_episode(e) for e in raw]
 
     def verify_optimal(self, task: Term | str, size: int, count: int
@@ -236,6 +290,10 @@ class World:
         self.close()
 
 
+def _trace(trace: bool, actions: bool) -> str:
+    return "true" if trace else "actions" if actions else "false"
+
+
 def _int(x: Term) -> int | None:
     return x if isinstance(x, int) else None
 
@@ -258,6 +316,8 @@ def _episode(raw: Term) -> Episode:
         else:
             steps_out.append({"state": [format_term(f) for f in item[1]], "action": None,
                               "reward": None})
-    return Episode(size=size, goal=format_term(goal), steps=steps, reward=float(reward),
-                   reached=reached == "true", optimal=_int(optimal), trace=tuple(steps_out))
+    return Episode(size=None if size == "none" else size, goal=format_term(goal),
+                   steps=steps, reward=float(reward), reached=reached == "true",
+                   optimal=_int(optimal), trace=tuple(steps_out),
+                   unreachable=optimal == "unreachable")
 

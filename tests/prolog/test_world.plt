@@ -10,6 +10,7 @@
 :- use_module('../../prolog/gateway').
 :- use_module('../../prolog/world').
 :- use_module('../../prolog/world_check').
+:- use_module('../../prolog/world_states').
 
 root_file(Relative, Path) :-
     module_property(relrl, file(RelrlFile)),
@@ -138,7 +139,8 @@ test(precondition_for_open_templates_only, [Line == 4]) :-
              "precondition(go(X, Y), S) :- ( nonvar(Y) -> member(F, S), arg(1, F, X) ; member(p(X), S), member(q(Y), S) ).",
              "effect(go(_, _), _, [], []).", "goal(t, _) :- fail."],
             KB, Path),
-    world_problems(KB, [problem(Path, Line, Msg)]),
+    world_problems(KB, Ps),                 % and its goal is unreachable
+    member(problem(Path, Line, Msg), Ps),
     once(sub_string(Msg, _, _, _, "precondition/2 called with go(_,b) gives [go(a,b),go(b,b),go(c,b)]")).
 
 test(effect_not_a_list, [Line == 5]) :-
@@ -153,7 +155,8 @@ test(undeclared_relation, [Msg == "the learner's view holds q(a), but no relatio
              "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
              "goal(t, _) :- fail.", "relation(p(_))."],
             KB, _),
-    world_problems(KB, [problem(_, 7, Msg)]).
+    world_problems(KB, Ps),                 % and its goal is unreachable
+    memberchk(problem(_, 7, Msg), Ps).
 
 test(wrong_optimal_steps, [Line == 10]) :-
     text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(inc).",
@@ -186,6 +189,78 @@ test(own_bias_without_an_action_test, [Msg == "task_own_bias(t): its bias would 
              "task_own_bias(t)."],
             KB, _),
     world_problems(KB, [problem(_, 9, Msg)]).
+
+test(unreachable_goal, [Line-Msg == 2-"task t: the goal t is unreachable from the drawn start state [at(0)] (a breadth-first search over the world's actions visited every state reachable from it)"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(5), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]).
+
+test(search_stopped_by_its_limit, [Line-Limit == 2-20000]) :-
+    % the states at(0), at(1) ... never end: no search proves at(-1) unreachable
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(-1), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [warning(Path, Line, Msg)]),
+    relrl_world_check:check_limit(bfs, Limit),
+    once(sub_string(Msg, _, _, _, "stopped at its limit of 20,000 states")).
+
+test(action_never_bound, [Line-Msg == 4-"action(jump(_)): precondition/2 bound this template in no state of the checked episodes (a precondition that never holds?)"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "action(jump(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "precondition(jump(X), S) :- memberchk(at(99), S), X = 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "effect(jump(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_))."],
+            KB, Path),
+    world_problems(KB, [warning(Path, Line, Msg)]).
+
+test(one_problem_for_every_task, [Line == 206]) :-
+    % every task's goal raises the same error: one problem, and the run stops there
+    numlist(1, 200, Is),
+    findall(L, ( member(I, Is), format(atom(L), "task(t(~w)).", [I]) ), Tasks),
+    append([["initial_state(_, [at(0)])."], Tasks,
+            ["action(go(_)).", "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "relation(at(_)).", "goal(t(_), S) :- atom_length(S, _)."]], Lines),
+    text_kb(Lines, KB, Path),
+    world_problems(KB, [problem(Path, Line, Msg)]),
+    once(sub_string(Msg, 0, _, _, "goal(t(1),[at(0)]) raised: atom_length/2: Type error")).
+
+test(at_most_ten_unreachable_tasks, [N == 11]) :-
+    numlist(1, 200, Is),
+    findall(L, ( member(I, Is), format(atom(L), "task(t(~w)).", [I]) ), Tasks),
+    append([["initial_state(_, [at(0)])."], Tasks,
+            ["action(go(_)).", "precondition(go(1), S) :- memberchk(at(0), S).",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "relation(at(_)).", "goal(t(_), S) :- memberchk(at(5), S)."]], Lines),
+    text_kb(Lines, KB, _),
+    world_problems(KB, Ps),
+    length(Ps, N),
+    last(Ps, warning('', 0, _)).
+
+test(reward_not_finite, [Msg == "reward/5 gave 1.5NaN for the action go(1): a reward must be a finite number of magnitude at most 1e+06"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_)).",
+             "reward(_, _, _, _, R) :- R is nan."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
+
+test(step_bound_not_a_positive_integer, [Msg == "step_bound/3 gave foo for t: it must give a positive integer"]) :-
+    text_kb(["initial_state(_, [at(0)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- memberchk(at(Y), S), Y < 3, X is Y + 1.",
+             "effect(go(X), S, [at(Y)], [at(X)]) :- memberchk(at(Y), S).",
+             "goal(t, S) :- memberchk(at(3), S).", "relation(at(_)).",
+             "step_bound(_, _, foo)."],
+            KB, _),
+    world_problems(KB, [problem(_, 8, Msg)]).
 
 :- end_tests(world_check).
 
@@ -467,3 +542,85 @@ test(boltzmann_draw_is_boltzmann_over_the_moves) :-
     assertion(TV < 0.05).
 
 :- end_tests(world_exploration).
+
+:- begin_tests(world_given_states).
+
+qtable_kb(KB, Seed) :-
+    world_kb('examples/worlds/blocks.pl', KB),
+    relrl_engine:engine_configure(KB, qtable, [alpha=0.5, gamma=1, epsilon=0.1,
+                                               temperature=0, q_init=0], Seed).
+
+states_file(Lines, Path) :-
+    tmp_file_stream(text, Path, S),
+    forall(member(L, Lines), format(S, "~w~n", [L])),
+    close(S).
+
+test(seeded_batch_leaves_the_learners_stream, [A == B]) :-
+    qtable_kb(KB1, 3),
+    world_episodes(KB1, episodes(stack, [3, 4], 7, greedy, [random(11)]), _),
+    world_episodes(KB1, episodes(stack, [3, 4], 20, learn, []), A),
+    qtable_kb(KB2, 3),
+    world_episodes(KB2, episodes(stack, [3, 4], 20, learn, []), B).
+
+test(seeded_batch_same_start_states, [G1 == G2]) :-
+    qtable_kb(KB1, 3),
+    world_episodes(KB1, episodes(on(_, _), [4], 5, greedy, [random(11)]), E1),
+    qtable_kb(KB2, 8),
+    world_episodes(KB2, episodes(on(_, _), [4], 30, learn, []), _),
+    world_episodes(KB2, episodes(on(_, _), [4], 5, greedy, [random(11)]), E2),
+    findall(G, member(ep(_, G, _, _, _, _, _), E1), G1),
+    findall(G, member(ep(_, G, _, _, _, _, _), E2), G2).
+
+test(given_states_known_optima, [Optima-Goals == [1, 2, 0, 2]-[stack, stack, stack, on(b1, b2)]]) :-
+    qtable_kb(KB, 0),
+    towers([[b1], [b2]], S1),
+    towers([[b1], [b2], [b3]], S2),
+    towers([[b1, b2]], S3),
+    towers([[b1, b2]], S4),                             % b2 on b1: two moves to on(b1, b2)
+    world_episodes_from(KB, from(stack, [start(S1, none), start(S2, none), start(S3, none)],
+                                 greedy, [optimal(1000)]), Eps1),
+    world_episodes_from(KB, from(on(_, _), [start(S4, on(b1, b2))], greedy,
+                                 [optimal(1000)]), Eps2),
+    append(Eps1, Eps2, Eps),
+    findall(O, member(ep(none, _, _, _, _, O, _), Eps), Optima),
+    findall(G, member(ep(none, G, _, _, _, _, _), Eps), Goals).
+
+test(read_states, [States == [state(2, [on(b1, floor), clear(b1)], none),
+                              state(3, [on(b1, floor), on(b2, floor), clear(b1), clear(b2)],
+                                    on(b1, b2))]]) :-
+    blocks(KB),
+    states_file(["% two states", "[on(b1, floor), clear(b1)].",
+                 "state([on(b1, floor), on(b2, floor), clear(b1), clear(b2)], on(b1, b2))."],
+                Path),
+    world_read_states(KB, Path, on(_, _), states(States)).
+
+test(states_syntax_error, [Line == 2]) :-
+    blocks(KB),
+    states_file(["[on(b1, floor), clear(b1)].", "[on(b1 floor)]."], Path),
+    world_read_states(KB, Path, stack, problem(Line, _)).
+
+test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_on/2,highest/1,on/2])"]) :-
+    blocks(KB),
+    states_file(["[on(b1, floor), clear(b1)].", "", "[on(b1, floor), fly(b1)]."], Path),
+    world_read_states(KB, Path, stack, problem(Line, Msg)).
+
+test(states_directive_is_data, [Line == 1]) :-
+    blocks(KB),
+    states_file([":- throw(ran)."], Path),
+    world_read_states(KB, Path, stack, problem(Line, _)).
+
+test(trace_of_actions_only, [States-Last == [[]]-[]]) :-
+    % the actions alone cross back: a few bytes a step, whatever the world's size
+    qtable_kb(KB, 1),
+    world_episodes(KB, episodes(unstack, [6], 1, greedy, [trace(actions)]),
+                   [ep(_, _, Steps, _, _, _, Trace)]),
+    length(Trace, Steps),
+    findall(S, member(step(S, _, _), Trace), States0),
+    sort(States0, States),
+    exclude([X]>>(X = step(_, _, _)), Trace, Last).
+
+test(state_texts, [Answer == facts([on(b1, floor), clear(b1)])]) :-
+    blocks(KB),
+    world_state_texts(KB, ["on(b1, floor)", "clear(b1)"], stack, Answer).
+
+:- end_tests(world_given_states).

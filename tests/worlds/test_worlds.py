@@ -189,3 +189,50 @@ def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
                  "--overwrite"]) == 2
     assert "link" in capsys.readouterr().err
     assert victim.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("learner", ["tg", "qtable"])
+def test_evaluation_never_moves_learning(tmp_path: Path, learner: str) -> None:
+    """The learned policy.pl is byte-identical whatever --eval-episodes, --eval-sizes,
+    --block and --traces are: evaluation draws from a random stream of its own."""
+    common = ["learn", str(BLOCKS), "--task", "stack", "--learner", learner, "--sizes", "3,4",
+              "--episodes", "60", "--seed", "5", "--no-speed"]
+    runs = {"a": ["--eval-episodes", "2", "--eval-sizes", "4", "--block", "30",
+                  "--traces", "0"],
+            "b": ["--eval-episodes", "7", "--eval-sizes", "5,6", "--block", "20",
+                  "--traces", "2"]}
+    policies = {}
+    for name, flags in runs.items():
+        out = tmp_path / name
+        assert main([*common, *flags, "--out", str(out)]) == 0
+        policies[name] = (out / "policy.pl").read_bytes()
+    assert policies["a"] == policies["b"]
+
+
+def test_evaluation_draws_the_same_states_whatever_was_learned() -> None:
+    """An evaluation point's start states depend on the run's seed and the point only."""
+    from relrl.worlds.learn import evaluation_seed
+
+    def goals(learned: int) -> list[str]:
+        with World(BLOCKS) as world:
+            world.attach(world.learner("tg"), seed=2)
+            world.episodes("on", [3], learned, "learn")
+            eps = world.episodes("on", [4], 5, "greedy", seed=evaluation_seed(2, "size 4"))
+            return [e.goal for e in eps]
+
+    assert goals(0) == goals(25)
+    assert evaluation_seed(2, "size 4") != evaluation_seed(3, "size 4")
+
+
+def test_experiment_worlds_policies_do_not_depend_on_evaluation(tmp_path: Path) -> None:
+    """relrl experiment worlds learns the same policies whatever its evaluation flags."""
+    common = ["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "on",
+              "--learners", "tg", "--seeds", "1", "--episodes", "40", "--sizes", "3,4",
+              "--workers", "1"]
+    texts = []
+    for name, flags in {"a": ["--block", "20", "--eval-episodes", "2", "--test-sizes", "4"],
+                        "b": ["--block", "10", "--eval-episodes", "6",
+                              "--test-sizes", "5,6"]}.items():
+        assert main([*common, *flags, "--out", str(tmp_path / name)]) == 0
+        texts.append((tmp_path / name / "policies" / "blocks-on-tg-s1.pl").read_bytes())
+    assert texts[0] == texts[1]
