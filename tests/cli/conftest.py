@@ -94,6 +94,7 @@ def corpus(tmp_path_factory) -> Path:
         (d / name).write_text(text)
     hostile_policies(d)
     hostile_tomls(d)
+    hostile_runs(d)
     head = (ROOT / "examples" / "heads" / "wha8030.toml").read_text()
     (d / "nul_scripts.toml").write_text(
         head.replace("[head]\n", '[head]\nscripts = "more\\u0000.toml"\n', 1))
@@ -104,6 +105,57 @@ def corpus(tmp_path_factory) -> Path:
     run_episode(parse_episode(episode_text(steps=30), d / "tree.toml"),
                 RunOptions(out=d / "tree-run", plots=False))
     return d
+
+
+def small_results(name: str) -> dict:
+    """A shipped run's results.json with its lists cut to two items and its jobs and
+    resolved settings left out (what no view renders): the same shape, small enough to write
+    many times."""
+    import json
+
+    unread = ("jobs", "worlds", "caregiver_resolved", "eval_caregiver_resolved")
+
+    def cut(value):
+        if isinstance(value, dict):
+            return {k: cut(v) for k, v in value.items() if k not in unread}
+        if isinstance(value, list):
+            return [cut(v) for v in value[:2]] if len(value) > 2 else [cut(v) for v in value]
+        return value
+
+    return cut(json.loads((ROOT / "docs" / "results" / name / "results.json").read_text()))
+
+
+def hostile_runs(d: Path) -> None:
+    """Run folders and Markdown files for ``relrl report``: a results.json with no config,
+    an experiment relrl does not render, block markers leading out of the document's tree
+    (``..``, an absolute path, a link), and names that are HTML."""
+    import json
+
+    def run(name: str, results: dict, records: dict | None = None) -> None:
+        (d / name).mkdir()
+        for file, data in {"results.json": results, **(records or {})}.items():
+            (d / name / file).write_text(json.dumps(data))
+
+    sis = small_results("exp1")
+    run("run_no_config", {k: v for k, v in sis.items() if k != "config"})
+    run("run_points_text", {**sis, "config": {**sis["config"], "points": "20"}})
+    run("run_unknown_kind", {"experiment": "nope", "summary": {}})
+    evil = "<script>alert(1)</script>"
+    worlds = small_results("worlds")
+    worlds["summary"][0]["task"] = f"{evil}|<img src=x onerror=alert(1)>\n# heading"
+    run("run_html", worlds, {".relrl-run.json": {
+        "command": "relrl `x` <!-- /relrl-report -->\n| a |"}})
+    (d / "run_html" / "f) ![x](javascript:alert(1).png").write_bytes(b"")
+    docs = {"md_traversal.md": "../../../../etc", "md_absolute.md": "/etc",
+            "md_link.md": "linked_run", "md_results_link.md": "run_results_link",
+            "md_space.md": "a-->b"}
+    for name, path in docs.items():
+        (d / name).write_text(f"# doc\n\n<!-- relrl-report {path} summary -->\n"
+                              "<!-- /relrl-report -->\n")
+    (d / "linked_run").symlink_to(ROOT / "docs" / "results" / "exp1")
+    (d / "run_results_link").mkdir()
+    (d / "run_results_link" / "results.json").symlink_to(
+        ROOT / "docs" / "results" / "exp1" / "results.json")
 
 
 def hostile_tomls(d: Path) -> None:

@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 231 cases: 165 bad inputs in ``CASES`` and 23 more tests here, 26 in
+The corpus holds 247 cases: 174 bad inputs in ``CASES`` and 30 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -285,6 +285,24 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("report-random-bytes", ["report", "{d}/random.toml"], ["random.toml", "run folder"]),
     ("report-missing-markdown", ["report", "--check", "{d}/nope.md"], ["nope.md"]),
     ("report-out-dir", ["report", "{d}/adir", "--out", "{d}/adir"], ["adir"]),
+    ("report-no-config", ["report", "{d}/run_no_config"],
+     ["run_no_config/results.json", "no config"]),
+    ("report-points-a-string", ["report", "{d}/run_points_text"],
+     ["run_points_text/results.json", 'config.points is "20" (a string)', "an integer"]),
+    ("report-unknown-experiment", ["report", "{d}/run_unknown_kind"],
+     ["run_unknown_kind/results.json", '"nope"', "not one relrl report renders"]),
+    ("report-marker-traversal", ["report", "--check", "{d}/md_traversal.md"],
+     ["md_traversal.md:3", "../../../../etc", "leads outside"]),
+    ("report-marker-absolute", ["report", "--update", "{d}/md_absolute.md"],
+     ["md_absolute.md:3", "'/etc'", "relative path"]),
+    ("report-marker-link-out", ["report", "--check", "{d}/md_link.md"],
+     ["md_link.md:3", "linked_run", "leads outside"]),
+    ("report-marker-results-link-out", ["report", "--check", "{d}/md_results_link.md"],
+     ["md_results_link.md:3", "run_results_link/results.json", "leads outside"]),
+    ("report-marker-ends-the-comment", ["report", "--check", "{d}/md_space.md"],
+     ["md_space.md:3", "a-->b", "cannot be named in a block"]),
+    ("report-root-missing", ["report", "--check", "{d}/md_space.md", "--root", "{d}/nope"],
+     ["--root", "nope", "no such folder"]),
 ]
 
 
@@ -294,6 +312,77 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
     needles = [n.format(d=corpus) for n in needles]
     one_line_exit_2(capsys, argv, *needles)
+
+
+def test_report_renders_html_and_markdown_in_a_run_as_text(capsys, corpus):
+    """Names and commands from a run are shown as the characters they are: no HTML tag, no
+    table column or line of their own, no block end, no link with a scheme."""
+    from relrl.report import BLOCK
+
+    assert main(["report", str(corpus / "run_html"), "--out", str(corpus / "html.md")]) == 0
+    page = (corpus / "html.md").read_text()
+    ours = re.compile(r"<!-- /?relrl-report[^\n]*-->$")
+    body = "\n".join(line for line in page.splitlines() if not ours.fullmatch(line))
+    assert re.findall(r"(?<!\\)[<>]", body) == [] and "\n# heading" not in page
+    assert ("\\<script\\>alert(1)\\</script\\>\\|\\<img src=x onerror=alert(1)\\> "
+            "\\# heading") in page
+    assert "made by relrl \\`x\\` \\<\\!-- /relrl-report --\\> \\| a \\| on" in page
+    assert "](./run_html/f%29%20%21%5Bx%5D%28javascript%3Aalert%281%29.png)" in page
+    blocks = list(BLOCK.finditer(page))
+    assert [b["view"] for b in blocks] == ["summary", "cost"]
+    rows = [line for line in blocks[0]["body"].splitlines() if line.startswith("|")]
+    assert any("alert(1)" in line for line in rows)
+    assert len({len(re.findall(r"(?<!\\)\|", line)) for line in rows}) == 1  # same columns
+    assert all(b["body"].rstrip().endswith(".*") for b in blocks)  # each ends at its own end
+    assert main(["report", "--check", str(corpus / "html.md")]) == 0
+
+
+def _paths(value, path=()):
+    """Every key path of a JSON value (a list's first item only)."""
+    yield path
+    items = (value.items() if isinstance(value, dict)
+             else [(0, value[0])] if value and isinstance(value, list) else [])
+    for key, inner in items:
+        yield from _paths(inner, (*path, key))
+
+
+@pytest.mark.parametrize("name", ["exp1", "exp2", "bench", "worlds", "scaling", "transfer"])
+def test_report_on_a_results_json_with_a_key_missing_or_of_another_type(tmp_path, name):
+    """Every key of a shipped run's results.json taken out, or made a string, null or a
+    list, in turn: each view renders, or says in one line which file and key
+    is wrong (the run is checked once, when loaded); never a traceback."""
+    import json
+
+    from relrl.errors import UserError
+    from relrl.report import VIEWS, load_run, render
+    from tests.cli.conftest import small_results
+
+    results = small_results(name)
+    whole = json.dumps(results)
+    views = [v for kind, v in VIEWS if kind == results["experiment"]]
+    refused = 0
+    for path in list(_paths(results))[1:]:
+        for swap in ("missing", "20", None, []):
+            data = json.loads(whole)
+            *up, last = path
+            parent = data
+            for key in up:
+                parent = parent[key]
+            if swap == "missing":
+                if isinstance(parent, list):
+                    continue
+                del parent[last]
+            else:
+                parent[last] = swap
+            (tmp_path / "results.json").write_text(json.dumps(data))
+            try:
+                run = load_run(tmp_path)
+                for v in views:
+                    render(run, v)
+            except UserError as exc:
+                assert "\n" not in str(exc) and str(exc).startswith(str(tmp_path)), exc
+                refused += 1
+    assert refused > 0
 
 
 def test_every_subcommand_is_in_the_corpus():
