@@ -140,6 +140,9 @@ def hostile_runs(d: Path) -> None:
     run("run_no_config", {k: v for k, v in sis.items() if k != "config"})
     run("run_points_text", {**sis, "config": {**sis["config"], "points": "20"}})
     run("run_unknown_kind", {"experiment": "nope", "summary": {}})
+    for name, config in {"points_float": {"points": 2.5}, "points_true": {"points": True},
+                         "sizes_text": {"sizes": [5, "9"]}}.items():
+        (d / f"config_{name}.json").write_text(json.dumps(config))
     evil = "<script>alert(1)</script>"
     worlds = small_results("worlds")
     worlds["summary"][0]["task"] = f"{evil}|<img src=x onerror=alert(1)>\n# heading"

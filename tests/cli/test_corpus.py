@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 247 cases: 174 bad inputs in ``CASES`` and 30 more tests here, 26 in
+The corpus holds 253 cases: 180 bad inputs in ``CASES`` and 30 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -57,6 +57,21 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("experiment-unknown-learner", EXP + ["--learners", "nope"], ["nope"]),
     ("experiment-nan-param", EXP + ["--param", "etg.q_init=nan"], ["q_init", "nan"]),
     ("experiment-inf-param", EXP + ["--param", "etg.alpha=inf"], ["alpha", "inf"]),
+    ("experiment-eval-runs-1e30", EXP + ["--eval-runs", str(10**30)],
+     ["--eval-runs", "at most 1,000,000,000"]),
+    ("experiment-points-1e30", EXP + ["--points", str(10**30)], ["--points", "1,000,000,000"]),
+    ("experiment-config-points-a-string", ["experiment", "sis", "--config",
+                                           "{d}/run_points_text/results.json"],
+     ["run_points_text/results.json", 'config.points is "20" (a string)', "an integer"]),
+    ("experiment-config-points-2.5", ["experiment", "sis", "--config",
+                                      "{d}/config_points_float.json"],
+     ["config_points_float.json", "config.points is 2.5", "an integer"]),
+    ("experiment-config-points-true", ["experiment", "sis", "--config",
+                                       "{d}/config_points_true.json"],
+     ["config_points_true.json", "config.points is true", "an integer"]),
+    ("experiment-config-sizes-text", ["experiment", "scaling", "--config",
+                                      "{d}/config_sizes_text.json"],
+     ["config_sizes_text.json", "config.sizes", "a list of integers"]),
     # ---- run -------------------------------------------------------------------------------
     ("run-missing", ["run", "{d}/nope.toml"], ["nope.toml"]),
     ("run-directory", ["run", "{d}/adir"], ["adir"]),
