@@ -95,6 +95,7 @@ def corpus(tmp_path_factory) -> Path:
     hostile_policies(d)
     hostile_tomls(d)
     hostile_runs(d)
+    hostile_sessions(d)
     head = (ROOT / "examples" / "heads" / "wha8030.toml").read_text()
     (d / "nul_scripts.toml").write_text(
         head.replace("[head]\n", '[head]\nscripts = "more\\u0000.toml"\n', 1))
@@ -123,6 +124,19 @@ def small_results(name: str) -> dict:
         return value
 
     return cut(json.loads((ROOT / "docs" / "results" / name / "results.json").read_text()))
+
+
+def hostile_sessions(d: Path) -> None:
+    """Sessions recorded as folders of frames (``relrl migrate``) whose session.json says a
+    duration that is no number of seconds, or a clock before 1970; an event with no time."""
+    sessions = {"nan": '{"seconds": NaN}', "1e300": '{"seconds": 1e300}',
+                "text": '{"seconds": "3"}', "1960": '{"seconds": 3, "recorded": '
+                                                    '"1960-03-02T10:14:05+0000"}'}
+    for name, manifest in {**sessions, "event": "{}"}.items():
+        (d / f"old_{name}").mkdir()
+        (d / f"old_{name}" / "trace.jsonl").write_text('{"t": 1}\n{"t": 2}\n')
+        (d / f"old_{name}" / "session.json").write_text(manifest)
+    (d / "old_event" / "events.jsonl").write_text('{"kind": "evaluation"}\n')
 
 
 def hostile_runs(d: Path) -> None:

@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 253 cases: 180 bad inputs in ``CASES`` and 30 more tests here, 26 in
+The corpus holds 258 cases: 185 bad inputs in ``CASES`` and 30 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -197,6 +197,15 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("migrate-missing", ["migrate", "{d}/nope"], ["nope", "no such folder"]),
     ("report-missing", ["report", "{d}/nope"], ["nope", "not a run folder"]),
     ("migrate-a-file", ["migrate", "{d}/afile"], ["afile"]),
+    ("migrate-seconds-nan", ["migrate", "{d}/old_nan"], ["old_nan/session.json", "seconds",
+                                                         "NaN"]),
+    ("migrate-seconds-1e300", ["migrate", "{d}/old_1e300"],
+     ["old_1e300/session.json", "seconds", "1e+300"]),
+    ("migrate-seconds-text", ["migrate", "{d}/old_text"], ["old_text/session.json", "'3'"]),
+    ("migrate-recorded-1960", ["migrate", "{d}/old_1960"],
+     ["old_1960/session.json", "1960-03-02", "outside 1970"]),
+    ("migrate-event-without-t", ["migrate", "{d}/old_event"],
+     ["old_event/events.jsonl", "event 1 has no t"]),
     ("tree-missing", ["tree", "{d}/nope.pl", "--domain", "{fruits}"], ["nope.pl"]),
     ("tree-no-domain", ["tree", "{d}/afile"], ["domain.pl", "--domain"]),
     ("tree-random-bytes", ["tree", "{d}/random.toml", "--domain", "{fruits}"],
