@@ -427,6 +427,7 @@ def build_worlds_config(args: argparse.Namespace):
     from relrl.errors import ConfigError
     from relrl.learners import WORLDS, learners, make_world_learner
     from relrl.resources import examples_dir
+    from relrl.terms import split_terms
     from relrl.worlds import World
     from relrl.worlds.experiment import WorldsConfig
 
@@ -442,7 +443,7 @@ def build_worlds_config(args: argparse.Namespace):
         if not Path(path).is_file():
             raise ConfigError(f"--worlds {path}: no such world file")
         config.worlds[i] = str(Path(path).resolve())
-    config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    config.tasks = split_terms(args.tasks)  # on(b1,b2) is one task
     names = ",".join(learners(WORLDS)) if args.learners is None else args.learners
     config.learners = [x.strip() for x in names.split(",") if x.strip()]
     for name in config.learners:

@@ -254,6 +254,14 @@ def hostile_policies(d: Path) -> None:
                                            "leaf(3, 2.0, 1))).\n")
     (d / "t_id1e9.pl").write_text(tg_head + "tg_tree(node(1, [sees(object)], [], "
                                             "leaf(1000000000, 1.0, 1), leaf(3, 2.0, 1))).\n")
+    # a second tree after the first: refused at its line, not one of the two restored
+    (d / "t_twice.pl").write_text(good["tg"] + "tg_tree(leaf(1, 0.0, 0)).\n")
+    # a byte that is not UTF-8, in a comment (Prolog's reader passes it silently)
+    (d / "p_latin1_comment.pl").write_bytes(good["etg"].encode() + "% caf\xe9\n".encode(
+        "latin-1"))
+    blocks = (ROOT / "examples" / "worlds" / "blocks.pl").read_bytes()
+    (d / "w_latin1_comment.pl").write_bytes("% caf\xe9\n".encode("latin-1") + blocks)
+    (d / "load_dir.toml").write_text(episode_text(head='learner = "etg"\npolicy_load = "adir"'))
     with np.load(d / "good_qlearning.npz") as table:
         arrays = {k: table[k] for k in table.files}
     arrays["q"] = arrays["q"].copy()

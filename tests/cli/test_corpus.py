@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 258 cases: 185 bad inputs in ``CASES`` and 30 more tests here, 26 in
+The corpus holds 269 cases: 194 bad inputs in ``CASES`` and 32 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -261,6 +261,25 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["p_cycle.pl:", "a cycle"]),
     ("run-policy-load-halt", ["run", "{d}/load_halt.toml", "--out", "{d}/out-halt"],
      ["p_halt.pl:", "halt is not a response"]),
+    ("tree-policy-tg-tree-twice", ["tree", "{d}/t_twice.pl", "--domain", "{fruits}"],
+     ["t_twice.pl:", "a second tg_tree/1", "the first is on line"]),
+    ("shell-policy-latin1-comment", ["shell", "{fruits}", "--policy",
+                                     "{d}/p_latin1_comment.pl"],
+     ["p_latin1_comment.pl:", "byte 0xe9 is not UTF-8"]),
+    ("learn-world-latin1-comment", ["learn", "{d}/w_latin1_comment.pl", "--task", "stack"],
+     ["w_latin1_comment.pl:1:", "byte 0xe9 is not UTF-8"]),
+    ("shell-policy-dev-zero", ["shell", "{fruits}", "--policy", "/dev/zero"],
+     ["/dev/zero", "not a regular file"]),
+    ("shell-policy-folder", ["shell", "{fruits}", "--policy", "{d}/adir"],
+     ["adir", "a folder, not a policy file"]),
+    ("tree-policy-dev-zero", ["tree", "/dev/zero", "--domain", "{fruits}"],
+     ["/dev/zero", "not a regular file"]),
+    ("learn-policy-folder", LEARN + ["--policy", "{d}/adir"], ["adir", "a folder"]),
+    ("run-policy-load-folder", ["run", "{d}/load_dir.toml", "--check"],
+     ["load_dir.toml:", "'adir' is a folder"]),
+    ("experiment-worlds-task-with-arguments", ["experiment", "worlds", "--worlds", BLOCKS,
+                                               "--tasks", "stack,fly(b1,b2)"],
+     ["fly(b1,b2)", "no such task"]),
     # ---- TOML nested 3,000 deep, or a device (conftest.hostile_tomls) ----------------------
     ("run-nested-arrays", ["run", "{d}/deep_array.toml"],
      ["deep_array.toml:", "nested more than 32 deep"]),
@@ -407,6 +426,18 @@ def test_report_on_a_results_json_with_a_key_missing_or_of_another_type(tmp_path
                 assert "\n" not in str(exc) and str(exc).startswith(str(tmp_path)), exc
                 refused += 1
     assert refused > 0
+
+
+@pytest.mark.parametrize("name, words", [
+    ("t_twice.pl", "a second tg_tree/1 (the first is on line {first})"),
+    ("p_latin1_comment.pl", "byte 0xe9 is not UTF-8")])
+def test_a_policy_refusal_names_the_line_at_fault(capsys, corpus, name, words):
+    """The second tree is the last line of t_twice.pl (the first, the line holding
+    ``tg_tree(`` before it); the byte in a comment is on p_latin1_comment.pl's last line."""
+    lines = (corpus / name).read_bytes().split(b"\n")[:-1]
+    first = next((i for i, x in enumerate(lines, 1) if x.startswith(b"tg_tree(")), 0)
+    line = one_line_exit_2(capsys, ["shell", str(FRUITS), "--policy", str(corpus / name)])
+    assert f"{corpus / name}:{len(lines)}: {words.format(first=first)}" in line
 
 
 def test_every_subcommand_is_in_the_corpus():
