@@ -58,8 +58,16 @@ class Run:
         return str(self.results.get("experiment", "?"))
 
 
+#: the largest run record read (a results.json of a long sweep is a few megabytes).
+MAX_BYTES = 256 << 20
+
+
 def _read_json(path: Path, *, required: bool) -> dict[str, Any]:
+    if path.exists() and not path.is_file():
+        raise UserError(f"{path}: not a regular file (a folder or a device); not a run record")
     try:
+        if path.is_file() and path.stat().st_size > MAX_BYTES:
+            raise UserError(f"{path}: larger than {MAX_BYTES >> 20} MB; not a run record")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         if required:
