@@ -256,6 +256,22 @@ TITLES = {"sis": "Experiment 1: the learners in the Social Interactive Simulator
           "scaling": "Worlds that grow: the scaling benchmark"}
 
 
+def _read_doc(md: Path) -> str:
+    """A Markdown file's text (UTF-8; a byte that is not is one line naming its line)."""
+    try:
+        if md.stat().st_size > MAX_BYTES:
+            raise UserError(f"{md}: larger than {MAX_BYTES >> 20} MB; not a document")
+        data = md.read_bytes()
+    except OSError as exc:
+        raise UserError(f"{md}: cannot read it ({exc.strerror or exc})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise UserError(f"{md}:{line}: byte 0x{data[exc.start]:02x} is not UTF-8 (relrl "
+                        "reads and writes Markdown as UTF-8)") from None
+
+
 def _line(m: re.Match[str]) -> int:
     return m.string.count("\n", 0, m.start()) + 1
 
@@ -264,7 +280,7 @@ def _blocks(md: Path, root: str | Path | None) -> list[tuple[re.Match[str], str]
     """Every block of ``md`` and what its runs render now. A block's runs must lie in the
     document's tree (:func:`tree_of`): a marker is text anyone may have written."""
     tree = tree_of(md, root)
-    doc = md.read_text(encoding="utf-8")
+    doc = _read_doc(md)
     out = []
     for m in BLOCK.finditer(doc):
         paths = m["path"].split(",")
@@ -290,7 +306,7 @@ def update_file(md: str | Path, root: str | Path | None = None) -> int:
     """Re-render every block of a Markdown file in place (runs read from ``root``'s tree,
     see :func:`tree_of`); the number of blocks changed."""
     md = Path(md)
-    doc = md.read_text(encoding="utf-8")
+    doc = _read_doc(md)
     changed = 0
     pieces, last = [], 0
     for m, fresh in _blocks(md, root):

@@ -38,7 +38,9 @@ def run(args: argparse.Namespace) -> int:
 
     for md in [*args.update, *args.check]:
         if not Path(md).is_file():
-            raise ConfigError(f"{md}: no such Markdown file")
+            raise ConfigError(f"{md}: " + ("not a regular file (a folder or a device), not "
+                                           "a Markdown file" if Path(md).exists() else
+                                           "no such Markdown file"))
     if args.root is not None and not Path(args.root).is_dir():
         raise ConfigError(f"--root {args.root}: no such folder")
     if not (args.runs or args.update or args.check):

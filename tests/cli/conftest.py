@@ -170,6 +170,7 @@ def hostile_runs(d: Path) -> None:
         (d / name).write_text(f"# doc\n\n<!-- relrl-report {path} summary -->\n"
                               "<!-- /relrl-report -->\n")
     (d / "linked_run").symlink_to(ROOT / "docs" / "results" / "exp1")
+    (d / "latin1.md").write_bytes("# doc\n\ncaf\xe9\n".encode("latin-1"))
     (d / "run_dev_zero").mkdir()
     (d / "run_dev_zero" / "results.json").symlink_to("/dev/zero")
     (d / "run_results_link").mkdir()
