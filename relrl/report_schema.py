@@ -15,6 +15,8 @@ named are allowed), :class:`ListOf`, :class:`MapOf` (any keys, one shape for the
 
 from __future__ import annotations
 
+import json
+import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,6 +50,7 @@ class MapOf:
     int_keys: bool = False
 
 
+_PLAIN_KEY = re.compile(r"[\w<=>.+-]{1,60}")
 _NAMES = {int: "an integer", float: "a number", str: "a string", bool: "true or false",
           dict: "an object", list: "a list"}
 
@@ -58,7 +61,7 @@ def _found(value: Any) -> str:
     kind = _NAMES.get(type(value), type(value).__name__)
     if isinstance(value, (dict, list)):
         return kind
-    shown = repr(value) if not isinstance(value, str) else '"' + value[:40] + '"'
+    shown = repr(value) if not isinstance(value, str) else json.dumps(value[:40])
     return f"{shown} ({kind})"
 
 
@@ -128,6 +131,10 @@ def _walk(value: Any, shape: Any, path: str, where: str) -> None:
 
 
 def _join(path: str, key: str) -> str:
+    """A key path, a key that is not a plain name written as JSON (so a message stays on
+    one line and shows exactly which key)."""
+    if not _PLAIN_KEY.fullmatch(key):
+        key = json.dumps(key)
     return f"{path}.{key}" if path else key
 
 

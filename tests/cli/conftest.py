@@ -154,6 +154,7 @@ def hostile_runs(d: Path) -> None:
     run("run_no_config", {k: v for k, v in sis.items() if k != "config"})
     run("run_points_text", {**sis, "config": {**sis["config"], "points": "20"}})
     run("run_unknown_kind", {"experiment": "nope", "summary": {}})
+    run("run_key_newline", {**sis, "summary": {"etg\nFAKE LINE": {"curve": "z"}}})
     for name, config in {"points_float": {"points": 2.5}, "points_true": {"points": True},
                          "sizes_text": {"sizes": [5, "9"]}}.items():
         (d / f"config_{name}.json").write_text(json.dumps(config))

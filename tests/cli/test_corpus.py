@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 272 cases: 197 bad inputs in ``CASES`` and 32 more tests here, 26 in
+The corpus holds 273 cases: 198 bad inputs in ``CASES`` and 32 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -336,6 +336,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["latin1.md:3", "byte 0xe9 is not UTF-8"]),
     ("report-markdown-a-folder", ["report", "--update", "{d}/adir"],
      ["adir", "not a regular file"]),
+    ("report-key-with-a-newline", ["report", "{d}/run_key_newline"],
+     ['summary."etg\\nFAKE LINE".curve is "z"']),
     ("report-results-dev-zero", ["report", "{d}/run_dev_zero"],
      ["run_dev_zero/results.json", "not a regular file"]),
     ("report-unknown-experiment", ["report", "{d}/run_unknown_kind"],
