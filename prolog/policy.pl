@@ -1,6 +1,7 @@
 :- module(relrl_policy,
           [ policy_learner/2,     % +File, -Learner
             policy_load/2,        % +KB, +File
+            policy_once/1,        % ?Template
             policy_refuse/3,      % +Term, +Format, +Args
             policy_number/3,      % +Term, +What, +Number
             policy_max_number/1   % -Max
@@ -72,9 +73,32 @@ policy_load(KB, File) :-
     ),
     check_info(KB, File, Line0, Info),
     maplist(check_term(File, Learner), Terms),
+    forall(policy_once(Template), once_only(File, Template, Terms)),
     pairs_values_(Terms, Values),
     catch(learner_restore_(Learner, KB, Values), error(Formal, _),
           restore_error(File, Terms, Formal)).
+
+%!  policy_once(?Template) is nondet.
+%
+%   A policy file holds at most one term that Template subsumes (a learner's whole tree,
+%   such as tg_tree/1): a second is refused, naming its line, rather than one of the two
+%   being silently restored. Learners add clauses (multifile).
+
+:- multifile policy_once/1.
+
+%   The second term of Terms that Template subsumes, if any, is an error naming its line.
+once_only(File, Template, Terms) :-
+    (   append(_, [Line1-T1|Rest], Terms),
+        subsumes_term(Template, T1)
+    ->  (   member(Line2-T2, Rest),
+            subsumes_term(Template, T2)
+        ->  functor(T2, Name, Arity),
+            policy_error(File, Line2, "a second ~q (the first is on line ~d): a policy holds \c
+                         one", [Name/Arity, Line1])
+        ;   true
+        )
+    ;   true
+    ).
 
 %!  policy_refuse(+Term, +Format, +Args) is det.
 %
@@ -152,6 +176,11 @@ learner_restore_(Learner, KB, Values) :-
 open_policy(File, S) :-
     (   exists_file(File)
     ->  true
+    ;   exists_directory(File)
+    ->  policy_error(File, 0, "a folder, not a policy file", [])
+    ;   access_file(File, exist)
+    ->  policy_error(File, 0, "not a regular file (a device, a pipe or a socket), not a \c
+                     policy file", [])
     ;   policy_error(File, 0, "no such policy file", [])
     ),
     size_file(File, Size),

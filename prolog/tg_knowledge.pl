@@ -23,6 +23,11 @@
 :- use_module(tg_tree).
 :- use_module(policy, [policy_refuse/3, policy_number/3]).
 
+%   A tg policy holds one tree (tg_tree/1; ptg's P-tree ptg_tree/1 too).
+:- multifile relrl_policy:policy_once/1.
+relrl_policy:policy_once(tg_tree(_)).
+relrl_policy:policy_once(ptg_tree(_)).
+
 /** <module> The TG tree as knowledge a person reads
 
 Explanations (the first-order tests on an example's path with the bindings that made them

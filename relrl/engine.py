@@ -305,7 +305,12 @@ def policy_learner(kb: KnowledgeBase, path: str | Path) -> str:
 @contextlib.contextmanager
 def _readable(path: str | Path) -> Iterator[None]:
     """Within the block, a term of the file at ``path`` nested too deep for the C stack
-    (reading it raised, as it does in plain swipl) is a :class:`PolicyError` naming it."""
+    (reading it raised, as it does in plain swipl) is a :class:`PolicyError` naming it.
+    A file that is not UTF-8 text, comments included, is refused before the block."""
+    from relrl.textfile import not_utf8
+
+    if (problem := not_utf8(path)) is not None:
+        raise PolicyError(f"{path}:{problem[0]}: {problem[1]}")
     try:
         yield
     except PrologError as exc:

@@ -93,6 +93,10 @@ class KnowledgeBase:
                 or (when ``strict``) a warning; the message names file and line.
         """
         p = Path(path)
+        from relrl.textfile import not_utf8
+
+        if (problem := not_utf8(p)) is not None:
+            raise PrologLoadError(display_path(str(p)), *problem)
         try:
             out = self._prolog.api("load", str(p), self.module, Var(), timeout=self.timeout)
         except Aborted as exc:

@@ -16,14 +16,27 @@ from relrl.loop import Agent
 from relrl.shell import Shell, command
 from relrl.terms import Term, format_term
 
-__all__ = ["policy_learner", "load_policy", "attach_learner"]
+__all__ = ["attach_learner", "load_policy", "not_a_policy_file", "policy_learner"]
+
+
+def not_a_policy_file(path: str | Path) -> str | None:
+    """What ``path`` is when it is no file a policy can be read from (``no such policy
+    file``, ``a folder ...``, ``not a regular file ...``); ``None`` for a regular file."""
+    path = Path(path)
+    if path.is_file():
+        return None
+    if path.is_dir():
+        return "a folder, not a policy file"
+    if path.exists():
+        return "not a regular file (a device, a pipe or a socket), not a policy file"
+    return "no such policy file"
 
 
 def policy_learner(path: str | Path, kb: KnowledgeBase) -> str:
     """The name of the learner that saved the policy file at ``path``."""
     path = Path(path)
-    if not path.exists():
-        raise UserError(f"{path}: no such policy file")
+    if (problem := not_a_policy_file(path)) is not None:
+        raise UserError(f"{path}: {problem}")
     if path.suffix == ".npz":
         return "qlearning"
     from relrl.engine import policy_learner as read_learner

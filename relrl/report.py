@@ -11,7 +11,12 @@ In a Markdown file, a generated table sits between two comments naming its sourc
     ...
     <!-- /relrl-report -->
 
-The path is relative to the Markdown file's folder. :func:`update_file` re-renders every such
+The path is relative to the Markdown file's folder and stays inside the document's tree (the
+git work tree holding it, else its folder, or ``--root DIR``): a marker is text anyone may
+write, and it never makes relrl read a file elsewhere. Everything a run's records hold is
+rendered as the text it is (:mod:`relrl.markdown`), never as markup, and a results.json is
+checked against what its views read before any is rendered (:mod:`relrl.report_schema`).
+:func:`update_file` re-renders every such
 block in place (``relrl report --update README.md``); :func:`stale_blocks` lists the blocks
 that no longer match their source (``relrl report --check``; the test suite runs it on the
 shipped docs). Views are looked up in :data:`VIEWS` by (experiment, view); adding an
@@ -28,9 +33,11 @@ from pathlib import Path
 from typing import Any
 
 from relrl.errors import UserError
+from relrl.markdown import Markdown, code, link, text
+from relrl.report_schema import check_run
 
 __all__ = ["MULTI_VIEWS", "Run", "VIEWS", "load_run", "render", "render_many",
-           "render_report", "stale_blocks", "update_file", "view"]
+           "render_report", "stale_blocks", "tree_of", "update_file", "view"]
 
 BLOCK = re.compile(r"<!-- relrl-report (?P<path>\S+) (?P<view>[\w-]+) -->\n"
                    r"(?P<body>.*?)<!-- /relrl-report -->", re.S)
@@ -51,8 +58,16 @@ class Run:
         return str(self.results.get("experiment", "?"))
 
 
+#: the largest run record read (a results.json of a long sweep is a few megabytes).
+MAX_BYTES = 256 << 20
+
+
 def _read_json(path: Path, *, required: bool) -> dict[str, Any]:
+    if path.exists() and not path.is_file():
+        raise UserError(f"{path}: not a regular file (a folder or a device); not a run record")
     try:
+        if path.is_file() and path.stat().st_size > MAX_BYTES:
+            raise UserError(f"{path}: larger than {MAX_BYTES >> 20} MB; not a run record")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         if required:
@@ -81,8 +96,10 @@ def load_run(path: str | Path) -> Run:
     if "experiment" not in results:
         raise UserError(f"{folder / 'results.json'}: no \"experiment\" key; "
                         "not the results of a relrl experiment")
-    return Run(folder, results, _read_json(folder / "timing.json", required=False),
-               _read_json(folder / ".relrl-run.json", required=False))
+    timing = _read_json(folder / "timing.json", required=False)
+    manifest = _read_json(folder / ".relrl-run.json", required=False)
+    check_run(folder, results, timing, manifest)
+    return Run(folder, results, timing, manifest)
 
 
 # ---- formatting helpers ---------------------------------------------------------------------
@@ -101,9 +118,10 @@ def _f(x: Any, digits: int = 2) -> str:
 
 
 def table(header: list[str], rows: list[list[Any]]) -> str:
-    """A Markdown table (values formatted by their type)."""
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(_f(v) if not isinstance(v, str) else v for v in row) + " |"
+    """A Markdown table (values formatted by their type; every string shown as the text it
+    is, unless the view marked it :class:`~relrl.markdown.Markdown`)."""
+    lines = ["| " + " | ".join(map(text, header)) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(text(v if isinstance(v, str) else _f(v)) for v in row) + " |"
               for row in rows]
     return "\n".join(lines) + "\n"
 
@@ -116,10 +134,10 @@ def provenance(run: Run, label: str) -> str:
     machine = (run.timing.get("machine_info") or run.results.get("machine_info")
                or {"machine": run.timing.get("machine"), "python": run.timing.get("python")})
     when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
-    line = f"*From `{label}/results.json`"
+    line = f"*From {code(f'{label}/results.json')}"
     if command:
-        line += f", made by `{command}`"
-    line += f" on {describe(machine)}" + (f", {when}" if when else "")
+        line += f", made by {code(command)}"
+    line += f" on {text(describe(machine))}" + (f", {text(when)}" if when else "")
     if run.results.get("partial"):
         line += " (**a partial run**: stopped before the end)"
     return line + ".*\n"
@@ -172,25 +190,65 @@ def _ended(body: str) -> str:
     return body if body.endswith("\n") else body + "\n"
 
 
-def render_report(paths: list[str | Path], out: Path) -> str:
+def render_report(paths: list[str | Path], out: Path, root: str | Path | None = None) -> str:
     """A whole results page: every view of every run, each in its block (links relative to
-    ``out``'s folder), figures linked from the run folders."""
+    ``out``'s folder), figures linked from the run folders.
+
+    Raises:
+        UserError: a run outside the document's tree (``root``, see :func:`tree_of`), or
+            whose path a block marker cannot name.
+    """
     import os
 
+    tree = tree_of(out, root)
     parts = ["# Results\n\n",
              "Generated by `relrl report` from the runs named in each block; "
              "re-render with `relrl report --update` after new runs.\n"]
     for p in paths:
         run = load_run(p)
         rel = Path(os.path.relpath(run.path.resolve(), out.resolve().parent)).as_posix()
+        _inside(tree, run.path, rel, str(out))
         names = [v for e, v in VIEWS if e == run.experiment and v != "short"]
-        parts.append(f"\n## {TITLES.get(run.experiment, run.experiment)} (`{rel}`)\n")
+        parts.append(f"\n## {TITLES.get(run.experiment, run.experiment)} ({code(rel)})\n")
         for name in names:
             parts.append(f"\n<!-- relrl-report {rel} {name} -->\n"
                          f"{render(run, name, rel)}<!-- /relrl-report -->\n")
         for png in sorted(run.path.glob("*.png")):
-            parts.append(f"\n![{png.stem}]({rel}/{png.name})\n")
+            parts.append(f"\n![{text(png.stem)}]({link(f'{rel}/{png.name}')})\n")
     return "".join(parts)
+
+
+#: the characters a run's path may have in a block marker (no space, quote, bracket or ``-->``
+#: to end the marker or the comment early, and nothing HTML or a shell reads specially).
+MARKER_PATH = re.compile(r"[\w.@+=~/-]+")
+#: the records of a run folder that a block reads.
+_RECORDS = ("results.json", "timing.json", ".relrl-run.json")
+
+
+def tree_of(md: str | Path, root: str | Path | None = None) -> Path:
+    """The tree a Markdown file's blocks may read runs from: ``root`` when given, else the
+    git work tree that holds the file, else the file's own folder."""
+    if root is not None:
+        return Path(root).resolve()
+    folder = Path(md).resolve().parent
+    for up in (folder, *folder.parents):
+        if (up / ".git").exists():
+            return up
+    return folder
+
+
+def _inside(tree: Path, folder: Path, named: str, where: str) -> None:
+    """Refuse a run folder named ``named`` in a block that is absolute, is not a plain path,
+    or (its records included, links followed) lies outside ``tree``."""
+    if not MARKER_PATH.fullmatch(named) or named.startswith("/"):
+        raise UserError(f"{where}: the run path {named!r} cannot be named in a block (a "
+                        "relative path of letters, digits and . _ - / @ + = ~)")
+    for path in (folder, *(folder / name for name in _RECORDS)):
+        real = path.resolve()
+        if not real.is_relative_to(tree):
+            what = named if path == folder else f"{named}/{path.name}"
+            raise UserError(f"{where}: {what} leads outside {tree}, the tree this "
+                            "document's blocks may read runs from (--root DIR widens it)")
 
 
 TITLES = {"sis": "Experiment 1: the learners in the Social Interactive Simulator",
@@ -198,11 +256,36 @@ TITLES = {"sis": "Experiment 1: the learners in the Social Interactive Simulator
           "scaling": "Worlds that grow: the scaling benchmark"}
 
 
-def _blocks(md: Path) -> list[tuple[re.Match[str], str]]:
-    text = md.read_text(encoding="utf-8")
+def _read_doc(md: Path) -> str:
+    """A Markdown file's text (UTF-8; a byte that is not is one line naming its line)."""
+    try:
+        if md.stat().st_size > MAX_BYTES:
+            raise UserError(f"{md}: larger than {MAX_BYTES >> 20} MB; not a document")
+        data = md.read_bytes()
+    except OSError as exc:
+        raise UserError(f"{md}: cannot read it ({exc.strerror or exc})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise UserError(f"{md}:{line}: byte 0x{data[exc.start]:02x} is not UTF-8 (relrl "
+                        "reads and writes Markdown as UTF-8)") from None
+
+
+def _line(m: re.Match[str]) -> int:
+    return m.string.count("\n", 0, m.start()) + 1
+
+
+def _blocks(md: Path, root: str | Path | None) -> list[tuple[re.Match[str], str]]:
+    """Every block of ``md`` and what its runs render now. A block's runs must lie in the
+    document's tree (:func:`tree_of`): a marker is text anyone may have written."""
+    tree = tree_of(md, root)
+    doc = _read_doc(md)
     out = []
-    for m in BLOCK.finditer(text):
+    for m in BLOCK.finditer(doc):
         paths = m["path"].split(",")
+        for p in paths:
+            _inside(tree, md.parent / p, p, f"{md}:{_line(m)}")
         if len(paths) == 1:
             out.append((m, render(load_run(md.parent / paths[0]), m["view"], paths[0])))
         else:
@@ -211,25 +294,27 @@ def _blocks(md: Path) -> list[tuple[re.Match[str], str]]:
     return out
 
 
-def stale_blocks(md: str | Path) -> list[str]:
-    """The blocks of a Markdown file that differ from what their source renders now."""
+def stale_blocks(md: str | Path, root: str | Path | None = None) -> list[str]:
+    """The blocks of a Markdown file that differ from what their source renders now (runs
+    read from ``root``'s tree, see :func:`tree_of`)."""
     md = Path(md)
-    return [f"{md}:{m.string.count(chr(10), 0, m.start()) + 1}: {m['path']} {m['view']}"
-            for m, fresh in _blocks(md) if m["body"] != fresh]
+    return [f"{md}:{_line(m)}: {m['path']} {m['view']}"
+            for m, fresh in _blocks(md, root) if m["body"] != fresh]
 
 
-def update_file(md: str | Path) -> int:
-    """Re-render every block of a Markdown file in place; the number of blocks changed."""
+def update_file(md: str | Path, root: str | Path | None = None) -> int:
+    """Re-render every block of a Markdown file in place (runs read from ``root``'s tree,
+    see :func:`tree_of`); the number of blocks changed."""
     md = Path(md)
-    text = md.read_text(encoding="utf-8")
+    doc = _read_doc(md)
     changed = 0
     pieces, last = [], 0
-    for m, fresh in _blocks(md):
-        pieces.append(text[last:m.start("body")])
+    for m, fresh in _blocks(md, root):
+        pieces.append(doc[last:m.start("body")])
         pieces.append(fresh)
         changed += m["body"] != fresh
         last = m.end("body")
-    pieces.append(text[last:])
+    pieces.append(doc[last:])
     if changed:
         from relrl.outdir import write_atomic
 
@@ -255,8 +340,8 @@ def _sis_summary(run: Run) -> str:
     cfg, summary = r["config"], r["summary"]
     head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), {cfg['points']} "
             f"evaluation points of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
-            f"{cfg['block']} learning units between points; caregiver `{cfg['caregiver']}`"
-            + (f", preset `{cfg['preset']}`" if cfg.get("preset") else "") + ".\n\n")
+            f"{cfg['block']} learning units between points; caregiver {code(cfg['caregiver'])}"
+            + (f", preset {code(cfg['preset'])}" if cfg.get("preset") else "") + ".\n\n")
     rows = []
     for name, s in summary.items():
         m1, s1 = _run1(s)
@@ -279,9 +364,9 @@ def _sis_short(run: Run) -> str:
         rows.append([name, _f(m1), _f(s["cgi_final"]), f"{s['eye_contacts']['mean']:.0f}",
                      _f(round(s["memory"].get("positions", 0)))])
     mem = paper.get("memory_positions", {})
-    rows.append(["*paper (2012)*", "≈ 0.8 (all)", "C flat; Q, ETG rise", "C most, Q fewest",
-                 f"Q {mem.get('qlearning', '—'):,}; ETG {mem.get('etg', '—')}"
-                 if mem else "—"])
+    rows.append([Markdown("*paper (2012)*"), "≈ 0.8 (all)", "C flat; Q, ETG rise",
+                 "C most, Q fewest",
+                 f"Q {_f(mem.get('qlearning'), 0)}; ETG {_f(mem.get('etg'), 0)}" if mem else "—"])
     return table(["learner", "CGI after run 1", "CGI final", "eye contacts", "positions"], rows)
 
 
@@ -344,7 +429,7 @@ def _exp2_confusions(run: Run) -> str:
             total = sum(said.values())
             ranked = sorted(said.items(), key=lambda kv: (-kv[1], kv[0]))
             rows.append([k, shown, ", ".join(f"{name} {100 * n / total:.1f} %"
-                                             for name, n in ranked)])
+                                             for name, n in ranked) if total > 0 else "—"])
     if not rows:
         raise UserError(f"{run.path / 'results.json'}: no confusions in this run")
     return table(["learner / time unit", "fruit shown", "what the robot would have said"], rows)
@@ -362,7 +447,8 @@ def _exp2_short(run: Run) -> str:
         rows.append([k, _f(fig6[-1]["cgi_mean"]) if fig6 else "—",
                      f"{t1['success'][0]:.1f}" if "success" in t1 else "—"])
     if "success" in paper:
-        rows.append(["*paper (2012)*", "rises, then flat", f"{paper['success'][0]}"])
+        rows.append([Markdown("*paper (2012)*"), "rises, then flat",
+                     f"{paper['success'][0]}"])
     return table(["learner / time unit", "final CGI (Fig. 6)", "success rate % (Table 1)"],
                  rows)
 
@@ -384,7 +470,7 @@ def _bench_summary(run: Run) -> str:
                          f"{f['steps_per_second']:,.0f} ({f['gateway_calls_per_step']:.2f})",
                          "tg ≥ 3,000; ≤ 1.5 calls" if name == "tg" else "≤ 1.5 calls"])
     etg = learners.get("etg", {})
-    if etg:
+    if "step_in_gateway_calls" in etg:
         rows.append(["ETG agent step, in gateway calls' worth of time",
                      f"{etg['step_in_gateway_calls']:.2f}", "≤ 3"])
     rows.append(["tg's step against ETG's (CPU time)", _f(r.get("tg_step_in_etg_steps")),
@@ -395,7 +481,7 @@ def _bench_summary(run: Run) -> str:
         rows.append([f"tg's learning step at P = {big} against P = 5",
                      f"{by_size[big]:.2f}", "≤ 1.5"])
     side = r.get("etg_prolog_side", {})
-    if "cpu_us_per_step" in side:
+    if "cpu_us_per_step" in side and "inferences_per_step" in side:
         rows.append(["the Prolog side of an ETG step, plain swipl (inferences)",
                      f"{side['cpu_us_per_step']:.1f} µs ({side['inferences_per_step']:.0f})",
                      "—"])
@@ -509,15 +595,18 @@ def _sis_claims_side_by_side(runs: list[Run]) -> str:
     """The paper's three claims judged on each run (results.json's ``claims``), one column
     per run (its setting: ``fixed task`` or the preset)."""
     claims = [_claims_of(r) for r in runs]
-    header = ["the paper's claim"] + [f"`{r.results['config'].get('preset') or 'fixed task'}`"
+    header = ["the paper's claim"] + [code(r.results['config'].get('preset') or 'fixed task')
                                       for r in runs]
     rows = []
     for key in [k for k in _CLAIM_ROWS if k in claims[0]] + \
             [k for k in claims[0] if k not in _CLAIM_ROWS]:
         row = [_CLAIM_ROWS.get(key, key)]
         for c in claims:
+            if key not in c:
+                row.append("—")
+                continue
             verdict = {True: "**held**", False: "not held", None: "not judged"}[c[key]["held"]]
-            row.append(f"{verdict}: {_claim_figures(c[key]['values'])}")
+            row.append(Markdown(f"{verdict}: {text(_claim_figures(c[key]['values']))}"))
         rows.append(row)
     return table(header, rows)
 
@@ -579,7 +668,7 @@ def _scaling_transfer(run: Run) -> str:
             s = by_size[size]
             rows.append([learner, int(size), _f(s.get("cgi_trained")), _f(s.get("cgi_unseen")),
                          f"{s['seeds']}"])
-    return (f"Zero-shot transfer ({what}).\n\n"
+    return (f"Zero-shot transfer ({text(what)}).\n\n"
             + table(["learner", "places P", "CGI trained", "CGI unseen", "seeds"], rows))
 
 

@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
-__all__ = ["Var", "Term", "compound", "format_term", "functor", "args"]
+__all__ = ["Var", "Term", "compound", "format_term", "functor", "args", "split_terms"]
 
 #: A Prolog term as a Python value (see the module documentation).
 Term = Any
@@ -108,3 +108,32 @@ def format_term(term: Term) -> str:
     if isinstance(term, Var):
         return "_" if term.name.startswith("_") else term.name
     raise TypeError(f"cannot write {term!r} as a Prolog term")
+
+
+_OPEN, _CLOSE = "([{", ")]}"
+
+
+def split_terms(text: str) -> list[str]:
+    """A comma-separated list of terms as typed (``--tasks stack,on(b1, b2)``), split at
+    the commas outside brackets and quotes only: ``on(b1,b2)`` stays one term. Blank
+    items are dropped; each item is stripped (its own reader says whether it is a term)."""
+    items, depth, quote, start, i = [], 0, "", 0, 0
+    while i < len(text):
+        c = text[i]
+        if quote:
+            if c == "\\":
+                i += 1
+            elif c == quote:
+                quote = ""
+        elif c in "'\"`":
+            quote = c
+        elif c in _OPEN:
+            depth += 1
+        elif c in _CLOSE:
+            depth = max(0, depth - 1)
+        elif c == "," and depth == 0:
+            items.append(text[start:i])
+            start = i + 1
+        i += 1
+    items.append(text[start:])
+    return [item.strip() for item in items if item.strip()]

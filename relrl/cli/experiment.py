@@ -223,6 +223,11 @@ def _ints(text: str, what: str) -> list[int]:
     return values
 
 
+#: the most evaluation points, runs, time units or learning units an option may ask for (more
+#: is no run that ends; numpy refuses arrays that large).
+MAX_COUNT = 10**9
+
+
 def _check_common(args: argparse.Namespace, config) -> None:
     """Validate and copy the options both experiments share into ``config``."""
     from relrl.errors import ConfigError
@@ -242,6 +247,8 @@ def _check_common(args: argparse.Namespace, config) -> None:
                         ("--block", config.block)]:
         if value < 1:
             raise ConfigError(f"{what} must be at least 1, not {value}")
+        if value > MAX_COUNT:
+            raise ConfigError(f"{what} must be at most {MAX_COUNT:,}, not {value}")
     if len(set(config.seeds)) != len(config.seeds) or any(s < 0 for s in config.seeds):
         raise ConfigError(f"--seeds must be distinct whole numbers >= 0, not {args.seeds!r}")
     config.eval_policy = args.eval_policy
@@ -275,8 +282,8 @@ def build_config(args: argparse.Namespace):
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
     config.eval_steps = args.eval_steps if args.eval_steps is not None else 500
     config.block = args.block if args.block is not None else 500
-    if config.points < 1:
-        raise ConfigError(f"--points must be at least 1, not {config.points}")
+    if not 1 <= config.points <= MAX_COUNT:
+        raise ConfigError(f"--points must be 1 to {MAX_COUNT:,}, not {config.points}")
     _check_common(args, config)
     config.learner_params = {k: v for k, v in config.learner_params.items()
                              if k in config.learners}
@@ -420,6 +427,7 @@ def build_worlds_config(args: argparse.Namespace):
     from relrl.errors import ConfigError
     from relrl.learners import WORLDS, learners, make_world_learner
     from relrl.resources import examples_dir
+    from relrl.terms import split_terms
     from relrl.worlds import World
     from relrl.worlds.experiment import WorldsConfig
 
@@ -435,7 +443,7 @@ def build_worlds_config(args: argparse.Namespace):
         if not Path(path).is_file():
             raise ConfigError(f"--worlds {path}: no such world file")
         config.worlds[i] = str(Path(path).resolve())
-    config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    config.tasks = split_terms(args.tasks)  # on(b1,b2) is one task
     names = ",".join(learners(WORLDS)) if args.learners is None else args.learners
     config.learners = [x.strip() for x in names.split(",") if x.strip()]
     for name in config.learners:

@@ -127,8 +127,11 @@ def run(args: argparse.Namespace) -> int:
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")
     params = dict(args.param)
-    if args.policy and not Path(args.policy).is_file():
-        raise ConfigError(f"--policy {args.policy}: no such file")
+    if args.policy:
+        from relrl.policy import not_a_policy_file
+
+        if (problem := not_a_policy_file(args.policy)) is not None:
+            raise ConfigError(f"--policy {args.policy}: {problem}")
     config = LearnConfig(world=str(path.resolve()), task=task_text, learner=args.learner,
                          params=params, train_sizes=train, test_sizes=test,
                          episodes=args.episodes, block=block,

@@ -14,7 +14,9 @@ line); options typed beside both override them too. ``--quick`` cannot be combin
 ``--config`` (the record says how long the run is).
 
 Everything a user can get wrong is one line and exit 2: no such file, not JSON, the results
-of another experiment, a field this relrl does not know (a record from another version).
+of another experiment, a field this relrl does not know (a record from another version), a
+field whose value is not of the setting's type (``"points": "20"``, ``2.5`` or ``true``:
+JSON's true is no number of points, though Python's bool is an int).
 A record written by another relrl version, or whose caregiver resolves to other parameters
 here, is run with a warning that the numbers may differ.
 """
@@ -68,12 +70,74 @@ DERIVED = {"sis": ("caregiver_resolved", "eval_caregiver_resolved", "setting"),
 
 def _settings(experiment: str) -> list[str]:
     """The settings of ``experiment``'s configuration (its dataclass's fields)."""
+    return list(_types(experiment))
+
+
+def _types(experiment: str) -> dict[str, Any]:
+    """Each setting of ``experiment``'s configuration and its type (the dataclass's hints)."""
     from dataclasses import fields
+    from typing import get_type_hints
 
     from relrl.experiments.scaling import ScalingConfig
     from relrl.experiments.sis import SISConfig
 
-    return [f.name for f in fields(SISConfig if experiment == "sis" else ScalingConfig)]
+    cls = SISConfig if experiment == "sis" else ScalingConfig
+    hints = get_type_hints(cls)
+    return {f.name: hints[f.name] for f in fields(cls)}
+
+
+_KINDS = {bool: "true or false", int: "an integer", float: "a number", str: "a string",
+          list: "a list", dict: "an object", type(None): "null"}
+
+
+def _fits(value: Any, hint: Any) -> bool:
+    """Whether a JSON value is of a setting's type (``bool`` is no integer here, an integer
+    is a number)."""
+    import types
+    import typing
+
+    origin = typing.get_origin(hint)
+    if hint is Any:
+        return True
+    if origin in (typing.Union, types.UnionType):
+        return any(_fits(value, h) for h in typing.get_args(hint))
+    if hint is type(None):
+        return value is None
+    if origin is list:
+        (item,) = typing.get_args(hint)
+        return isinstance(value, list) and all(_fits(v, item) for v in value)
+    if origin is dict:
+        key, item = typing.get_args(hint)
+        return isinstance(value, dict) and all(_fits(v, item) for v in value.values())
+    if isinstance(value, bool):
+        return hint is bool
+    if hint is float:
+        return isinstance(value, (int, float))
+    return isinstance(value, hint)
+
+
+def _described(hint: Any, plural: bool = False) -> str:
+    """A setting's type in words (``a list of integers``, ``an object of numbers``)."""
+    import typing
+
+    args = typing.get_args(hint)
+    origin = typing.get_origin(hint)
+    if origin in (list, dict):
+        inner = "" if args[-1] is Any else f" of {_described(args[-1], True)}"
+        return ("lists" if plural else "a list") + inner if origin is list else \
+            ("objects" if plural else "an object") + inner
+    if args:
+        return " or ".join(_described(a, plural) for a in args)
+    if plural:
+        return {int: "integers", float: "numbers", str: "strings"}.get(hint, str(hint))
+    return _KINDS.get(hint, str(hint))
+
+
+def _shown(value: Any) -> str:
+    kind = _KINDS.get(type(value), type(value).__name__)
+    if isinstance(value, (list, dict)) or value is None:
+        return kind
+    return f"{json.dumps(value)[:40]} ({kind})"
 
 
 def _plan(experiment: str, parser: argparse.ArgumentParser
@@ -152,11 +216,16 @@ def read_record(path: str | Path, experiment: str) -> dict[str, Any]:
     config = data.get("config", data if other is None else None)
     if not isinstance(config, dict):
         raise ConfigError(f"{where}: no \"config\" object (give the results.json of a run)")
-    names = set(_settings(experiment)) | set(DERIVED[experiment])
-    for name in config:
-        if name not in names:
+    types = _types(experiment)
+    for name, value in config.items():
+        if name in DERIVED[experiment]:
+            continue
+        if name not in types:
             raise ConfigError(f"{where}: config.{name} is not a setting of relrl "
                               f"experiment {experiment} (a record of another relrl version?)")
+        if not _fits(value, types[name]):
+            raise ConfigError(f"{where}: config.{name} is {_shown(value)}, expected "
+                              f"{_described(types[name])}")
     version = data.get("relrl_version")
     from relrl import __version__
 

@@ -23,6 +23,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--check", nargs="+", metavar="FILE.md", default=[],
                         help="exit 1 and name every generated block that its run no longer "
                              "renders the same")
+    parser.add_argument("--root", metavar="DIR",
+                        help="the tree whose runs a document's blocks may read (default: the "
+                             "git work tree holding the document, else its folder); a block "
+                             "naming a run outside it is refused")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -34,15 +38,19 @@ def run(args: argparse.Namespace) -> int:
 
     for md in [*args.update, *args.check]:
         if not Path(md).is_file():
-            raise ConfigError(f"{md}: no such Markdown file")
+            raise ConfigError(f"{md}: " + ("not a regular file (a folder or a device), not "
+                                           "a Markdown file" if Path(md).exists() else
+                                           "no such Markdown file"))
+    if args.root is not None and not Path(args.root).is_dir():
+        raise ConfigError(f"--root {args.root}: no such folder")
     if not (args.runs or args.update or args.check):
         raise ConfigError("give run folders to render, or --update/--check FILE.md")
     status = 0
     for md in args.update:
-        n = update_file(md)
+        n = update_file(md, args.root)
         print(f"{md}: {n} block(s) re-rendered" if n else f"{md}: up to date")
     for md in args.check:
-        stale = stale_blocks(md)
+        stale = stale_blocks(md, args.root)
         for line in stale:
             print(f"stale: {line}")
         status = max(status, 1 if stale else 0)
@@ -55,8 +63,8 @@ def run(args: argparse.Namespace) -> int:
 
             out = Path(args.out)
             check_out_file(out, "--out", suffixes=(".md",))
-            write_atomic(out, render_report(args.runs, out))
+            write_atomic(out, render_report(args.runs, out, args.root))
             print(f"wrote {out}")
         else:
-            print(render_report(args.runs, Path.cwd() / "results.md"))
+            print(render_report(args.runs, Path.cwd() / "results.md", args.root))
     return status

@@ -33,11 +33,11 @@ def run(args: argparse.Namespace) -> int:
     from relrl.loop import Agent
     from relrl.monitor.graph import GraphError, learner_graph, render
     from relrl.outdir import check_out_file, write_atomic
-    from relrl.policy import policy_learner
+    from relrl.policy import not_a_policy_file, policy_learner
 
     policy = Path(args.policy)
-    if not policy.is_file():
-        raise UserError(f"{policy}: no such policy file")
+    if (problem := not_a_policy_file(policy)) is not None:
+        raise UserError(f"{policy}: {problem}")
     domain = Path(args.domain) if args.domain else policy.parent / "domain.pl"
     if not domain.is_file():
         raise ConfigError(f"{domain}: no such domain file; name the policy's domain with "

@@ -373,7 +373,10 @@ def _episode_table(c: _Checker, head: dict[str, Any], ep: Episode) -> None:
     elif load:
         ep.policy_load = (base / load).resolve()
         if not ep.policy_load.is_file():
-            c.fail(w + ("policy_load",), f"policy file {load!r} not found")
+            what = ("is a folder, not a policy file" if ep.policy_load.is_dir() else
+                    "is not a regular file (a device, a pipe or a socket)"
+                    if ep.policy_load.exists() else "not found")
+            c.fail(w + ("policy_load",), f"policy file {load!r} {what}")
     save = c.get(head, "policy_save", str, "policy.pl", w)
     ep.policy_save = c.policy_file(save, w + ("policy_save",)) if save else None
     unit = c.get(head, "time_unit", str, "step", w)

@@ -149,7 +149,7 @@ def _jsonl(path: Path, shape: dict[str, Any]) -> list[tuple[int, dict[str, Any]]
         except (schema.ShapeError, RecursionError) as exc:
             raise UserError(f"{path}:{n}: {_why(exc)}") from None
         for key in ("t", "index"):
-            if key in shape or f"{key}!" in shape:
+            if key in row and (key in shape or f"{key}!" in shape):
                 low = 1 if key == "index" else 0
                 if not low <= row[key] <= MAX_T:
                     raise UserError(f"{path}:{n}: {key} must be a whole number from {low} "

@@ -13,6 +13,7 @@ time unit: the units are spread evenly over the session's recorded duration
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +37,25 @@ from relrl.recording.channels import (
 from relrl.recording.channels import JOINTS as JOINT_STATES
 
 __all__ = ["migrate_folder"]
+
+
+#: a message's time in an MCAP file is an unsigned 64-bit count of nanoseconds.
+_NS_END = 2**64
+#: the longest session duration read from ``session.json`` (a year, in seconds).
+MAX_SECONDS = 366 * 24 * 3600
+
+
+def _per_unit(manifest: dict[str, Any], units: int, where: Path) -> int:
+    """Nanoseconds per time unit: the session's recorded duration spread over its units
+    (a tenth of a second each when ``seconds`` is not recorded)."""
+    seconds = manifest.get("seconds")
+    if seconds is None or seconds == 0:
+        return 100_000_000
+    if isinstance(seconds, bool) or not isinstance(seconds, (int, float)) or \
+            not math.isfinite(seconds) or not 0 < seconds <= MAX_SECONDS:
+        raise UserError(f"{where}: seconds must be a number above 0 and at most "
+                        f"{MAX_SECONDS:,} (a year), not {seconds!r}")
+    return max(1, int(1e9 * seconds / units))
 
 
 def _start_ns(manifest: dict[str, Any], folder: Path) -> int:
@@ -66,9 +86,22 @@ def migrate_folder(folder: str | Path) -> Path:
         raise UserError(f"{target}: already there; the folder needs no migration")
     old = Recording(folder)  # the folder's reader: its errors name the file and line
     rows, frames, manifest, summary = old.rows, old.frames, old.manifest, old.summary
+    if not rows:
+        raise UserError(f"{folder}/trace.jsonl: no time unit recorded; nothing to migrate")
     start = _start_ns(manifest, folder)
-    per_unit = int(1e9 * float(manifest.get("seconds") or len(rows) / 10) / len(rows))
+    per_unit = _per_unit(manifest, len(rows), folder / "session.json")
     first = int(rows[0]["t"])
+    for n, event in enumerate(old.events, 1):
+        if "t" not in event:
+            raise UserError(f"{folder}/events.jsonl: event {n} has no t (the time unit it "
+                            "happened in)")
+    times = [int(x["t"]) for x in (*rows, *frames, *old.trees, *old.events)]
+    ends = (start + (min(times) - first) * per_unit, start + (max(times) - first) * per_unit)
+    if ends[0] < 0 or ends[1] >= _NS_END:
+        raise UserError(f"{folder}/session.json: the session's clock (recorded "
+                        f"{manifest.get('recorded')!r}, {len(rows)} units over "
+                        f"{manifest.get('seconds')!r} s) runs outside 1970 to 2554, the "
+                        "times an MCAP file holds")
 
     def at(t: int) -> int:  # the session's clock, units spread evenly over its duration
         return start + (int(t) - first) * per_unit

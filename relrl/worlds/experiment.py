@@ -316,7 +316,10 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
 
 
 def worlds_table(results: dict[str, Any]) -> str:
-    """The summary as a Markdown table (what ``relrl report``'s worlds view renders)."""
+    """The summary as a Markdown table (what ``relrl report``'s worlds view renders; names
+    shown as the text they are)."""
+    from relrl.markdown import text
+
     sizes = results["config"]["test_sizes"]
     train = results["config"]["train_sizes"]
     head = (f"| world | task | learner | seeds | of optimal, sizes {min(train)}–{max(train)} "
@@ -325,7 +328,8 @@ def worlds_table(results: dict[str, Any]) -> str:
     lines = [head, "|" + "---|" * (8 + len(sizes) - 1)]
     for r in results["summary"]:
         lines.append(
-            f"| {Path(r['world']).stem} | {r['task']} | {r['learner']} | {r['seeds']} | "
+            f"| {text(Path(r['world']).stem)} | {text(r['task'])} | {text(r['learner'])} | "
+            f"{r['seeds']} | "
             f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
             + " | ".join(_f(r["test"][str(s)]["optimality"]) for s in sizes)
             + f" | {_f(r['episodes_to_095'], 0)} | {_f(r['memory_positions'], 0)} |")

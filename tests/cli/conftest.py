@@ -94,6 +94,8 @@ def corpus(tmp_path_factory) -> Path:
         (d / name).write_text(text)
     hostile_policies(d)
     hostile_tomls(d)
+    hostile_runs(d)
+    hostile_sessions(d)
     head = (ROOT / "examples" / "heads" / "wha8030.toml").read_text()
     (d / "nul_scripts.toml").write_text(
         head.replace("[head]\n", '[head]\nscripts = "more\\u0000.toml"\n', 1))
@@ -104,6 +106,77 @@ def corpus(tmp_path_factory) -> Path:
     run_episode(parse_episode(episode_text(steps=30), d / "tree.toml"),
                 RunOptions(out=d / "tree-run", plots=False))
     return d
+
+
+def small_results(name: str) -> dict:
+    """A shipped run's results.json with its lists cut to two items and its jobs and
+    resolved settings left out (what no view renders): the same shape, small enough to write
+    many times."""
+    import json
+
+    unread = ("jobs", "worlds", "caregiver_resolved", "eval_caregiver_resolved")
+
+    def cut(value):
+        if isinstance(value, dict):
+            return {k: cut(v) for k, v in value.items() if k not in unread}
+        if isinstance(value, list):
+            return [cut(v) for v in value[:2]] if len(value) > 2 else [cut(v) for v in value]
+        return value
+
+    return cut(json.loads((ROOT / "docs" / "results" / name / "results.json").read_text()))
+
+
+def hostile_sessions(d: Path) -> None:
+    """Sessions recorded as folders of frames (``relrl migrate``) whose session.json says a
+    duration that is no number of seconds, or a clock before 1970; an event with no time."""
+    sessions = {"nan": '{"seconds": NaN}', "1e300": '{"seconds": 1e300}',
+                "text": '{"seconds": "3"}', "1960": '{"seconds": 3, "recorded": '
+                                                    '"1960-03-02T10:14:05+0000"}'}
+    for name, manifest in {**sessions, "event": "{}"}.items():
+        (d / f"old_{name}").mkdir()
+        (d / f"old_{name}" / "trace.jsonl").write_text('{"t": 1}\n{"t": 2}\n')
+        (d / f"old_{name}" / "session.json").write_text(manifest)
+    (d / "old_event" / "events.jsonl").write_text('{"kind": "evaluation"}\n')
+
+
+def hostile_runs(d: Path) -> None:
+    """Run folders and Markdown files for ``relrl report``: a results.json with no config,
+    an experiment relrl does not render, block markers leading out of the document's tree
+    (``..``, an absolute path, a link), and names that are HTML."""
+    import json
+
+    def run(name: str, results: dict, records: dict | None = None) -> None:
+        (d / name).mkdir()
+        for file, data in {"results.json": results, **(records or {})}.items():
+            (d / name / file).write_text(json.dumps(data))
+
+    sis = small_results("exp1")
+    run("run_no_config", {k: v for k, v in sis.items() if k != "config"})
+    run("run_points_text", {**sis, "config": {**sis["config"], "points": "20"}})
+    run("run_unknown_kind", {"experiment": "nope", "summary": {}})
+    run("run_key_newline", {**sis, "summary": {"etg\nFAKE LINE": {"curve": "z"}}})
+    for name, config in {"points_float": {"points": 2.5}, "points_true": {"points": True},
+                         "sizes_text": {"sizes": [5, "9"]}}.items():
+        (d / f"config_{name}.json").write_text(json.dumps(config))
+    evil = "<script>alert(1)</script>"
+    worlds = small_results("worlds")
+    worlds["summary"][0]["task"] = f"{evil}|<img src=x onerror=alert(1)>\n# heading"
+    run("run_html", worlds, {".relrl-run.json": {
+        "command": "relrl `x` <!-- /relrl-report -->\n| a |"}})
+    (d / "run_html" / "f) ![x](javascript:alert(1).png").write_bytes(b"")
+    docs = {"md_traversal.md": "../../../../etc", "md_absolute.md": "/etc",
+            "md_link.md": "linked_run", "md_results_link.md": "run_results_link",
+            "md_space.md": "a-->b"}
+    for name, path in docs.items():
+        (d / name).write_text(f"# doc\n\n<!-- relrl-report {path} summary -->\n"
+                              "<!-- /relrl-report -->\n")
+    (d / "linked_run").symlink_to(ROOT / "docs" / "results" / "exp1")
+    (d / "latin1.md").write_bytes("# doc\n\ncaf\xe9\n".encode("latin-1"))
+    (d / "run_dev_zero").mkdir()
+    (d / "run_dev_zero" / "results.json").symlink_to("/dev/zero")
+    (d / "run_results_link").mkdir()
+    (d / "run_results_link" / "results.json").symlink_to(
+        ROOT / "docs" / "results" / "exp1" / "results.json")
 
 
 def hostile_tomls(d: Path) -> None:
@@ -185,6 +258,14 @@ def hostile_policies(d: Path) -> None:
                                            "leaf(3, 2.0, 1))).\n")
     (d / "t_id1e9.pl").write_text(tg_head + "tg_tree(node(1, [sees(object)], [], "
                                             "leaf(1000000000, 1.0, 1), leaf(3, 2.0, 1))).\n")
+    # a second tree after the first: refused at its line, not one of the two restored
+    (d / "t_twice.pl").write_text(good["tg"] + "tg_tree(leaf(1, 0.0, 0)).\n")
+    # a byte that is not UTF-8, in a comment (Prolog's reader passes it silently)
+    (d / "p_latin1_comment.pl").write_bytes(good["etg"].encode() + "% caf\xe9\n".encode(
+        "latin-1"))
+    blocks = (ROOT / "examples" / "worlds" / "blocks.pl").read_bytes()
+    (d / "w_latin1_comment.pl").write_bytes("% caf\xe9\n".encode("latin-1") + blocks)
+    (d / "load_dir.toml").write_text(episode_text(head='learner = "etg"\npolicy_load = "adir"'))
     with np.load(d / "good_qlearning.npz") as table:
         arrays = {k: table[k] for k in table.files}
     arrays["q"] = arrays["q"].copy()

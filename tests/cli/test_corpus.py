@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 231 cases: 165 bad inputs in ``CASES`` and 23 more tests here, 26 in
+The corpus holds 273 cases: 198 bad inputs in ``CASES`` and 32 more tests here, 26 in
 ``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -57,6 +57,21 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("experiment-unknown-learner", EXP + ["--learners", "nope"], ["nope"]),
     ("experiment-nan-param", EXP + ["--param", "etg.q_init=nan"], ["q_init", "nan"]),
     ("experiment-inf-param", EXP + ["--param", "etg.alpha=inf"], ["alpha", "inf"]),
+    ("experiment-eval-runs-1e30", EXP + ["--eval-runs", str(10**30)],
+     ["--eval-runs", "at most 1,000,000,000"]),
+    ("experiment-points-1e30", EXP + ["--points", str(10**30)], ["--points", "1,000,000,000"]),
+    ("experiment-config-points-a-string", ["experiment", "sis", "--config",
+                                           "{d}/run_points_text/results.json"],
+     ["run_points_text/results.json", 'config.points is "20" (a string)', "an integer"]),
+    ("experiment-config-points-2.5", ["experiment", "sis", "--config",
+                                      "{d}/config_points_float.json"],
+     ["config_points_float.json", "config.points is 2.5", "an integer"]),
+    ("experiment-config-points-true", ["experiment", "sis", "--config",
+                                       "{d}/config_points_true.json"],
+     ["config_points_true.json", "config.points is true", "an integer"]),
+    ("experiment-config-sizes-text", ["experiment", "scaling", "--config",
+                                      "{d}/config_sizes_text.json"],
+     ["config_sizes_text.json", "config.sizes", "a list of integers"]),
     # ---- run -------------------------------------------------------------------------------
     ("run-missing", ["run", "{d}/nope.toml"], ["nope.toml"]),
     ("run-directory", ["run", "{d}/adir"], ["adir"]),
@@ -182,6 +197,15 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("migrate-missing", ["migrate", "{d}/nope"], ["nope", "no such folder"]),
     ("report-missing", ["report", "{d}/nope"], ["nope", "not a run folder"]),
     ("migrate-a-file", ["migrate", "{d}/afile"], ["afile"]),
+    ("migrate-seconds-nan", ["migrate", "{d}/old_nan"], ["old_nan/session.json", "seconds",
+                                                         "NaN"]),
+    ("migrate-seconds-1e300", ["migrate", "{d}/old_1e300"],
+     ["old_1e300/session.json", "seconds", "1e+300"]),
+    ("migrate-seconds-text", ["migrate", "{d}/old_text"], ["old_text/session.json", "'3'"]),
+    ("migrate-recorded-1960", ["migrate", "{d}/old_1960"],
+     ["old_1960/session.json", "1960-03-02", "outside 1970"]),
+    ("migrate-event-without-t", ["migrate", "{d}/old_event"],
+     ["old_event/events.jsonl", "event 1 has no t"]),
     ("tree-missing", ["tree", "{d}/nope.pl", "--domain", "{fruits}"], ["nope.pl"]),
     ("tree-no-domain", ["tree", "{d}/afile"], ["domain.pl", "--domain"]),
     ("tree-random-bytes", ["tree", "{d}/random.toml", "--domain", "{fruits}"],
@@ -237,6 +261,25 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["p_cycle.pl:", "a cycle"]),
     ("run-policy-load-halt", ["run", "{d}/load_halt.toml", "--out", "{d}/out-halt"],
      ["p_halt.pl:", "halt is not a response"]),
+    ("tree-policy-tg-tree-twice", ["tree", "{d}/t_twice.pl", "--domain", "{fruits}"],
+     ["t_twice.pl:", "a second tg_tree/1", "the first is on line"]),
+    ("shell-policy-latin1-comment", ["shell", "{fruits}", "--policy",
+                                     "{d}/p_latin1_comment.pl"],
+     ["p_latin1_comment.pl:", "byte 0xe9 is not UTF-8"]),
+    ("learn-world-latin1-comment", ["learn", "{d}/w_latin1_comment.pl", "--task", "stack"],
+     ["w_latin1_comment.pl:1:", "byte 0xe9 is not UTF-8"]),
+    ("shell-policy-dev-zero", ["shell", "{fruits}", "--policy", "/dev/zero"],
+     ["/dev/zero", "not a regular file"]),
+    ("shell-policy-folder", ["shell", "{fruits}", "--policy", "{d}/adir"],
+     ["adir", "a folder, not a policy file"]),
+    ("tree-policy-dev-zero", ["tree", "/dev/zero", "--domain", "{fruits}"],
+     ["/dev/zero", "not a regular file"]),
+    ("learn-policy-folder", LEARN + ["--policy", "{d}/adir"], ["adir", "a folder"]),
+    ("run-policy-load-folder", ["run", "{d}/load_dir.toml", "--check"],
+     ["load_dir.toml:", "'adir' is a folder"]),
+    ("experiment-worlds-task-with-arguments", ["experiment", "worlds", "--worlds", BLOCKS,
+                                               "--tasks", "stack,fly(b1,b2)"],
+     ["fly(b1,b2)", "no such task"]),
     # ---- TOML nested 3,000 deep, or a device (conftest.hostile_tomls) ----------------------
     ("run-nested-arrays", ["run", "{d}/deep_array.toml"],
      ["deep_array.toml:", "nested more than 32 deep"]),
@@ -285,6 +328,32 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("report-random-bytes", ["report", "{d}/random.toml"], ["random.toml", "run folder"]),
     ("report-missing-markdown", ["report", "--check", "{d}/nope.md"], ["nope.md"]),
     ("report-out-dir", ["report", "{d}/adir", "--out", "{d}/adir"], ["adir"]),
+    ("report-no-config", ["report", "{d}/run_no_config"],
+     ["run_no_config/results.json", "no config"]),
+    ("report-points-a-string", ["report", "{d}/run_points_text"],
+     ["run_points_text/results.json", 'config.points is "20" (a string)', "an integer"]),
+    ("report-markdown-latin1", ["report", "--check", "{d}/latin1.md"],
+     ["latin1.md:3", "byte 0xe9 is not UTF-8"]),
+    ("report-markdown-a-folder", ["report", "--update", "{d}/adir"],
+     ["adir", "not a regular file"]),
+    ("report-key-with-a-newline", ["report", "{d}/run_key_newline"],
+     ['summary."etg\\nFAKE LINE".curve is "z"']),
+    ("report-results-dev-zero", ["report", "{d}/run_dev_zero"],
+     ["run_dev_zero/results.json", "not a regular file"]),
+    ("report-unknown-experiment", ["report", "{d}/run_unknown_kind"],
+     ["run_unknown_kind/results.json", '"nope"', "not one relrl report renders"]),
+    ("report-marker-traversal", ["report", "--check", "{d}/md_traversal.md"],
+     ["md_traversal.md:3", "../../../../etc", "leads outside"]),
+    ("report-marker-absolute", ["report", "--update", "{d}/md_absolute.md"],
+     ["md_absolute.md:3", "'/etc'", "relative path"]),
+    ("report-marker-link-out", ["report", "--check", "{d}/md_link.md"],
+     ["md_link.md:3", "linked_run", "leads outside"]),
+    ("report-marker-results-link-out", ["report", "--check", "{d}/md_results_link.md"],
+     ["md_results_link.md:3", "run_results_link/results.json", "leads outside"]),
+    ("report-marker-ends-the-comment", ["report", "--check", "{d}/md_space.md"],
+     ["md_space.md:3", "a-->b", "cannot be named in a block"]),
+    ("report-root-missing", ["report", "--check", "{d}/md_space.md", "--root", "{d}/nope"],
+     ["--root", "nope", "no such folder"]),
 ]
 
 
@@ -294,6 +363,89 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]
     needles = [n.format(d=corpus) for n in needles]
     one_line_exit_2(capsys, argv, *needles)
+
+
+def test_report_renders_html_and_markdown_in_a_run_as_text(capsys, corpus):
+    """Names and commands from a run are shown as the characters they are: no HTML tag, no
+    table column or line of their own, no block end, no link with a scheme."""
+    from relrl.report import BLOCK
+
+    assert main(["report", str(corpus / "run_html"), "--out", str(corpus / "html.md")]) == 0
+    page = (corpus / "html.md").read_text()
+    ours = re.compile(r"<!-- /?relrl-report[^\n]*-->$")
+    body = "\n".join(line for line in page.splitlines() if not ours.fullmatch(line))
+    assert re.findall(r"(?<!\\)[<>]", body) == [] and "\n# heading" not in page
+    assert ("\\<script\\>alert(1)\\</script\\>\\|\\<img src=x onerror=alert(1)\\> "
+            "\\# heading") in page
+    assert "made by relrl \\`x\\` \\<\\!-- /relrl-report --\\> \\| a \\| on" in page
+    assert "](./run_html/f%29%20%21%5Bx%5D%28javascript%3Aalert%281%29.png)" in page
+    blocks = list(BLOCK.finditer(page))
+    assert [b["view"] for b in blocks] == ["summary", "cost"]
+    rows = [line for line in blocks[0]["body"].splitlines() if line.startswith("|")]
+    assert any("alert(1)" in line for line in rows)
+    assert len({len(re.findall(r"(?<!\\)\|", line)) for line in rows}) == 1  # same columns
+    assert all(b["body"].rstrip().endswith(".*") for b in blocks)  # each ends at its own end
+    assert main(["report", "--check", str(corpus / "html.md")]) == 0
+
+
+def _paths(value, path=()):
+    """Every key path of a JSON value (a list's first item only)."""
+    yield path
+    items = (value.items() if isinstance(value, dict)
+             else [(0, value[0])] if value and isinstance(value, list) else [])
+    for key, inner in items:
+        yield from _paths(inner, (*path, key))
+
+
+@pytest.mark.parametrize("name", ["exp1", "exp2", "bench", "worlds", "scaling", "transfer"])
+def test_report_on_a_results_json_with_a_key_missing_or_of_another_type(tmp_path, name):
+    """Every key of a shipped run's results.json taken out, or made a string, null or a
+    list, in turn: each view renders, or says in one line which file and key
+    is wrong (the run is checked once, when loaded); never a traceback."""
+    import json
+
+    from relrl.errors import UserError
+    from relrl.report import VIEWS, load_run, render
+    from tests.cli.conftest import small_results
+
+    results = small_results(name)
+    whole = json.dumps(results)
+    views = [v for kind, v in VIEWS if kind == results["experiment"]]
+    refused = 0
+    for path in list(_paths(results))[1:]:
+        for swap in ("missing", "20", None, []):
+            data = json.loads(whole)
+            *up, last = path
+            parent = data
+            for key in up:
+                parent = parent[key]
+            if swap == "missing":
+                if isinstance(parent, list):
+                    continue
+                del parent[last]
+            else:
+                parent[last] = swap
+            (tmp_path / "results.json").write_text(json.dumps(data))
+            try:
+                run = load_run(tmp_path)
+                for v in views:
+                    render(run, v)
+            except UserError as exc:
+                assert "\n" not in str(exc) and str(exc).startswith(str(tmp_path)), exc
+                refused += 1
+    assert refused > 0
+
+
+@pytest.mark.parametrize("name, words", [
+    ("t_twice.pl", "a second tg_tree/1 (the first is on line {first})"),
+    ("p_latin1_comment.pl", "byte 0xe9 is not UTF-8")])
+def test_a_policy_refusal_names_the_line_at_fault(capsys, corpus, name, words):
+    """The second tree is the last line of t_twice.pl (the first, the line holding
+    ``tg_tree(`` before it); the byte in a comment is on p_latin1_comment.pl's last line."""
+    lines = (corpus / name).read_bytes().split(b"\n")[:-1]
+    first = next((i for i, x in enumerate(lines, 1) if x.startswith(b"tg_tree(")), 0)
+    line = one_line_exit_2(capsys, ["shell", str(FRUITS), "--policy", str(corpus / name)])
+    assert f"{corpus / name}:{len(lines)}: {words.format(first=first)}" in line
 
 
 def test_every_subcommand_is_in_the_corpus():

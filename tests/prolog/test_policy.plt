@@ -196,3 +196,21 @@ test(learned_rule_twice) :-
     assertion(sub_string(Message, 0, _, _, "this learned rule is given twice")).
 
 :- end_tests(contingency_policy).
+
+% ---------------------------------------------------------------------------------------
+:- begin_tests(policy_once).
+
+test(trees_are_declared_once) :-
+    policy_once(tg_tree(_)),
+    policy_once(ptg_tree(_)).
+
+test(second_tree_named_at_its_line,
+     [error(relrl_policy_error(f, 7, "a second tg_tree/1 (the first is on line 3): a policy \c
+                                     holds one"))]) :-
+    relrl_policy:once_only(f, tg_tree(_), [1-relrl_policy(tg, []), 3-tg_tree(leaf(1, 0.0, 0)),
+                                          5-q(a, b, c), 7-tg_tree(leaf(1, 0.0, 0))]).
+
+test(one_tree_passes) :-
+    relrl_policy:once_only(f, tg_tree(_), [3-tg_tree(leaf(1, 0.0, 0)), 5-q(a, b, c)]).
+
+:- end_tests(policy_once).

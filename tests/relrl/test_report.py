@@ -62,10 +62,18 @@ def test_blocks_are_rerendered_in_place_and_staleness_is_found(sis_run: Path,
 
 
 def test_a_results_page_holds_every_view(sis_run: Path, tmp_path: Path) -> None:
+    """The page's blocks name runs inside its tree (``--root``, else the git work tree or its
+    folder): a run elsewhere is refused when the page is written, not when it is updated."""
+    shutil.copytree(sis_run, tmp_path / "runs" / "exp1")
     out = tmp_path / "docs" / "results.md"
-    assert main(["report", str(sis_run), "--out", str(out)]) == 0
-    assert stale_blocks(out) == []
-    assert "<!-- relrl-report" in out.read_text() and "fig5_cgi.png" in out.read_text()
+    assert main(["report", str(tmp_path / "runs" / "exp1"), "--out", str(out)]) == 2
+    assert not out.exists()
+    assert main(["report", str(tmp_path / "runs" / "exp1"), "--out", str(out),
+                 "--root", str(tmp_path)]) == 0
+    assert stale_blocks(out, tmp_path) == []
+    assert "<!-- relrl-report ../runs/exp1 summary" in out.read_text()
+    assert "](../runs/exp1/fig5_cgi.png)" in out.read_text()
+    assert main(["report", "--check", str(out), "--root", str(tmp_path)]) == 0
 
 
 @pytest.mark.parametrize("content, words", [
