@@ -148,9 +148,11 @@ class Prolog:
         self._check_thread()
         mark = c_size_t()
         self.lib.mark_string_buffers(byref(mark))
+        outer, self.marshal.mark = self.marshal.mark, mark
         try:
             yield
         finally:
+            self.marshal.mark = outer
             self.lib.release_string_buffers_from_mark(mark.value)
             self._flush()
 
