@@ -3,8 +3,11 @@
             error_result/2,       % +Exception, -Result
             halt_message/2,       % +Where, -Message
             gw_take_abort/1,      % -Where
-            text_failed/1         % +Error
+            text_failed/1,        % +Error
+            progress_watch/2,     % +Limit, :Goal
+            progress_mark/0
           ]).
+:- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(prolog_wrap)).
@@ -27,11 +30,13 @@ raises a Prolog signal in this thread while a call runs too long (vtalrm) or the
 presses Ctrl-C (usr1). The handlers below throw `time_limit_exceeded`, as
 call_with_time_limit/2's alarm does, or `relrl_interrupted`, inside the running goal; a
 signal that arrives when no guarded call runs (it was raised as the call returned) does
-nothing. The host deregisters the OS handlers of both signals: only Prolog's signal table
+nothing. Under progress_watch/2 (a batch of a world's episodes, which may rightly run for
+an hour) the limit is the time since the last progress_mark/0 (a world's step): a rule
+that loops is stopped once it has run Limit seconds, however long the batch. The host deregisters the OS handlers of both signals: only Prolog's signal table
 knows them.
 */
 
-:- meta_predicate guarded(0, -), once_result(0, -).
+:- meta_predicate guarded(0, -), once_result(0, -), progress_watch(+, 0).
 
 %!  guarded(:Goal, -Result) is det.
 %
@@ -131,15 +136,53 @@ load_location(Where) :-
 :- initialization(on_signal(vtalrm, _, relrl_guard:time_up)).
 :- initialization(on_signal(usr1, _, relrl_guard:interrupt)).
 
-%   The running call's time limit passed: remember where a file being loaded was (a
-%   directive that never ends), then throw as call_with_time_limit/2 does.
+%   The running call's time limit passed (under progress_watch/2: the signal comes every
+%   tenth of a second): remember where a file being loaded was (a directive that never
+%   ends), then throw as call_with_time_limit/2 does.
 time_up(_Signal) :-
-    (   nb_current(relrl_active, true)
+    (   nb_current(relrl_active, true),
+        \+ progressing
     ->  load_location(Where),
         nb_setval(relrl_timeout_where, Where),
         throw(time_limit_exceeded)
     ;   true
     ).
+
+%   Under progress_watch/2, true while the last progress mark seen is younger than the
+%   limit (a mark made since the last look counts from now).
+progressing :-
+    nb_current(relrl_watch, watch(Limit, Seen, Since)),
+    flag(relrl_progress, N, N),
+    get_time(Now),
+    (   N =\= Seen
+    ->  nb_setval(relrl_watch, watch(Limit, N, Now))
+    ;   Now - Since < Limit
+    ).
+
+%!  progress_watch(+Limit:number, :Goal) is semidet.
+%
+%   Run Goal once, with the time limit of the call it runs in (the host arms it to signal
+%   every tenth of a second) counted from the last progress_mark/0 instead of from the
+%   start: Goal is stopped with `time_limit_exceeded` once Limit seconds pass with no mark.
+
+progress_watch(Limit, Goal) :-
+    must_be(number, Limit),
+    (   Limit > 0
+    ->  true
+    ;   domain_error(positive_number, Limit)
+    ),
+    flag(relrl_progress, N, N),
+    get_time(Now),
+    setup_call_cleanup(nb_setval(relrl_watch, watch(Limit, N, Now)),
+                       once(Goal),
+                       nb_setval(relrl_watch, none)).
+
+%!  progress_mark is det.
+%
+%   A unit of work (a world's step) has ended: progress_watch/2 counts its limit from now.
+
+progress_mark :-
+    flag(relrl_progress, N, N + 1).
 
 interrupt(_Signal) :-
     (   nb_current(relrl_active, true)

@@ -237,7 +237,14 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
     ;   Reached == true
     ->  R = 1
     ;   R = 0
-    ).
+    ),
+    progress.
+
+%   A step of the world is done: the gateway's time limit of a batch of episodes counts
+%   from here (relrl_guard:progress_watch/2 reads this flag), so a rule that loops is
+%   stopped after the limit however long the batch runs.
+progress :-
+    flag(relrl_progress, N, N + 1).
 
 %!  world_view(+KB, +Goal, +State, -View:list) is det.
 %
@@ -339,7 +346,7 @@ episode(Run, Task, Sizes, ep(Size, Goal, Steps, Return, Reached, Optimal, Trace)
     world_actions(KB, S0, A0),
     steps(Run, Goal, S0, V0, A0, 0, Bound, 0, Steps, Return, Reached, [], Examples, Trace),
     (   Run = run(_, Learner, learn, episode, _, _)
-    ->  forall(member(T, Examples), learner_update(Learner, KB, T))
+    ->  forall(member(T, Examples), ( learner_update(Learner, KB, T), progress ))
     ;   true
     ).
 

@@ -34,6 +34,30 @@ def _sizes(text: str, option: str) -> list[int]:
     return sizes
 
 
+def _seconds(text: str) -> float:
+    """A positive, finite number of seconds (``--rule-seconds``)."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, not {text!r}")
+    return value
+
+
+def add_rule_seconds(parser: argparse.ArgumentParser) -> None:
+    """``--rule-seconds S``: how long a rule of a world may run (relrl learn, relrl check
+    --world, relrl experiment worlds)."""
+    from relrl.worlds.world import RULE_SECONDS
+
+    parser.add_argument("--rule-seconds", type=_seconds, default=RULE_SECONDS, metavar="S",
+                        help=f"stop a rule of the world that runs S seconds, naming it "
+                             f"(default {RULE_SECONDS:g}; a batch of episodes runs as long "
+                             "as its steps end)")
+
+
 def _param(text: str) -> tuple[str, float]:
     try:
         key, value = text.split("=", 1)
@@ -67,6 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eval-episodes", type=int, default=100,
                         help="greedy episodes per evaluation and per evaluation size (100)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    add_rule_seconds(parser)
     parser.add_argument("--param", type=_param, action="append", default=[],
                         metavar="NAME=X", help="learner parameter (repeatable)")
     parser.add_argument("--updates", choices=["episode", "online"], default="episode",
@@ -101,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     if not path.is_file():
         raise ConfigError(f"{args.world}: no such world file")
     make_world_learner(args.learner, **dict(args.param))          # validate before loading
-    with World(path) as world:
+    with World(path, rule_seconds=args.rule_seconds) as world:
         problems = world.problems()
         if problems:
             raise ConfigError("\n".join([*problems, f"{len(problems)} problem"
@@ -132,7 +157,8 @@ def run(args: argparse.Namespace) -> int:
                          params=params, train_sizes=train, test_sizes=test,
                          episodes=args.episodes, block=block,
                          eval_episodes=args.eval_episodes, seed=args.seed,
-                         updates=args.updates, speed=not args.no_speed)
+                         updates=args.updates, speed=not args.no_speed,
+                         rule_seconds=args.rule_seconds)
 
     def show(event: dict) -> None:
         e = event["entry"]

@@ -29,6 +29,7 @@ from relrl.learners import WORLDS, learners
 from relrl.machine import machine_info
 from relrl.outdir import write_atomic, write_json_atomic
 from relrl.worlds.learn import LearnConfig, learn_task
+from relrl.worlds.world import RULE_SECONDS
 
 __all__ = ["OUTPUTS", "WorldsConfig", "run_worlds", "run_worlds_job", "worlds_table"]
 
@@ -55,6 +56,7 @@ class WorldsConfig:
     updates: str = "episode"
     verify_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
     verify_states: int = 30
+    rule_seconds: float = RULE_SECONDS      #: how long a rule of a world may run
 
     def jobs(self) -> list[tuple[str, str, str, int]]:
         """Every (world, task, learner, seed) job."""
@@ -68,7 +70,7 @@ class WorldsConfig:
                            train_sizes=list(self.train_sizes),
                            test_sizes=list(self.test_sizes), episodes=self.episodes,
                            block=self.block, eval_episodes=self.eval_episodes, seed=seed,
-                           updates=self.updates)
+                           updates=self.updates, rule_seconds=self.rule_seconds)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (world files by name: the folder is the machine's)."""
@@ -98,7 +100,7 @@ def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = Non
     from relrl.worlds.world import World
 
     rows = []
-    with World(world) as w:
+    with World(world, rule_seconds=config.rule_seconds) as w:
         if not w.optimal_known:
             return {"world": Path(world).name, "task": task, "rows": [], "stated": False}
         w.attach(make_world_learner("qtable"), 0)

@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from relrl.worlds.world import World, score
+from relrl.worlds.world import RULE_SECONDS, World, score
 
 __all__ = ["LearnConfig", "learn_task", "step_cost_by_size"]
 
@@ -46,6 +46,7 @@ class LearnConfig:
     seed: int = 0
     updates: str = "episode"                #: episode (RRL's) or online
     speed: bool = True                      #: measure the step cost by size and the shape
+    rule_seconds: float = RULE_SECONDS      #: how long a rule of the world may run
     cost_sizes: list[int] = field(default_factory=list)   #: default: train + test sizes
 
     def to_dict(self) -> dict[str, Any]:
@@ -74,7 +75,7 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
     ``memory``, ``timing`` (wall-clock figures; the caller keeps them out of results.json)
     and, with ``traces``, ``traces``.
     """
-    with World(config.world) as world:
+    with World(config.world, rule_seconds=config.rule_seconds) as world:
         task = world.task(config.task)
         learner = world.learner(config.learner, **config.params)
         world.attach(learner, config.seed, task)
