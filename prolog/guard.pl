@@ -27,7 +27,7 @@ is noted for gw_take_abort/1 on its way out.
 
 The time limit and Ctrl-C come from the host (relrl/bridge/deadline.py): a watchdog thread
 raises a Prolog signal in this thread while a call runs too long (vtalrm) or the user
-presses Ctrl-C (usr1). The handlers below throw `time_limit_exceeded`, as
+presses Ctrl-C (usr1), and ticks a watched call (prof). The handlers below throw `time_limit_exceeded`, as
 call_with_time_limit/2's alarm does, or `relrl_interrupted`, inside the running goal; a
 signal that arrives when no guarded call runs (it was raised as the call returned) does
 nothing. Under progress_watch/2 (a batch of a world's episodes, which may rightly run for
@@ -135,35 +135,40 @@ load_location(Where) :-
 
 :- initialization(on_signal(vtalrm, _, relrl_guard:time_up)).
 :- initialization(on_signal(usr1, _, relrl_guard:interrupt)).
+:- initialization(on_signal(prof, _, relrl_guard:tick)).
 
-%   The running call's time limit passed (under progress_watch/2: the signal comes every
-%   tenth of a second): remember where a file being loaded was (a directive that never
-%   ends), then throw as call_with_time_limit/2 does.
+%   The running call's time limit passed: remember where a file being loaded was (a
+%   directive that never ends), then throw as call_with_time_limit/2 does.
 time_up(_Signal) :-
-    (   nb_current(relrl_active, true),
-        \+ progressing
+    (   nb_current(relrl_active, true)
     ->  load_location(Where),
         nb_setval(relrl_timeout_where, Where),
         throw(time_limit_exceeded)
     ;   true
     ).
 
-%   Under progress_watch/2, true while the last progress mark seen is younger than the
-%   limit (a mark made since the last look counts from now).
-progressing :-
-    nb_current(relrl_watch, watch(Limit, Seen, Since)),
-    flag(relrl_progress, N, N),
-    get_time(Now),
-    (   N =\= Seen
-    ->  nb_setval(relrl_watch, watch(Limit, N, Now))
-    ;   Now - Since < Limit
+%   A watched call's tick (every tenth of a second): throw as time_up/1 does once the
+%   watched goal has run its limit since its last progress mark; nothing outside the goal
+%   (the moments before progress_watch/2 sets the watch and after it ends).
+tick(_Signal) :-
+    (   nb_current(relrl_active, true),
+        nb_current(relrl_watch, watch(Limit, Seen, Since)),
+        flag(relrl_progress, N, N),
+        get_time(Now),
+        (   N =\= Seen
+        ->  nb_setval(relrl_watch, watch(Limit, N, Now)),
+            fail
+        ;   Now - Since >= Limit
+        )
+    ->  throw(time_limit_exceeded)
+    ;   true
     ).
 
 %!  progress_watch(+Limit:number, :Goal) is semidet.
 %
-%   Run Goal once, with the time limit of the call it runs in (the host arms it to signal
-%   every tenth of a second) counted from the last progress_mark/0 instead of from the
-%   start: Goal is stopped with `time_limit_exceeded` once Limit seconds pass with no mark.
+%   Run Goal once, stopped with `time_limit_exceeded` once Limit seconds pass with no
+%   progress_mark/0 (the host raises the prof signal every tenth of a second while the
+%   call runs: relrl/bridge/deadline.py, SIG_TICK).
 
 progress_watch(Limit, Goal) :-
     must_be(number, Limit),

@@ -36,12 +36,15 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["Watchdog", "SIG_TIME", "SIG_INTERRUPT"]
+__all__ = ["Watchdog", "SIG_TIME", "SIG_INTERRUPT", "SIG_TICK"]
 
 #: The Prolog signals the watchdog raises (numbers of Prolog's signal table; the OS does
 #: not deliver them: see :mod:`relrl.bridge.lib`).
 SIG_TIME = int(signal.SIGVTALRM)
 SIG_INTERRUPT = int(signal.SIGUSR1)
+#: The signal of a watched call (:meth:`Watchdog.arm` with ``tick``): raised every
+#: :data:`RAISE_AGAIN` seconds, Prolog's handler decides (prolog/guard.pl, progress_watch/2).
+SIG_TICK = int(signal.SIGPROF)
 #: Seconds between raises while a call runs past its deadline: a signal taken before the
 #: guard of the call was entered does nothing, the next one stops the goal.
 RAISE_AGAIN = 0.1
@@ -64,6 +67,7 @@ class Watchdog:
         self._lock = threading.Lock()
         self._deadline: float | None = None     # the running call's; None between calls
         self._raised = False                    # a signal was raised for the running call
+        self._signal = SIG_TIME                 # what the running call's deadline raises
         self._stop = False                      # a stop signal came while the call ran
         self._shortest = 10.0                   # the shortest limit so far: the idle sleep
         self._wake_at = math.inf                # when the thread wakes next
@@ -73,12 +77,17 @@ class Watchdog:
             os.set_blocking(fd, False)
         threading.Thread(target=self._watch, name="relrl-watchdog", daemon=True).start()
 
-    def arm(self, limit: float | None) -> None:
-        """A call with a time limit of ``limit`` seconds (0 or None: none) starts."""
+    def arm(self, limit: float | None, *, tick: bool = False) -> None:
+        """A call with a time limit of ``limit`` seconds (0 or None: none) starts; with
+        ``tick``, a watched call: :data:`SIG_TICK` every :data:`RAISE_AGAIN` seconds instead,
+        Prolog's handler holding the limit (it counts from the call's last progress)."""
         now = time.monotonic()
+        if tick:
+            limit = RAISE_AGAIN
         deadline = now + limit if limit and limit > 0 else math.inf
         with self._lock:
             self._deadline = deadline
+            self._signal = SIG_TICK if tick else SIG_TIME
             self._raised = self._stop = False
         if deadline < self._wake_at:            # sooner than the thread looks next
             self._shortest = min(self._shortest, limit)
@@ -126,7 +135,7 @@ class Watchdog:
                     deadline = now + RAISE_AGAIN
                 elif deadline is not None and now >= deadline:
                     self._raised = True
-                    self._raise(SIG_TIME)
+                    self._raise(self._signal)
                     deadline = now + RAISE_AGAIN      # until the call ends
                 elif deadline is None or deadline == math.inf:
                     deadline = now + self._shortest    # a call armed meanwhile ends later

@@ -8,7 +8,9 @@ world's stated optimum (optimal_steps/3) is checked against a breadth-first sear
 start states of the small sizes, and the check is written with the results.
 
 Files: ``results.json`` (every number and the configuration; ``"partial": true`` when
-stopped early), ``timing.json`` (wall clock, steps/s, the CPU cost of a step by size and its log-log
+stopped early, with the evaluation points of each job that had not finished, marked
+partial, among the jobs and in curves.csv, and the summary of the jobs that finished),
+``timing.json`` (wall clock, steps/s, the CPU cost of a step by size and its log-log
 slope), ``summary.csv``
 (per world, task and learner: the mean over seeds), ``curves.csv``, ``test.csv``,
 ``step_cost.csv``, ``optimal_check.csv``, ``curves.png``, ``transfer.png``,
@@ -139,8 +141,10 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
                        units=config.episodes // config.block + 1, label=_label)
     jobs, timings, verified = [], [], []
     policies: dict[str, str] = {}
-    for task, result in zip(tasks, outcome.results, strict=True):
+    for task, result, events in zip(tasks, outcome.results, outcome.events, strict=True):
         if result is None:
+            if len(task) != 3:
+                jobs += _unfinished(task, events)
             continue
         if len(task) == 3:
             verified.append(result)
@@ -152,7 +156,8 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
         jobs.append(result)
     results = {"experiment": "worlds", "relrl_version": __version__,
                "config": config.to_dict(), "seeds": config.seeds,
-               "partial": not outcome.complete, "summary": summarize(jobs, config),
+               "partial": not outcome.complete,
+               "summary": summarize([j for j in jobs if not j.get("partial")], config),
                "optimal_check": verified, "jobs": jobs}
     if outcome.interrupted:
         results["interrupted_by"] = outcome.interrupted
@@ -166,6 +171,18 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
     if outcome.error:
         raise_kept(outcome.error, out)
     return results, files
+
+
+def _unfinished(task: tuple, events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A job that did not finish, as the evaluation points it reported (none: nothing),
+    marked ``"partial": true``: in ``jobs`` and curves.csv, not in the summary."""
+    curve = [ev["entry"] for ev in events if ev.get("kind") == "point"]
+    if not curve:
+        return []
+    _, world, name, learner, seed = task
+    return [{"world": Path(world).name, "task": name, "learner": learner, "seed": seed,
+             "curve": curve, "test": {}, "final": curve[-1],
+             "memory": {"positions": curve[-1]["memory_positions"]}, "partial": True}]
 
 
 def _policy_name(job: dict[str, Any]) -> str:

@@ -38,8 +38,6 @@ BFS_LIMIT = 20_000
 #: between two steps, that runs longer is stopped with an error naming the rule. A batch of
 #: episodes, a check or a search runs as long as it makes progress.
 RULE_SECONDS = 10.0
-#: The watchdog's period while a world's goals run: how soon after the limit a rule stops.
-_TICK = 0.1
 
 
 @dataclass(frozen=True)
@@ -264,7 +262,7 @@ class World:
         try:
             with self.kb.interruptible():
                 values = prolog().run((":", watched, (watcher, self.rule_seconds, inner)),
-                                      _TICK, [1])
+                                      self.rule_seconds, [1], watched=True)
         except QueryTimeout as exc:
             limit = (f"ran longer than {self.rule_seconds:g} s (a rule that never ends? "
                      "--rule-seconds sets the limit)")

@@ -161,3 +161,126 @@ def test_experiment_worlds_quick_runs_tg_alone() -> None:
                                                    str(BLOCKS), "--tasks", "stack",
                                                    "--learners", "ptg", "--episodes", "7"]))
     assert (given.learners, given.episodes) == (["ptg"], 7)
+
+
+# ---- B: relrl learn stopped keeps what it learned ------------------------------------------
+
+LONG_LEARN = ("learn", str(BLOCKS), "--task", "stack", "--episodes", "1000000", "--block",
+              "20", "--eval-episodes", "4", "--no-speed")
+
+
+def assert_partial(out: Path, points: int) -> dict:
+    """results.json marked partial with at least ``points`` evaluation points, the policy
+    of the last of them, the folder's record partial."""
+    import json
+
+    from relrl.worlds import World
+
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] and len(results["curve"]) >= points
+    assert results["policy_episodes"] >= results["curve"][-1]["episodes"] >= 20
+    assert (out / "curve.csv").read_text().count("\n") == len(results["curve"]) + 1
+    policy = out / "policy.pl"
+    assert f"(after {results['policy_episodes']} of 1000000" in policy.read_text()
+    with World(BLOCKS) as world:                 # the policy kept loads, as data
+        world.attach(world.learner("tg"), 0, "stack")
+        world.load_policy(policy)
+    record = json.loads((out / ".relrl-run.json").read_text())
+    assert record["status"] == "partial" and "policy.pl" in record["files"]
+    assert not [p.name for p in out.iterdir() if p.name.endswith(".tmp")
+                or p.name in (".relrl-run.files", ".relrl-run.spare")]
+    return results
+
+
+@pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM", "SIGHUP"])
+def test_a_stopped_learn_keeps_its_policy_and_partial_results(tmp_path: Path,
+                                                               signame: str) -> None:
+    import signal
+
+    signum = getattr(signal, signame)
+    out = tmp_path / "out"
+    proc = started(*LONG_LEARN, "--out", str(out))
+    wait_for(proc.stdout, "episodes     40", proc)
+    proc.send_signal(signum)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 128 + signum, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert "interrupted" in lines[0] and "policy.pl (learned from" in lines[0]
+    assert_partial(out, 3)
+
+
+@pytest.mark.parametrize("gap", [0.0, 0.05])
+def test_a_second_ctrl_c_does_not_lose_what_was_learned(tmp_path: Path, gap: float) -> None:
+    import signal
+    import time
+
+    out = tmp_path / "out"
+    proc = started(*LONG_LEARN, "--out", str(out))
+    wait_for(proc.stdout, "episodes     20", proc)
+    proc.send_signal(signal.SIGINT)
+    time.sleep(gap)
+    if proc.poll() is None:
+        proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode in (130, -signal.SIGINT), err
+    assert "policy.pl (learned from" in err and "Traceback" not in err, err
+    assert_partial(out, 2)
+
+
+def test_a_rule_error_mid_run_keeps_the_policy_learned_before_it(tmp_path: Path) -> None:
+    """A rule that fails only on the larger test size: exit 2 naming it, and the policy
+    (saved before that evaluation), the curve and the finished test size are written."""
+    import json
+
+    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- length(S, N), N > 12, "
+                                       "atom_length(S, _).")
+    out = tmp_path / "out"
+    proc = relrl("learn", str(world), "--size", "3", "--eval-sizes", "4,8", "--episodes",
+                 "40", "--block", "20", "--eval-episodes", "3", "--no-speed", "--out",
+                 str(out))
+    message = one_line(proc)
+    assert f"w.pl:{line}: rule precondition(" in message and "atom_length/2" in message
+    assert "policy.pl (learned from 40 of 40 episodes)" in message
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] and f"w.pl:{line}: rule precondition(" in results["error"]
+    assert list(results["test"]) == ["4"] and len(results["curve"]) == 3
+    assert "task stack\n" in (out / "policy.pl").read_text().splitlines(True)[0]
+    assert json.loads((out / ".relrl-run.json").read_text())["status"] == "partial"
+
+
+# ---- J: a stopped relrl experiment worlds keeps every finished evaluation point -------------
+
+def test_a_stopped_experiment_worlds_keeps_every_finished_point(tmp_path: Path,
+                                                               monkeypatch) -> None:
+    """Stopped while its jobs ran (run_jobs as a signal leaves it: no job finished, each
+    reported some points), it writes those points -- jobs and curves.csv -- marked partial,
+    as its last line says."""
+    import csv
+    import json
+
+    import relrl.worlds.experiment as experiment
+    from relrl.experiments.runner import Outcome
+
+    def point(i: int) -> dict:
+        return {"kind": "point", "entry": {
+            "point": i, "episodes": 10 * i, "learning_steps": 40 * i, "optimality": 0.5,
+            "success": 1.0, "memory_positions": 3 + i, "episodes_evaluated": 5}}
+
+    def stopped(fn, tasks, **kwargs) -> Outcome:
+        events = [[] if len(t) == 3 else [point(0), point(1)] for t in tasks]
+        return Outcome([None] * len(tasks), events, interrupted="SIGINT")
+
+    monkeypatch.setattr(experiment, "run_jobs", stopped)
+    config = experiment.WorldsConfig(worlds=[str(BLOCKS)], tasks=["stack"],
+                                     learners=["tg", "ptg"], seeds=[0], episodes=50, block=10)
+    results, _ = experiment.run_worlds(config, tmp_path)
+    assert results["partial"] and results["interrupted_by"] == "SIGINT"
+    assert [(j["learner"], len(j["curve"]), j["partial"]) for j in results["jobs"]] == \
+        [("tg", 2, True), ("ptg", 2, True)]
+    assert results["summary"] == []                     # no job finished
+    saved = json.loads((tmp_path / "results.json").read_text())
+    assert len(saved["jobs"]) == 2
+    rows = list(csv.DictReader((tmp_path / "curves.csv").open()))
+    assert [(r["learner"], r["episodes"]) for r in rows] == \
+        [("tg", "0"), ("tg", "10"), ("ptg", "0"), ("ptg", "10")]
