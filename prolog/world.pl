@@ -14,6 +14,7 @@
             world_defines/2,      % +KB, ?Name/Arity
             world_task/3,         % +KB, +Spec, -Task
             world_verify/5,       % +KB, +Task, +Size, +Count, -Pairs
+            world_reachable/5,    % +KB, +Task, +Size, +Limit, -Verdict
             world_for_task/2      % +KB, +Task
           ]).
 :- use_module(library(error)).
@@ -430,6 +431,15 @@ world_optimal(KB, Goal, State, Limit, Steps) :-
 
 world_bfs(KB, Goal, State, Limit, Steps) :-
     must_be(nonneg, Limit),
+    search(KB, Goal, State, Limit, Steps0),
+    (   Steps0 == exhausted
+    ->  Steps = none
+    ;   Steps = Steps0
+    ).
+
+%   Steps: the least number of actions, `exhausted` when every reachable state was visited
+%   without reaching Goal, `none` when Limit states were visited.
+search(KB, Goal, State, Limit, Steps) :-
     (   holds_goal(KB, Goal, State)
     ->  Steps = 0
     ;   list_to_assoc([State-0], Seen),
@@ -439,7 +449,7 @@ world_bfs(KB, Goal, State, Limit, Steps) :-
 %   Frontier: the states at depth D; Next: those found at depth D + 1 so far.
 bfs([], Next, D, KB, Goal, Seen, N, Limit, Steps) :-
     (   Next == []
-    ->  Steps = none
+    ->  Steps = exhausted
     ;   D1 is D + 1,
         bfs(Next, [], D1, KB, Goal, Seen, N, Limit, Steps)
     ).
@@ -548,6 +558,37 @@ world_task(KB, Spec, Task) :-
         subsumes_term(T, Spec)
     ->  Task = Spec
     ).
+
+%!  world_reachable(+KB, +Task, +Size, +Limit, -Verdict) is det.
+%
+%   Verdict says whether the goal of Task (a task instance: on(b1, b2)) can be reached in
+%   a world of Size objects, by a breadth-first search of at most Limit states from each of
+%   three start states drawn with seed 0 (the generator of no knowledge base):
+%   `reachable` from one of them, `unreachable` when each search visited every state it
+%   could reach, else `unknown`. A task whose goal names an object the world does not
+%   have at that size, or a relation no state can hold (on(b1, b1)), is `unreachable`.
+
+world_reachable(KB, Task, Size, Limit, Verdict) :-
+    must_be(positive_integer, Size),
+    must_be(nonneg, Limit),
+    set_random(seed(0)),
+    findall(V, ( between(1, 3, _),
+                 world_start(KB, Task, Size, S, Goal),
+                 search(KB, Goal, S, Limit, Steps),
+                 reach_verdict(Steps, V) ), Vs),
+    (   memberchk(reachable, Vs)
+    ->  Verdict = reachable
+    ;   Vs = [_|_],
+        forall(member(V, Vs), V == unreachable)
+    ->  Verdict = unreachable
+    ;   Verdict = unknown
+    ).
+
+reach_verdict(Steps, reachable) :-
+    integer(Steps),
+    !.
+reach_verdict(exhausted, unreachable) :- !.
+reach_verdict(_, unknown).
 
 %!  world_verify(+KB, +Task, +Size, +Count, -Pairs:list) is det.
 %

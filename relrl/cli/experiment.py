@@ -498,7 +498,7 @@ def build_worlds_config(args: argparse.Namespace):
                 raise ConfigError("\n".join([*problems, f"{len(problems)} problem(s) in "
                                              f"{path} (relrl check --world {path})"]))
             for task in config.tasks:
-                world.task(task)
+                world.check_instance(task, [*config.train_sizes, *config.test_sizes])
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     return config

@@ -140,11 +140,13 @@ def run(args: argparse.Namespace) -> int:
         task_text = args.task or world.task_names()[0].split("(")[0]
         world.task(task_text)                                     # validate now
         train = ([args.size] if args.size is not None else
-                 _sizes(args.sizes, "--sizes") if args.sizes else world.train_sizes)
+                 _sizes(args.sizes, "--sizes") if args.sizes is not None
+                 else world.train_sizes)
         if args.size is not None and args.size < 1:
             raise ConfigError(f"--size must be at least 1, not {args.size}")
-        test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes
+        test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes is not None
                 else world.test_sizes)
+        world.check_instance(task_text, [*train, *test])
     if args.size is not None and args.sizes:
         raise ConfigError("give --size or --sizes, not both")
     if args.episodes < 0 or (args.episodes == 0 and not args.policy):

@@ -34,6 +34,9 @@ __all__ = ["Episode", "World", "score"]
 #: Breadth-first search bound (states) for the optimal number of steps of a world that
 #: does not state it (optimal_steps/3).
 BFS_LIMIT = 20_000
+#: States a search visits, from each start state, to tell a task instance whose goal cannot
+#: be reached (:meth:`World.check_instance`).
+REACH_LIMIT = 2_000
 #: Seconds a world's rule may run (``--rule-seconds``): a step of the world, or a goal of it
 #: between two steps, that runs longer is stopped with an error naming the rule. A batch of
 #: episodes, a check or a search runs as long as it makes progress.
@@ -169,6 +172,29 @@ class World:
                               f"{_display_path(str(self.path))} (tasks: "
                               f"{', '.join(self.task_names())})")
         return out[0]
+
+    def check_instance(self, text: str, sizes: Sequence[int]) -> None:
+        """Refuse a task instance (``on(b1, b2)``; a task's name passes) whose goal cannot be
+        reached at one of ``sizes``: an object the world does not have (``on(b1, b99)``,
+        ``on(b1, shell(x))``) or a goal no state holds (``on(b1, b1)``), found by a
+        breadth-first search of at most :data:`REACH_LIMIT` states (larger sizes pass).
+
+        Raises:
+            ConfigError: naming the task and the size.
+        """
+        text = text.strip()
+        if re.fullmatch(r"[a-z][A-Za-z0-9_]*", text):
+            return
+        task = self.task(text)
+        for size in sorted(set(sizes)):
+            verdict = self._ask("world_reachable", self.kb.module, task, int(size),
+                                REACH_LIMIT)
+            if verdict == "unreachable":
+                raise ConfigError(f"--task {text!r}: its goal cannot be reached in a world of "
+                                  f"{size} objects (a search of every state reachable from "
+                                  f"its start states; tasks of "
+                                  f"{_display_path(str(self.path))}: "
+                                  f"{', '.join(self.task_names())})")
 
     def _task(self, task: Term | str) -> Term:
         return self.task(task) if isinstance(task, str) else task

@@ -284,3 +284,39 @@ def test_a_stopped_experiment_worlds_keeps_every_finished_point(tmp_path: Path,
     rows = list(csv.DictReader((tmp_path / "curves.csv").open()))
     assert [(r["learner"], r["episodes"]) for r in rows] == \
         [("tg", "0"), ("tg", "10"), ("ptg", "0"), ("ptg", "10")]
+
+
+# ---- G, H: relrl learn's seed, traces and task instances -------------------------------------
+
+LEARN = ["learn", str(BLOCKS), "--episodes", "1", "--eval-episodes", "1", "--no-speed"]
+
+
+@pytest.mark.parametrize("argv, needles", [
+    (["--seed", "-1"], ["--seed", "-1"]),
+    (["--traces", "-1"], ["--traces", "-1"]),
+    (["--sizes="], ["--sizes", "''"]),
+    (["--eval-sizes="], ["--eval-sizes", "''"]),
+    (["--task", "on(b1, b1)"], ["on(b1, b1)", "cannot be reached", "3 objects"]),
+    (["--task", "on(b1, b99)"], ["on(b1, b99)", "cannot be reached"]),
+    (["--task", "on(b1, shell(x))"], ["on(b1, shell(x))", "cannot be reached"]),
+    (["--task", "on(b4, b5)", "--sizes", "5,3"], ["on(b4, b5)", "3 objects"]),
+])
+def test_learn_options_are_checked(capsys, argv: list[str], needles: list[str]) -> None:
+    from tests.cli.conftest import one_line_exit_2
+
+    one_line_exit_2(capsys, [*LEARN, *argv], *needles)
+
+
+def test_a_reachable_task_instance_is_learned() -> None:
+    from relrl.worlds import World
+
+    with World(BLOCKS) as world:
+        world.check_instance("on(b1, b2)", [3, 4, 8])       # 8: too many states to tell
+        world.check_instance("on", [3])
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "soon"])
+def test_a_rule_limit_that_is_no_positive_number_is_refused(value: str) -> None:
+    for argv in (LEARN, ["check", "--world", str(BLOCKS)], ["experiment", "worlds"]):
+        line = one_line(relrl(*argv, f"--rule-seconds={value}"))
+        assert "--rule-seconds" in line and repr(value) in line
