@@ -320,3 +320,21 @@ def test_a_rule_limit_that_is_no_positive_number_is_refused(value: str) -> None:
     for argv in (LEARN, ["check", "--world", str(BLOCKS)], ["experiment", "worlds"]):
         line = one_line(relrl(*argv, f"--rule-seconds={value}"))
         assert "--rule-seconds" in line and repr(value) in line
+
+
+def test_ctrl_c_stops_a_domain_directive_that_never_ends_at_once(tmp_path: Path) -> None:
+    """C's sibling on domains: `relrl check DOMAIN.pl` whose directive loops waited for the
+    load's time limit; Ctrl-C now stops it at once."""
+    import signal
+    import time
+
+    domain = tmp_path / "d.pl"
+    domain.write_text("stimulus(face).\n:- format(user_error, \"loaded~n\", []).\n"
+                      ":- repeat, fail.\nresponse(look).\n")
+    proc = started("check", str(domain))
+    wait_for(proc.stderr, "loaded", proc)
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert time.monotonic() - t0 < 3, err
+    assert proc.returncode == 130 and "Traceback" not in err, err
