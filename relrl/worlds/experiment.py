@@ -84,13 +84,22 @@ class WorldsConfig:
 def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, seed: int, *,
                    report: Any = None) -> dict[str, Any]:
     """One job: :func:`learn_task` of (world, task, learner, seed); the learned policy comes
-    back as text (``policy``), for the run folder's ``policies/``."""
+    back as text (``policy``), for the run folder's ``policies/``. A job that fails reports
+    the policy it had saved (``{"kind": "policy", "text": ...}``, before each evaluation)
+    before its error goes on, so that it is kept too."""
     import tempfile
+
+    from relrl.errors import RelrlError
 
     with tempfile.TemporaryDirectory(prefix="relrl-worlds-") as tmp:
         path = Path(tmp) / "policy.pl"
-        result = learn_task(config.learn_config(world, task, learner, seed), report=report,
-                            policy_out=path)
+        try:
+            result = learn_task(config.learn_config(world, task, learner, seed),
+                                report=report, policy_out=path)
+        except RelrlError:
+            if report is not None and path.is_file():
+                report({"kind": "policy", "text": path.read_text(encoding="utf-8")})
+            raise
         result["policy"] = path.read_text(encoding="utf-8")
     return result
 
@@ -144,7 +153,11 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
     for task, result, events in zip(tasks, outcome.results, outcome.events, strict=True):
         if result is None:
             if len(task) != 3:
-                jobs += _unfinished(task, events)
+                unfinished = _unfinished(task, events)
+                jobs += unfinished
+                kept = [ev["text"] for ev in events if ev.get("kind") == "policy"]
+                if unfinished and kept:
+                    policies[_policy_name(unfinished[0])] = kept[-1]
             continue
         if len(task) == 3:
             verified.append(result)
@@ -175,7 +188,8 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
 
 def _unfinished(task: tuple, events: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """A job that did not finish, as the evaluation points it reported (none: nothing),
-    marked ``"partial": true``: in ``jobs`` and curves.csv, not in the summary."""
+    marked ``"partial": true``: in ``jobs`` and curves.csv, not in the summary (its policy,
+    when it failed after saving one, in ``policies/`` as a finished job's)."""
     curve = [ev["entry"] for ev in events if ev.get("kind") == "point"]
     if not curve:
         return []

@@ -338,3 +338,21 @@ def test_ctrl_c_stops_a_domain_directive_that_never_ends_at_once(tmp_path: Path)
     _, err = proc.communicate(timeout=60)
     assert time.monotonic() - t0 < 3, err
     assert proc.returncode == 130 and "Traceback" not in err, err
+
+
+def test_a_failed_experiment_worlds_job_keeps_its_points_and_policy(tmp_path: Path) -> None:
+    """A job whose rule fails on the larger test size: the run stops (exit 2, one line), the
+    job's evaluation points and the policy it saved before that evaluation are kept."""
+    import json
+
+    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- length(S, N), N > 12, "
+                                       "atom_length(S, _).")
+    out = tmp_path / "out"
+    message = one_line(relrl("experiment", "worlds", "--worlds", str(world), "--tasks",
+                             "stack", "--learners", "tg", "--seeds", "0", "--episodes", "20",
+                             "--block", "10", "--eval-episodes", "3", "--sizes", "3",
+                             "--test-sizes", "4,8", "--workers", "1", "--out", str(out)))
+    assert f"w.pl:{line}: rule precondition(" in message and "partial" in message
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] and [len(j["curve"]) for j in results["jobs"]] == [3]
+    assert "task stack\n" in (out / "policies" / "w-stack-tg-s0.pl").read_text()
