@@ -231,7 +231,7 @@ def _keep_partial(out: Any, config: Any, exc: BaseException) -> None:
     try:
         with deferred_signals():
             files = _write(out.path, config, dict(partial))
-    except BaseException as inner:  # noqa: BLE001 -- whatever it is, the first error goes on
+    except BaseException as inner:  # whatever it is, the first error goes on
         exc.kept = f"nothing more could be written to {out.path} ({inner})"  # type: ignore
         return
     learned = partial["policy_episodes"]

@@ -135,6 +135,7 @@ class _Run:
 
     def learn(self, report: Callable[[dict[str, Any]], None] | None,
               policy_in: str | Path | None, traces: int, monitor: Any) -> dict[str, Any]:
+        """The run itself (see :func:`learn_task`): its result when it finishes."""
         config, world = self.config, self.world
         task = world.task(config.task)
         learner = world.learner(config.learner, **config.params)

@@ -228,19 +228,23 @@ def test_a_second_ctrl_c_does_not_lose_what_was_learned(tmp_path: Path, gap: flo
     assert_partial(out, 2)
 
 
-def test_a_rule_error_mid_run_keeps_the_policy_learned_before_it(tmp_path: Path) -> None:
-    """A rule that fails only on the larger test size: exit 2 naming it, and the policy
-    (saved before that evaluation), the curve and the finished test size are written."""
+@pytest.mark.parametrize("goal, words", [("atom_length(S, _)", "atom_length/2"),
+                                         ("halt", "called halt/0,1")])
+def test_a_rule_error_mid_run_keeps_the_policy_learned_before_it(tmp_path: Path, goal: str,
+                                                                 words: str) -> None:
+    """A rule that fails (or halts) only on the larger test size: exit 2 naming it, and the
+    policy (saved before that evaluation), the curve and the finished test size are
+    written; the folder's record is not left running."""
     import json
 
     world, line = world_with(tmp_path, "precondition(move(_, _), S) :- length(S, N), N > 12, "
-                                       "atom_length(S, _).")
+                                       f"{goal}.")
     out = tmp_path / "out"
     proc = relrl("learn", str(world), "--size", "3", "--eval-sizes", "4,8", "--episodes",
                  "40", "--block", "20", "--eval-episodes", "3", "--no-speed", "--out",
                  str(out))
     message = one_line(proc)
-    assert f"w.pl:{line}: rule precondition(" in message and "atom_length/2" in message
+    assert f"w.pl:{line}: rule precondition(" in message and words in message
     assert "policy.pl (learned from 40 of 40 episodes)" in message
     results = json.loads((out / "results.json").read_text())
     assert results["partial"] and f"w.pl:{line}: rule precondition(" in results["error"]
