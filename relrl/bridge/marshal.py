@@ -17,7 +17,7 @@ from fractions import Fraction
 from typing import Any
 
 from relrl.bridge import lib as L
-from relrl.errors import PrologError, RelrlError
+from relrl.errors import AnswerTooLarge, RelrlError
 from relrl.terms import Term, Var
 
 __all__ = ["Cached", "Marshal", "MAX_DEPTH", "MAX_LIST"]
@@ -228,12 +228,12 @@ class Marshal:
         """The term at reference ``t`` as a Python value.
 
         Raises:
-            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
+            AnswerTooLarge: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
                 holds a list longer than :data:`MAX_LIST` (or cyclic).
         """
         if depth > MAX_DEPTH:
-            raise PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
-                              "cannot be passed to Python", "term_too_deep")
+            raise AnswerTooLarge(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
+                                 "cannot be passed to Python", "term_too_deep")
         lib = self.lib
         kind = lib.term_type(t)
         if kind == L.ATOM:
@@ -274,8 +274,8 @@ class Marshal:
         while lib.get_list(rest, head, rest):
             items.append(self.get(head, depth + 1))
             if len(items) > MAX_LIST:
-                raise PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) "
-                                  "cannot be passed to Python", "list_too_long")
+                raise AnswerTooLarge(f"a list longer than {MAX_LIST} elements (or cyclic) "
+                                     "cannot be passed to Python", "list_too_long")
         if lib.term_type(rest) == L.NIL:
             return items
         value: Term = self.get(rest, depth + 1)      # a partial list [a, b|T]: as the

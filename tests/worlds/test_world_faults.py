@@ -360,3 +360,31 @@ def test_a_failed_experiment_worlds_job_keeps_its_points_and_policy(tmp_path: Pa
     results = json.loads((out / "results.json").read_text())
     assert results["partial"] and [len(j["curve"]) for j in results["jobs"]] == [3]
     assert "task stack\n" in (out / "policies" / "w-stack-tg-s0.pl").read_text()
+
+
+DEEP_WORLD = """initial_state(_, [pos(0), deep(T)]) :- deep(600, T).
+deep(0, x) :- !.
+deep(N, f(T)) :- N1 is N - 1, deep(N1, T).
+task(reach).
+action(step).
+precondition(step, S) :- memberchk(pos(P), S), P < 3.
+effect(step, S, [pos(P)], [pos(P1)]) :- memberchk(pos(P), S), P1 is P + 1.
+goal(reach, S) :- memberchk(pos(3), S).
+"""
+
+
+def test_an_answer_too_deep_to_cross_is_one_line_and_keeps_the_policy(tmp_path: Path) -> None:
+    """S's other way: an answer relrl cannot read (the kept greedy episodes' states hold a
+    term 600 deep) fails with one line, exit 2 -- not a traceback -- after the policy and
+    the points before it were written."""
+    import json
+
+    world = tmp_path / "deep.pl"
+    world.write_text(DEEP_WORLD)
+    out = tmp_path / "out"
+    message = one_line(relrl("learn", str(world), "--learner", "qtable", "--episodes", "4",
+                             "--block", "2", "--eval-episodes", "2", "--size", "1",
+                             "--eval-sizes", "1", "--no-speed", "--out", str(out)))
+    assert "nested deeper than 400 levels" in message and "policy.pl (learned from 4" in message
+    assert json.loads((out / "results.json").read_text())["partial"]
+    assert (out / "policy.pl").is_file()
