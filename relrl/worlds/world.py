@@ -96,7 +96,7 @@ class World:
     Args:
         path: the world file (Prolog; docs/worlds.md).
         timeout: seconds a call that runs none of the world's rules may run (a learner's
-            save or load).
+            save or load); loading the file has ``rule_seconds``.
         rule_seconds: seconds a rule of the world may run (:data:`RULE_SECONDS`).
 
     Raises:
@@ -112,10 +112,10 @@ class World:
                               f"not {rule_seconds!r}")
         self.path = Path(path)
         self.rule_seconds = float(rule_seconds)
-        self.kb = KnowledgeBase(timeout=timeout)
+        self.kb = KnowledgeBase(timeout=self.rule_seconds)   # the file's directives too
         try:
-            with self.kb.interruptible():
-                self.kb.load(self.path)
+            self.kb.load(self.path)
+            self.kb.timeout = timeout
             info = {item[0]: item[1:] for item in self._ask("world_info", self.kb.module)}
         except BaseException:
             self.kb.close()

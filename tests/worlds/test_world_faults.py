@@ -388,3 +388,16 @@ def test_an_answer_too_deep_to_cross_is_one_line_and_keeps_the_policy(tmp_path: 
     assert "nested deeper than 400 levels" in message and "policy.pl (learned from 4" in message
     assert json.loads((out / "results.json").read_text())["partial"]
     assert (out / "policy.pl").is_file()
+
+
+def test_a_world_directive_that_never_ends_is_stopped_at_the_rule_limit(tmp_path: Path) -> None:
+    """Loading a world is bounded by --rule-seconds too (it waited 600 s)."""
+    import time
+
+    world = tmp_path / "w.pl"
+    world.write_text(":- repeat, fail.\n" + BLOCKS.read_text())
+    t0 = time.monotonic()
+    proc = relrl("check", "--world", str(world), "--rule-seconds", "1")
+    assert time.monotonic() - t0 < 60
+    assert proc.returncode == 2 and "w.pl:1:" in proc.stderr, proc.stderr
+    assert "loading ran longer than the time limit" in proc.stderr
