@@ -190,7 +190,7 @@ def run(args: argparse.Namespace) -> int:
                 result = learn_task(config, report=show, policy_in=args.policy, monitor=hub,
                                     stop=stop)
                 _summary(result, result["timing"])
-                return 0
+                return _late(stop)
             with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
                               outputs=OUTPUTS) as out:
                 try:
@@ -216,7 +216,20 @@ def run(args: argparse.Namespace) -> int:
           f"{', '.join(str(f.relative_to(out.path)) for f in files)}")
     if (out.path / "replay").is_dir():
         print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
-    return 0
+    return _late(stop)
+
+
+def _late(stop: Any) -> int:
+    """0, or 128 + N when stop signal N came after the learning, as the outputs were
+    written (they are whole: the command says so, and the status tells a script)."""
+    if stop.signum is None:
+        return 0
+    import signal
+    import sys
+
+    print(f"{signal.Signals(stop.signum).name} came as the outputs were written: they are "
+          "complete", file=sys.stderr)
+    return 128 + stop.signum
 
 
 def _keep_partial(out: Any, config: Any, exc: BaseException) -> None:

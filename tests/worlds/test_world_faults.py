@@ -401,3 +401,16 @@ def test_a_world_directive_that_never_ends_is_stopped_at_the_rule_limit(tmp_path
     assert time.monotonic() - t0 < 60
     assert proc.returncode == 2 and "w.pl:1:" in proc.stderr, proc.stderr
     assert "loading ran longer than the time limit" in proc.stderr
+
+
+def test_a_signal_after_the_learning_says_the_outputs_are_complete(capsys) -> None:
+    """As relrl experiment does: a stop that came as the outputs were written ends the
+    command with 128 + N and says they are whole."""
+    from types import SimpleNamespace
+
+    from relrl.cli.learn import _late
+
+    assert _late(SimpleNamespace(signum=None)) == 0
+    assert _late(SimpleNamespace(signum=15)) == 143
+    assert "SIGTERM came as the outputs were written: they are complete" in \
+        capsys.readouterr().err
