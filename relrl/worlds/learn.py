@@ -184,8 +184,15 @@ class _Run:
                            + ", ".join(map(str, config.test_sizes)))
         for size in config.test_sizes:
             self._go_on()
-            eps = world.episodes(task, [size], config.eval_episodes, "greedy", optimal=True,
-                                 trace=traces > 0)
+            # only the episodes kept for replay bring their steps back (an answer of 100
+            # traced episodes of 50 blocks is millions of terms); the rest follow in the
+            # same stream
+            kept = min(traces, config.eval_episodes)
+            eps = world.episodes(task, [size], kept, "greedy", optimal=True, trace=True) \
+                if kept else []
+            if config.eval_episodes > kept:
+                eps += world.episodes(task, [size], config.eval_episodes - kept, "greedy",
+                                      optimal=True)
             self.test[str(size)] = score(eps)
             if traces:
                 self.kept[str(size)] = [{"goal": e.goal, "steps": e.steps,
