@@ -42,7 +42,7 @@ loaded file that draws random numbers draws from none of the agents' streams; an
 check of which facts the next step may read straight off working memory).
 */
 
-:- meta_predicate gw_run(0, -), api_call(0).
+:- meta_predicate gw_run(0, -), api_call(0), gw_watched(+, 0).
 
 %!  gw_run(:Goal, -Result) is det.
 %
@@ -136,11 +136,13 @@ python_api(world_episodes, relrl_world:world_episodes/3).
 python_api(world_info, relrl_world:world_info/2).
 python_api(world_task, relrl_world:world_task/3).
 python_api(world_verify, relrl_world:world_verify/5).
+python_api(world_reachable, relrl_world:world_reachable/5).
 python_api(world_for_task, relrl_world:world_for_task/2).
 python_api(world_check, relrl_world_check:world_problems/2).
 python_api(world_episodes_from, relrl_world:world_episodes_from/3).
 python_api(world_read_states, relrl_world_states:world_read_states/4).
 python_api(world_state_texts, relrl_world_states:world_state_texts/4).
+python_api(watched, relrl_gateway:gw_watched/2).
 python_api(new_kb, relrl_gateway:gw_new_kb/1).
 python_api(drop_kb, relrl_gateway:gw_drop_kb/1).
 python_api(load, relrl_gateway:gw_load/3).
@@ -149,6 +151,16 @@ python_api(parse, relrl_gateway:gw_parse/3).
 python_api(take_abort, relrl_gateway:gw_take_abort/1).
 python_api(api, relrl_gateway:gw_api/1).
 python_api(answer_again, relrl_gateway:gw_answer_again/1).
+
+%!  gw_watched(+Limit:number, :Goal) is semidet.
+%
+%   Goal, a goal Python may call (as gw_run/2 runs it), with the call's time limit counted
+%   from the last progress mark (relrl_guard:progress_watch/2): a batch of a world's
+%   episodes runs as long as it makes progress, a rule that loops is stopped after Limit
+%   seconds.
+
+gw_watched(Limit, Goal) :-
+    progress_watch(Limit, api_call(Goal)).
 
 %!  gw_findall(+Module, +Template, -List) is det.
 %

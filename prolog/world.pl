@@ -17,6 +17,7 @@
             world_defines/2,      % +KB, ?Name/Arity
             world_task/3,         % +KB, +Spec, -Task
             world_verify/5,       % +KB, +Task, +Size, +Count, -Pairs
+            world_reachable/5,    % +KB, +Task, +Size, +Limit, -Verdict
             world_for_task/2      % +KB, +Task
           ]).
 :- use_module(library(error)).
@@ -253,7 +254,14 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
     ;   Reached == true
     ->  R = 1
     ;   R = 0
-    ).
+    ),
+    progress.
+
+%   A step of the world is done: the gateway's time limit of a batch of episodes counts
+%   from here (relrl_guard:progress_watch/2 reads this flag), so a rule that loops is
+%   stopped after the limit however long the batch runs.
+progress :-
+    flag(relrl_progress, N, N + 1).
 
 %!  world_view(+KB, +Goal, +State, -View:list) is det.
 %
@@ -451,7 +459,7 @@ run_episode(Run, Size, S0, Goal, ep(Size, Goal, Steps, Return, Reached, Optimal,
     world_actions(KB, S0, A0),
     steps(Run, Goal, S0, V0, A0, 0, Bound, 0, Steps, Return, Reached, [], Examples, Trace),
     (   Run = run(_, Learner, learn, episode, _, _)
-    ->  forall(member(T, Examples), learner_update(Learner, KB, T))
+    ->  forall(member(T, Examples), ( learner_update(Learner, KB, T), progress ))
     ;   true
     ).
 
@@ -539,6 +547,11 @@ world_optimal(KB, Goal, State, Limit, Steps) :-
 
 world_bfs(KB, Goal, State, Limit, Steps) :-
     must_be(nonneg, Limit),
+    search(KB, Goal, State, Limit, Steps).
+
+%   Steps: the least number of actions, `unreachable` when every reachable state was visited
+%   without reaching Goal, `none` when Limit states were visited.
+search(KB, Goal, State, Limit, Steps) :-
     (   holds_goal(KB, Goal, State)
     ->  Steps = 0
     ;   list_to_assoc([State-0], Seen),
@@ -657,6 +670,37 @@ world_task(KB, Spec, Task) :-
         subsumes_term(T, Spec)
     ->  Task = Spec
     ).
+
+%!  world_reachable(+KB, +Task, +Size, +Limit, -Verdict) is det.
+%
+%   Verdict says whether the goal of Task (a task instance: on(b1, b2)) can be reached in
+%   a world of Size objects, by a breadth-first search of at most Limit states from each of
+%   three start states drawn with seed 0 (the generator of no knowledge base):
+%   `reachable` from one of them, `unreachable` when each search visited every state it
+%   could reach, else `unknown`. A task whose goal names an object the world does not
+%   have at that size, or a relation no state can hold (on(b1, b1)), is `unreachable`.
+
+world_reachable(KB, Task, Size, Limit, Verdict) :-
+    must_be(positive_integer, Size),
+    must_be(nonneg, Limit),
+    set_random(seed(0)),
+    findall(V, ( between(1, 3, _),
+                 world_start(KB, Task, Size, S, Goal),
+                 search(KB, Goal, S, Limit, Steps),
+                 reach_verdict(Steps, V) ), Vs),
+    (   memberchk(reachable, Vs)
+    ->  Verdict = reachable
+    ;   Vs = [_|_],
+        forall(member(V, Vs), V == unreachable)
+    ->  Verdict = unreachable
+    ;   Verdict = unknown
+    ).
+
+reach_verdict(Steps, reachable) :-
+    integer(Steps),
+    !.
+reach_verdict(unreachable, unreachable) :- !.
+reach_verdict(_, unknown).
 
 %!  world_verify(+KB, +Task, +Size, +Count, -Pairs:list) is det.
 %

@@ -377,10 +377,10 @@ view_problem(KB, Goal, State, found(problem(File, Line, Msg))) :-
     format(string(Msg), "the learner's view holds ~q, but no relation/1 declares ~q (add \c
                          relation(~q).)", [F, Name/Arity, Name/Arity]).
 
-%   An error of a world goal: a problem at its file and line (a time limit or Ctrl-C is
-%   not the world's problem: it propagates).
+%   An error of a world goal: a problem at its file and line (a time limit, Ctrl-C or a
+%   halt/0,1 the rule called is not a problem to list: it propagates and ends the check).
 rule_problem(Goal, Where, E, found(problem(File, Line, Msg))) :-
-    (   ( E == time_limit_exceeded ; E == relrl_interrupted )
+    (   ( E == time_limit_exceeded ; E == relrl_interrupted ; E == relrl_halt_called )
     ->  throw(relrl_rule_error(Goal, Where, E))
     ;   true
     ),

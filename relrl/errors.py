@@ -23,6 +23,7 @@ __all__ = [
     "JobFailed",
     "JobCrashed",
     "PrologError",
+    "AnswerTooLarge",
     "PrologLoadError",
     "QueryTimeout",
     "RuleError",
@@ -63,6 +64,11 @@ class PrologError(RelrlError):
         super().__init__(message)
         self.message = message
         self.term = term
+
+
+class AnswerTooLarge(PrologError, UserError):
+    """An answer of Prolog that cannot be passed to Python: a term nested deeper, or a list
+    longer, than relrl reads (what a user's rules built: one line, not a traceback)."""
 
 
 class PrologLoadError(UserError):

@@ -84,7 +84,8 @@ class KnowledgeBase:
     # -- loading ---------------------------------------------------------------------------
 
     def load(self, path: str | os.PathLike, *, strict: bool = True) -> list[Problem]:
-        """Consult a domain file into this knowledge base, under the time limit.
+        """Consult a domain file into this knowledge base, under the time limit (Ctrl-C
+        stops it at once).
 
         Returns the warnings when ``strict`` is False.
 
@@ -98,7 +99,9 @@ class KnowledgeBase:
         if (problem := not_utf8(p)) is not None:
             raise PrologLoadError(display_path(str(p)), *problem)
         try:
-            out = self._prolog.api("load", str(p), self.module, Var(), timeout=self.timeout)
+            with self.interruptible():          # Ctrl-C stops a directive that never ends
+                out = self._prolog.api("load", str(p), self.module, Var(),
+                                       timeout=self.timeout)
         except Aborted as exc:
             raise PrologLoadError(display_path(str(p)), None,
                                   "abort/0 called while loading") from exc

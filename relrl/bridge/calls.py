@@ -98,9 +98,12 @@ class Prolog:
 
     # -- a goal, once ----------------------------------------------------------------------
 
-    def run(self, goal: Term, timeout: float, outputs: Sequence[int] = ()) -> list | None:
+    def run(self, goal: Term, timeout: float, outputs: Sequence[int] = (), *,
+            watched: bool = False) -> list | None:
         """Run ``goal`` (``Module:Goal``) once; return the values of the arguments of
-        ``Goal`` at the positions ``outputs``, or None when it fails.
+        ``Goal`` at the positions ``outputs``, or None when it fails. ``watched``: the goal
+        runs under ``relrl_guard:progress_watch/2``, which holds its time limit (the
+        watchdog only ticks).
 
         Raises:
             QueryTimeout, RuleError, PrologError, ...: see :func:`check_result`.
@@ -113,7 +116,7 @@ class Prolog:
                 a0 = lib.new_term_refs(2)
                 marshal.put(a0, goal, {})
                 if not self._timed(timeout, lib.call_predicate, None, L.Q_FLAGS,
-                                   self._gw_run, a0):
+                                   self._gw_run, a0, tick=watched):
                     self._raise_exception()
                 result = marshal.get(a0 + 1)
                 if result == "false":
@@ -131,11 +134,12 @@ class Prolog:
             finally:
                 lib.discard_foreign_frame(fid)
 
-    def _timed(self, timeout: float, call: Any, *args: Any) -> Any:
-        """``call(*args)``, a foreign call that runs Prolog, under the time limit."""
+    def _timed(self, timeout: float, call: Any, *args: Any, tick: bool = False) -> Any:
+        """``call(*args)``, a foreign call that runs Prolog, under the time limit (``tick``:
+        a watched call, see :meth:`run`)."""
         self.calls += 1
         watchdog = self.watchdog
-        watchdog.arm(timeout)
+        watchdog.arm(timeout, tick=tick)
         try:
             return call(*args)
         finally:
@@ -148,9 +152,11 @@ class Prolog:
         self._check_thread()
         mark = c_size_t()
         self.lib.mark_string_buffers(byref(mark))
+        outer, self.marshal.mark = self.marshal.mark, mark
         try:
             yield
         finally:
+            self.marshal.mark = outer
             self.lib.release_string_buffers_from_mark(mark.value)
             self._flush()
 

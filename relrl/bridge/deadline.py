@@ -10,7 +10,8 @@ then, it raises :data:`SIG_TIME` in Prolog's thread (``PL_thread_raise``: a Prol
 handled at the goal's next call port or in a blocking system call), whose handler in
 ``prolog/guard.pl`` throws ``time_limit_exceeded`` inside the goal — what
 ``call_with_time_limit/2``'s alarm throws. Within :meth:`Watchdog.interruptible`, Ctrl-C
-(which Python sees only between bytecodes, not while Prolog runs) reaches the watchdog
+(which Python sees only between bytecodes, not while Prolog runs; SIGTERM and SIGHUP too,
+when Python handles them) reaches the watchdog
 through :func:`signal.set_wakeup_fd` and raises :data:`SIG_INTERRUPT`, whose handler throws
 ``relrl_interrupted``: the goal stops at once, as at swipl's toplevel.
 
@@ -35,15 +36,23 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-__all__ = ["Watchdog", "SIG_TIME", "SIG_INTERRUPT"]
+__all__ = ["Watchdog", "SIG_TIME", "SIG_INTERRUPT", "SIG_TICK"]
 
 #: The Prolog signals the watchdog raises (numbers of Prolog's signal table; the OS does
 #: not deliver them: see :mod:`relrl.bridge.lib`).
 SIG_TIME = int(signal.SIGVTALRM)
 SIG_INTERRUPT = int(signal.SIGUSR1)
+#: The signal of a watched call (:meth:`Watchdog.arm` with ``tick``): raised every
+#: :data:`RAISE_AGAIN` seconds, Prolog's handler decides (prolog/guard.pl, progress_watch/2).
+SIG_TICK = int(signal.SIGPROF)
 #: Seconds between raises while a call runs past its deadline: a signal taken before the
 #: guard of the call was entered does nothing, the next one stops the goal.
 RAISE_AGAIN = 0.1
+#: The signals that stop the running call within :meth:`Watchdog.interruptible` (when the
+#: process has a Python handler for them: Ctrl-C always; SIGTERM and SIGHUP while a command
+#: keeps what it learned on a stop).
+STOP_SIGNALS = tuple(int(getattr(signal, n)) for n in ("SIGINT", "SIGTERM", "SIGHUP")
+                     if hasattr(signal, n))
 
 
 class Watchdog:
@@ -58,6 +67,8 @@ class Watchdog:
         self._lock = threading.Lock()
         self._deadline: float | None = None     # the running call's; None between calls
         self._raised = False                    # a signal was raised for the running call
+        self._signal = SIG_TIME                 # what the running call's deadline raises
+        self._stop = False                      # a stop signal came while the call ran
         self._shortest = 10.0                   # the shortest limit so far: the idle sleep
         self._wake_at = math.inf                # when the thread wakes next
         self._interruptible = False
@@ -66,13 +77,18 @@ class Watchdog:
             os.set_blocking(fd, False)
         threading.Thread(target=self._watch, name="relrl-watchdog", daemon=True).start()
 
-    def arm(self, limit: float | None) -> None:
-        """A call with a time limit of ``limit`` seconds (0 or None: none) starts."""
+    def arm(self, limit: float | None, *, tick: bool = False) -> None:
+        """A call with a time limit of ``limit`` seconds (0 or None: none) starts; with
+        ``tick``, a watched call: :data:`SIG_TICK` every :data:`RAISE_AGAIN` seconds instead,
+        Prolog's handler holding the limit (it counts from the call's last progress)."""
         now = time.monotonic()
+        if tick:
+            limit = RAISE_AGAIN
         deadline = now + limit if limit and limit > 0 else math.inf
         with self._lock:
             self._deadline = deadline
-            self._raised = False
+            self._signal = SIG_TICK if tick else SIG_TIME
+            self._raised = self._stop = False
         if deadline < self._wake_at:            # sooner than the thread looks next
             self._shortest = min(self._shortest, limit)
             self._nudge()
@@ -82,14 +98,15 @@ class Watchdog:
         the caller lets Prolog take it outside any call)."""
         with self._lock:
             self._deadline = None
-            raised, self._raised = self._raised, False
+            raised, self._raised, self._stop = self._raised, False, False
         return raised
 
     @contextmanager
     def interruptible(self) -> Iterator[None]:
         """Within the block, Ctrl-C (SIGINT) stops the running call at once (a user's
-        query at a terminal); Python's ``KeyboardInterrupt`` follows when it returns.
-        Outside the main thread this does nothing."""
+        query at a terminal); Python's ``KeyboardInterrupt`` follows when it returns. So
+        do SIGTERM and SIGHUP when Python handles them (a command that keeps what it
+        learned when stopped). Outside the main thread this does nothing."""
         if threading.current_thread() is not threading.main_thread():
             yield
             return
@@ -112,9 +129,13 @@ class Watchdog:
             with self._lock:
                 now = time.monotonic()
                 deadline = self._deadline
-                if deadline is not None and now >= deadline:
+                if deadline is not None and self._stop:
+                    self._raised = True               # Ctrl-C (also after the time limit's
+                    self._raise(SIG_INTERRUPT)        # signals): again until the call ends
+                    deadline = now + RAISE_AGAIN
+                elif deadline is not None and now >= deadline:
                     self._raised = True
-                    self._raise(SIG_TIME)
+                    self._raise(self._signal)
                     deadline = now + RAISE_AGAIN      # until the call ends
                 elif deadline is None or deadline == math.inf:
                     deadline = now + self._shortest    # a call armed meanwhile ends later
@@ -122,8 +143,7 @@ class Watchdog:
             ready, _, _ = select.select([self._wake_r], [], [], max(deadline - now, 0.0))
             if ready:
                 data = os.read(self._wake_r, 512)
-                if self._interruptible and signal.SIGINT in data:
+                if self._interruptible and any(s in data for s in STOP_SIGNALS):
                     with self._lock:
-                        if self._deadline is not None and not self._raised:
-                            self._raised = True
-                            self._raise(SIG_INTERRUPT)
+                        if self._deadline is not None:
+                            self._stop = True         # raised at the top of the loop

@@ -17,7 +17,7 @@ from fractions import Fraction
 from typing import Any
 
 from relrl.bridge import lib as L
-from relrl.errors import PrologError, RelrlError
+from relrl.errors import AnswerTooLarge, RelrlError
 from relrl.terms import Term, Var
 
 __all__ = ["Cached", "Marshal", "MAX_DEPTH", "MAX_LIST"]
@@ -28,6 +28,9 @@ MAX_DEPTH = 400
 MAX_LIST = 10_000_000
 #: Most atoms and records kept in a cache before it is emptied (what it holds is freed).
 CACHE_SIZE = 4096
+#: Texts read from one answer between two releases of SWI-Prolog's string buffers (each
+#: text is copied at once; SWI-Prolog aborts the process above some 600,000 buffers held).
+TEXTS_PER_RELEASE = 50_000
 
 
 class Cached:
@@ -82,6 +85,10 @@ class Marshal:
         self._held_names: dict[str, int] = {}
         self.records: dict[Any, int] = {}
         self._size, self._text_ptr = c_size_t(), c_char_p()
+        #: the string buffers' mark of the crossing whose answers are read (set by the
+        #: caller that marked; None: texts are not released while an answer is read)
+        self.mark: c_size_t | None = None
+        self._texts = 0                      # texts read since the last release
 
     # -- atoms, functors, records ----------------------------------------------------------
 
@@ -196,11 +203,18 @@ class Marshal:
     # -- Prolog -> Python ------------------------------------------------------------------
 
     def _text(self, t: int, flags: int) -> str:
-        """Text of the term at ``t`` (the caller marks and releases the string stack)."""
+        """Text of the term at ``t`` (the caller marks and releases the string stack; with
+        :attr:`mark` set, the buffers of the texts copied are released every
+        :data:`TEXTS_PER_RELEASE` texts, so an answer of any size can be read)."""
         if not self.lib.get_nchars(t, byref(self._size), byref(self._text_ptr),
                                    flags | L.REP_UTF8):
             raise RelrlError("cannot read text from a Prolog term")
-        return ctypes.string_at(self._text_ptr, self._size.value).decode("utf-8")
+        text = ctypes.string_at(self._text_ptr, self._size.value).decode("utf-8")
+        self._texts += 1
+        if self._texts >= TEXTS_PER_RELEASE and self.mark is not None:
+            self._texts = 0
+            self.lib.release_string_buffers_from_mark(self.mark.value)
+        return text
 
     def atom_name(self, atom: int) -> str:
         """The name of the atom with handle ``atom``."""
@@ -214,12 +228,12 @@ class Marshal:
         """The term at reference ``t`` as a Python value.
 
         Raises:
-            PrologError: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
+            AnswerTooLarge: the term is nested deeper than :data:`MAX_DEPTH` (or cyclic), or
                 holds a list longer than :data:`MAX_LIST` (or cyclic).
         """
         if depth > MAX_DEPTH:
-            raise PrologError(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
-                              "cannot be passed to Python", "term_too_deep")
+            raise AnswerTooLarge(f"a term nested deeper than {MAX_DEPTH} levels (or cyclic) "
+                                 "cannot be passed to Python", "term_too_deep")
         lib = self.lib
         kind = lib.term_type(t)
         if kind == L.ATOM:
@@ -260,8 +274,8 @@ class Marshal:
         while lib.get_list(rest, head, rest):
             items.append(self.get(head, depth + 1))
             if len(items) > MAX_LIST:
-                raise PrologError(f"a list longer than {MAX_LIST} elements (or cyclic) "
-                                  "cannot be passed to Python", "list_too_long")
+                raise AnswerTooLarge(f"a list longer than {MAX_LIST} elements (or cyclic) "
+                                     "cannot be passed to Python", "list_too_long")
         if lib.term_type(rest) == L.NIL:
             return items
         value: Term = self.get(rest, depth + 1)      # a partial list [a, b|T]: as the

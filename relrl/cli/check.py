@@ -42,6 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "never perceived (" + "; ".join(
                                  f"{name}: {v.description}" for name, v in WORLDS.items())
                         + ")")
+    from relrl.cli.learn import add_rule_seconds
+
+    add_rule_seconds(parser)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -124,7 +127,7 @@ def _check_world(args: argparse.Namespace) -> int:
         raise ConfigError(f"--world {args.world}: no such world file, and not a world's "
                           f"percepts (sis, episodes, fruits)")
     try:
-        world = World(path)
+        world = World(path, rule_seconds=args.rule_seconds)
     except PrologLoadError as exc:
         _print_problems(_load_problems(exc))
         return 2

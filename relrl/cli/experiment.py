@@ -206,7 +206,12 @@ def _add_worlds(sub) -> None:
     w.add_argument("--engine", choices=["local", "ray"], default="local",
                    help="local worker processes (default) or a Ray cluster")
     w.add_argument("--address", default=None, help="with --engine ray: the cluster to join")
-    w.add_argument("--quick", action="store_true", help="a short run (one seed, tg)")
+    from relrl.cli.learn import add_rule_seconds
+
+    add_rule_seconds(w)
+    w.add_argument("--quick", action="store_true",
+                   help="a short run: seed 0, learner tg, 200 episodes in blocks of 50, 30 "
+                        "greedy episodes per evaluation (each overridden by its option)")
     add_out_options(w, default="runs/worlds",
                     what="output folder: results.json, CSVs, figures")
 
@@ -228,6 +233,15 @@ def _ints(text: str, what: str) -> list[int]:
 MAX_COUNT = 10**9
 
 
+def _distinct(option: str, names: list[str], why: str = "each would count twice") -> None:
+    """Refuse a name given twice in a comma-separated option (one line naming it)."""
+    from relrl.errors import ConfigError
+
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ConfigError(f"{option} names {', '.join(twice)} twice ({why})")
+
+
 def _check_common(args: argparse.Namespace, config) -> None:
     """Validate and copy the options both experiments share into ``config``."""
     from relrl.errors import ConfigError
@@ -242,6 +256,7 @@ def _check_common(args: argparse.Namespace, config) -> None:
                               f"(known: {', '.join(sorted(learners_known))})")
     if not learners:
         raise ConfigError("--learners is empty")
+    _distinct("--learners", learners)
     config.learners = learners
     for what, value in [("--eval-runs", config.eval_runs), ("--eval-steps", config.eval_steps),
                         ("--block", config.block)]:
@@ -277,7 +292,8 @@ def build_config(args: argparse.Namespace):
     from relrl.sim.caregiver import make_caregiver
 
     record = apply_record(args, "sis")
-    config = SISConfig.from_preset(args.preset, seeds=_ints(args.seeds or "0", "--seeds"))
+    config = SISConfig.from_preset(args.preset, seeds=_ints(
+        args.seeds if args.seeds is not None else "0", "--seeds"))
     config.points = args.points if args.points is not None else (4 if args.quick else 20)
     config.eval_runs = args.eval_runs if args.eval_runs is not None else (5 if args.quick else 20)
     config.eval_steps = args.eval_steps if args.eval_steps is not None else 500
@@ -307,7 +323,8 @@ def build_scaling_config(args: argparse.Namespace):
 
     record = apply_record(args, "scaling")
     quick = QUICK_SCALING if args.quick else {}
-    config = ScalingConfig(seeds=_ints(args.seeds or quick.get("seeds", "0,1,2"), "--seeds"))
+    config = ScalingConfig(seeds=_ints(args.seeds if args.seeds is not None
+                                       else quick.get("seeds", "0,1,2"), "--seeds"))
     config.sizes = _ints(args.sizes, "--sizes")
     for name in ("budget", "block", "eval_runs", "eval_steps"):
         value = getattr(args, name)
@@ -337,9 +354,10 @@ def build_scaling_config(args: argparse.Namespace):
         except ConfigError as exc:
             raise ConfigError(f"--sizes {size}: {exc}") from None
     config.transfer = args.transfer
-    transfer_sizes = args.transfer_sizes or quick.get("transfer_sizes")
-    config.transfer_sizes = (_ints(transfer_sizes, "--transfer-sizes") if transfer_sizes
-                             else list(config.sizes))
+    transfer_sizes = (args.transfer_sizes if args.transfer_sizes is not None
+                      else quick.get("transfer_sizes"))
+    config.transfer_sizes = (_ints(transfer_sizes, "--transfer-sizes")
+                             if transfer_sizes is not None else list(config.sizes))
     if math.isnan(args.holdout) or not 0 < args.holdout < 1:
         raise ConfigError(f"--holdout must be between 0 and 1, not {args.holdout}")
     config.holdout = args.holdout
@@ -431,11 +449,13 @@ def build_worlds_config(args: argparse.Namespace):
     from relrl.worlds import World
     from relrl.worlds.experiment import WorldsConfig
 
-    config = WorldsConfig(seeds=_ints(args.seeds or "0,1,2", "--seeds"))
-    if args.quick:
-        config.seeds = _ints(args.seeds or "0", "--seeds")
-    if args.worlds:
+    seeds = args.seeds if args.seeds is not None else ("0" if args.quick else "0,1,2")
+    config = WorldsConfig(seeds=_ints(seeds, "--seeds"))
+    if args.worlds is not None:
         config.worlds = [w.strip() for w in args.worlds.split(",") if w.strip()]
+        if not config.worlds:
+            raise ConfigError(f"--worlds must name at least one world file, not "
+                              f"{args.worlds!r}")
     else:
         folder = examples_dir() / "worlds"
         config.worlds = [str(folder / "blocks.pl"), str(folder / "blocks_moves.pl")]
@@ -443,9 +463,14 @@ def build_worlds_config(args: argparse.Namespace):
         if not Path(path).is_file():
             raise ConfigError(f"--worlds {path}: no such world file")
         config.worlds[i] = str(Path(path).resolve())
+    _distinct("--worlds", [Path(w).name for w in config.worlds],
+              "results are kept by the world's file name")
     config.tasks = split_terms(args.tasks)  # on(b1,b2) is one task
-    names = ",".join(learners(WORLDS)) if args.learners is None else args.learners
+    names = (args.learners if args.learners is not None
+             else "tg" if args.quick else ",".join(learners(WORLDS)))
     config.learners = [x.strip() for x in names.split(",") if x.strip()]
+    _distinct("--tasks", config.tasks)
+    _distinct("--learners", config.learners)
     for name in config.learners:
         if name not in learners(WORLDS):
             raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "
@@ -456,9 +481,11 @@ def build_worlds_config(args: argparse.Namespace):
     config.test_sizes = _ints(args.test_sizes, "--test-sizes")
     if any(s < 1 for s in config.train_sizes + config.test_sizes):
         raise ConfigError("sizes must be whole numbers >= 1")
-    config.episodes = args.episodes or (200 if args.quick else 1000)
-    config.block = args.block or (50 if args.quick else 100)
-    config.eval_episodes = args.eval_episodes or (30 if args.quick else 100)
+    config.episodes = (args.episodes if args.episodes is not None
+                       else 200 if args.quick else 1000)
+    config.block = args.block if args.block is not None else 50 if args.quick else 100
+    config.eval_episodes = (args.eval_episodes if args.eval_episodes is not None
+                            else 30 if args.quick else 100)
     for what, value in [("--episodes", config.episodes), ("--block", config.block),
                         ("--eval-episodes", config.eval_episodes)]:
         if value < 1:
@@ -471,14 +498,15 @@ def build_worlds_config(args: argparse.Namespace):
         config.learner_params.setdefault(learner, {})[name] = value
     for learner in config.learners:
         make_world_learner(learner, **config.learner_params.get(learner, {}))  # validate
+    config.rule_seconds = args.rule_seconds
     for path in config.worlds:
-        with World(path) as world:
+        with World(path, rule_seconds=config.rule_seconds) as world:
             problems = world.problems()
             if problems:
                 raise ConfigError("\n".join([*problems, f"{len(problems)} problem(s) in "
                                              f"{path} (relrl check --world {path})"]))
             for task in config.tasks:
-                world.task(task)
+                world.check_instance(task, [*config.train_sizes, *config.test_sizes])
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     return config

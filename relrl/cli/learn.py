@@ -34,6 +34,30 @@ def _sizes(text: str, option: str) -> list[int]:
     return sizes
 
 
+def _seconds(text: str) -> float:
+    """A positive, finite number of seconds (``--rule-seconds``)."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a positive number of seconds, not {text!r}")
+    return value
+
+
+def add_rule_seconds(parser: argparse.ArgumentParser) -> None:
+    """``--rule-seconds S``: how long a rule of a world may run (relrl learn, relrl check
+    --world, relrl experiment worlds)."""
+    from relrl.worlds.world import RULE_SECONDS
+
+    parser.add_argument("--rule-seconds", type=_seconds, default=RULE_SECONDS, metavar="S",
+                        help=f"stop a rule of the world that runs S seconds, naming it "
+                             f"(default {RULE_SECONDS:g}; a batch of episodes runs as long "
+                             "as its steps end)")
+
+
 def _param(text: str) -> tuple[str, float]:
     try:
         key, value = text.split("=", 1)
@@ -67,6 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eval-episodes", type=int, default=100,
                         help="greedy episodes per evaluation and per evaluation size (100)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    add_rule_seconds(parser)
     parser.add_argument("--param", type=_param, action="append", default=[],
                         metavar="NAME=X", help="learner parameter (repeatable)")
     parser.add_argument("--updates", choices=["episode", "online"], default="episode",
@@ -90,8 +115,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Check the world and the options, learn, print the curve and the evaluation."""
-    from relrl.errors import ConfigError
+    """Check the world and the options, learn, print the curve and the evaluation.
+
+    Stopped (Ctrl-C, SIGTERM, SIGHUP: 130, 143, 129) or ended by an error in the world (2),
+    it writes what it learned into ``--out``: the policy saved before the evaluation that
+    was running, and results.json, timing.json and curve.csv with every evaluation point
+    and test size that finished, marked ``"partial": true``."""
+    from relrl.errors import USER_ERRORS, ConfigError, UserError
     from relrl.learners import make_world_learner
     from relrl.outdir import OutDir
     from relrl.worlds import World
@@ -101,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     if not path.is_file():
         raise ConfigError(f"{args.world}: no such world file")
     make_world_learner(args.learner, **dict(args.param))          # validate before loading
-    with World(path) as world:
+    with World(path, rule_seconds=args.rule_seconds) as world:
         problems = world.problems()
         if len(problems) == 1:
             raise ConfigError(f"{problems[0]} (relrl check --world {args.world})")
@@ -111,11 +141,13 @@ def run(args: argparse.Namespace) -> int:
         task_text = args.task or world.task_names()[0].split("(")[0]
         world.task(task_text)                                     # validate now
         train = ([args.size] if args.size is not None else
-                 _sizes(args.sizes, "--sizes") if args.sizes else world.train_sizes)
+                 _sizes(args.sizes, "--sizes") if args.sizes is not None
+                 else world.train_sizes)
         if args.size is not None and args.size < 1:
             raise ConfigError(f"--size must be at least 1, not {args.size}")
-        test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes
+        test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes is not None
                 else world.test_sizes)
+        world.check_instance(task_text, [*train, *test])
     if args.size is not None and args.sizes:
         raise ConfigError("give --size or --sizes, not both")
     if args.episodes < 0 or (args.episodes == 0 and not args.policy):
@@ -123,6 +155,10 @@ def run(args: argparse.Namespace) -> int:
                           f"{args.episodes}")
     if args.eval_episodes < 1:
         raise ConfigError(f"--eval-episodes must be at least 1, not {args.eval_episodes}")
+    if args.seed < 0:
+        raise ConfigError(f"--seed must be a whole number >= 0, not {args.seed}")
+    if args.traces < 0:
+        raise ConfigError(f"--traces must be 0 or more, not {args.traces}")
     block = args.block if args.block is not None else max(1, args.episodes // 10)
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")
@@ -136,7 +172,8 @@ def run(args: argparse.Namespace) -> int:
                          params=params, train_sizes=train, test_sizes=test,
                          episodes=args.episodes, block=block,
                          eval_episodes=args.eval_episodes, seed=args.seed,
-                         updates=args.updates, speed=not args.no_speed)
+                         updates=args.updates, speed=not args.no_speed,
+                         rule_seconds=args.rule_seconds)
 
     def show(event: dict) -> None:
         e = event["entry"]
@@ -147,25 +184,82 @@ def run(args: argparse.Namespace) -> int:
     print(f"{args.learner} learns {task_text} on sizes {','.join(map(str, train))} "
           f"({args.episodes} episodes, seed {args.seed}); greedy evaluation of "
           f"{args.eval_episodes} episodes:")
-    with _live_monitor(args.monitor, config) as hub:
-        if args.out is None:
-            result = learn_task(config, report=show, policy_in=args.policy, monitor=hub)
-            _summary(result, result["timing"])
-            return 0
-        with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
-                          outputs=OUTPUTS) as out:
-            result = learn_task(config, report=show, policy_in=args.policy,
-                                policy_out=out.path / "policy.pl", traces=args.traces,
-                                monitor=hub)
-            timing = result["timing"]
-            files = _write(out.path, config, result)
-            out.status = "complete"
+    from relrl.episodes import StopRequest
+
+    stop = StopRequest(force=False)  # each signal stops the running call into Prolog
+    try:
+        # a stop signal from here on ends the run with what it learned written
+        with stop.installed(), _live_monitor(args.monitor, config) as hub:
+            if args.out is None:
+                result = learn_task(config, report=show, policy_in=args.policy, monitor=hub,
+                                    stop=stop)
+                _summary(result, result["timing"])
+                return _late(stop)
+            with OutDir.claim(args.out, command=args.command_line, overwrite=args.overwrite,
+                              outputs=OUTPUTS) as out:
+                try:
+                    result = learn_task(config, report=show, policy_in=args.policy,
+                                        policy_out=out.path / "policy.pl",
+                                        traces=args.traces, monitor=hub, stop=stop)
+                except (KeyboardInterrupt, *USER_ERRORS) as exc:
+                    _keep_partial(out, config, exc)
+                    raise
+                timing = result["timing"]
+                files = _write(out.path, config, result)
+                out.status = "complete"
+    except KeyboardInterrupt as exc:
+        exc.signum = stop.signum or 2  # type: ignore[attr-defined]
+        raise
+    except USER_ERRORS as exc:
+        kept = getattr(exc, "kept", None)
+        if kept is None:
+            raise
+        raise UserError(f"{exc}; {kept}") from None
     _summary(result, timing)
     print(f"\nwrote {len(files)} files to {out.path}/: "
           f"{', '.join(str(f.relative_to(out.path)) for f in files)}")
     if (out.path / "replay").is_dir():
         print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
-    return 0
+    return _late(stop)
+
+
+def _late(stop: Any) -> int:
+    """0, or 128 + N when stop signal N came after the learning, as the outputs were
+    written (they are whole: the command says so, and the status tells a script)."""
+    if stop.signum is None:
+        return 0
+    import signal
+    import sys
+
+    print(f"{signal.Signals(stop.signum).name} came as the outputs were written: they are "
+          "complete", file=sys.stderr)
+    return 128 + stop.signum
+
+
+def _keep_partial(out: Any, config: Any, exc: BaseException) -> None:
+    """Write what a stopped or failed run learned (``exc.partial``), marked partial, while
+    further signals wait; ``exc.kept`` says what was written. Never raises: the first error
+    is the one the user must see."""
+    from relrl.outdir import deferred_signals
+
+    partial = getattr(exc, "partial", None)
+    if partial is None:
+        return
+    try:
+        with deferred_signals():
+            files = _write(out.path, config, dict(partial))
+    except BaseException as inner:  # whatever it is, the first error goes on
+        exc.kept = f"nothing more could be written to {out.path} ({inner})"  # type: ignore
+        return
+    learned = partial["policy_episodes"]
+    policy = (f"policy.pl (learned from {learned} of {config.episodes} episodes)"
+              if learned is not None and (out.path / "policy.pl").is_file()
+              else "no policy (none was saved yet)")
+    names = ", ".join(str(f.relative_to(out.path)) for f in files if f.name != "policy.pl")
+    exc.kept = (f"{len(partial['curve'])} evaluation point"  # type: ignore[attr-defined]
+                f"{'s' * (len(partial['curve']) != 1)}, {len(partial['test'])} of "
+                f"{len(config.test_sizes)} test sizes and {policy} written to {out.path} "
+                f"({names}: partial)")
 
 
 @contextmanager
@@ -244,7 +338,8 @@ def _write(out: Path, config, result: dict) -> list[Path]:
     for c in result["curve"]:
         w.writerow([c[k] for k in keys])
     files.append(write_atomic(out / "curve.csv", buf.getvalue()))
-    files.append(out / "policy.pl")
+    if (out / "policy.pl").is_file():            # saved before each evaluation
+        files.append(out / "policy.pl")
     if traces:
         from relrl.worlds.replay import write_replay
 

@@ -54,14 +54,21 @@ log = logging.getLogger(__name__)
 class StopRequest:
     """A flag set by SIGINT, SIGTERM or SIGHUP (a second SIGINT raises KeyboardInterrupt).
 
+    Args:
+        force: whether a second SIGINT raises KeyboardInterrupt (a run whose step may be
+            held up in Python); False for a command whose calls into Prolog each signal
+            stops by itself (:meth:`relrl.kb.KnowledgeBase.interruptible`): a second Ctrl-C
+            then only asks again, and cannot cut the writing of what was learned.
+
     Attributes:
         requested: a stop was asked for.
         signum: the signal that asked (``None`` when set by code).
     """
 
-    def __init__(self) -> None:
+    def __init__(self, *, force: bool = True) -> None:
         self.requested = False
         self.signum: int | None = None
+        self.force = force
 
     def __call__(self) -> bool:
         return self.requested
@@ -74,7 +81,7 @@ class StopRequest:
             return
 
         def handler(signum: int, frame: Any) -> None:
-            if self.requested and signum == signal.SIGINT:
+            if self.requested and signum == signal.SIGINT and self.force:
                 raise KeyboardInterrupt
             self.requested = True
             self.signum = self.signum or signum

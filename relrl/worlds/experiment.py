@@ -8,7 +8,9 @@ world's stated optimum (optimal_steps/3) is checked against a breadth-first sear
 start states of the small sizes, and the check is written with the results.
 
 Files: ``results.json`` (every number and the configuration; ``"partial": true`` when
-stopped early), ``timing.json`` (wall clock, steps/s, the CPU cost of a step by size and its log-log
+stopped early, with the evaluation points of each job that had not finished, marked
+partial, among the jobs and in curves.csv, and the summary of the jobs that finished),
+``timing.json`` (wall clock, steps/s, the CPU cost of a step by size and its log-log
 slope), ``summary.csv``
 (per world, task and learner: the mean over seeds), ``curves.csv``, ``test.csv``,
 ``step_cost.csv``, ``optimal_check.csv``, ``curves.png``, ``transfer.png``,
@@ -29,6 +31,7 @@ from relrl.learners import WORLDS, learners
 from relrl.machine import machine_info
 from relrl.outdir import write_atomic, write_json_atomic
 from relrl.worlds.learn import LearnConfig, learn_task
+from relrl.worlds.world import RULE_SECONDS
 
 __all__ = ["OUTPUTS", "WorldsConfig", "run_worlds", "run_worlds_job", "worlds_table"]
 
@@ -55,6 +58,7 @@ class WorldsConfig:
     updates: str = "episode"
     verify_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
     verify_states: int = 30
+    rule_seconds: float = RULE_SECONDS      #: how long a rule of a world may run
 
     def jobs(self) -> list[tuple[str, str, str, int]]:
         """Every (world, task, learner, seed) job."""
@@ -68,7 +72,7 @@ class WorldsConfig:
                            train_sizes=list(self.train_sizes),
                            test_sizes=list(self.test_sizes), episodes=self.episodes,
                            block=self.block, eval_episodes=self.eval_episodes, seed=seed,
-                           updates=self.updates)
+                           updates=self.updates, rule_seconds=self.rule_seconds)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (world files by name: the folder is the machine's)."""
@@ -80,13 +84,22 @@ class WorldsConfig:
 def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, seed: int, *,
                    report: Any = None) -> dict[str, Any]:
     """One job: :func:`learn_task` of (world, task, learner, seed); the learned policy comes
-    back as text (``policy``), for the run folder's ``policies/``."""
+    back as text (``policy``), for the run folder's ``policies/``. A job that fails reports
+    the policy it had saved (``{"kind": "policy", "text": ...}``, before each evaluation)
+    before its error goes on, so that it is kept too."""
     import tempfile
+
+    from relrl.errors import RelrlError
 
     with tempfile.TemporaryDirectory(prefix="relrl-worlds-") as tmp:
         path = Path(tmp) / "policy.pl"
-        result = learn_task(config.learn_config(world, task, learner, seed), report=report,
-                            policy_out=path)
+        try:
+            result = learn_task(config.learn_config(world, task, learner, seed),
+                                report=report, policy_out=path)
+        except RelrlError:
+            if report is not None and path.is_file():
+                report({"kind": "policy", "text": path.read_text(encoding="utf-8")})
+            raise
         result["policy"] = path.read_text(encoding="utf-8")
     return result
 
@@ -98,7 +111,7 @@ def verify_job(config: WorldsConfig, world: str, task: str, *, report: Any = Non
     from relrl.worlds.world import World
 
     rows = []
-    with World(world) as w:
+    with World(world, rule_seconds=config.rule_seconds) as w:
         if not w.optimal_known:
             return {"world": Path(world).name, "task": task, "rows": [], "stated": False}
         w.attach(make_world_learner("qtable"), 0)
@@ -137,8 +150,14 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
                        units=config.episodes // config.block + 1, label=_label)
     jobs, timings, verified = [], [], []
     policies: dict[str, str] = {}
-    for task, result in zip(tasks, outcome.results, strict=True):
+    for task, result, events in zip(tasks, outcome.results, outcome.events, strict=True):
         if result is None:
+            if len(task) != 3:
+                unfinished = _unfinished(task, events)
+                jobs += unfinished
+                kept = [ev["text"] for ev in events if ev.get("kind") == "policy"]
+                if unfinished and kept:
+                    policies[_policy_name(unfinished[0])] = kept[-1]
             continue
         if len(task) == 3:
             verified.append(result)
@@ -150,7 +169,8 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
         jobs.append(result)
     results = {"experiment": "worlds", "relrl_version": __version__,
                "config": config.to_dict(), "seeds": config.seeds,
-               "partial": not outcome.complete, "summary": summarize(jobs, config),
+               "partial": not outcome.complete,
+               "summary": summarize([j for j in jobs if not j.get("partial")], config),
                "optimal_check": verified, "jobs": jobs}
     if outcome.interrupted:
         results["interrupted_by"] = outcome.interrupted
@@ -164,6 +184,19 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
     if outcome.error:
         raise_kept(outcome.error, out)
     return results, files
+
+
+def _unfinished(task: tuple, events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """A job that did not finish, as the evaluation points it reported (none: nothing),
+    marked ``"partial": true``: in ``jobs`` and curves.csv, not in the summary (its policy,
+    when it failed after saving one, in ``policies/`` as a finished job's)."""
+    curve = [ev["entry"] for ev in events if ev.get("kind") == "point"]
+    if not curve:
+        return []
+    _, world, name, learner, seed = task
+    return [{"world": Path(world).name, "task": name, "learner": learner, "seed": seed,
+             "curve": curve, "test": {}, "final": curve[-1],
+             "memory": {"positions": curve[-1]["memory_positions"]}, "partial": True}]
 
 
 def _policy_name(job: dict[str, Any]) -> str:

@@ -29,7 +29,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from relrl.worlds.world import World, score
+from relrl.worlds.world import RULE_SECONDS, World, score
 
 __all__ = ["LearnConfig", "evaluation_seed", "learn_task", "step_cost_by_size"]
 
@@ -50,6 +50,7 @@ class LearnConfig:
     seed: int = 0
     updates: str = "episode"                #: episode (RRL's) or online
     speed: bool = True                      #: measure the step cost by size and the shape
+    rule_seconds: float = RULE_SECONDS      #: how long a rule of the world may run
     cost_sizes: list[int] = field(default_factory=list)   #: default: train + test sizes
 
     def to_dict(self) -> dict[str, Any]:
@@ -59,13 +60,15 @@ class LearnConfig:
 
 def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] | None = None,
                policy_out: str | Path | None = None, policy_in: str | Path | None = None,
-               traces: int = 0, monitor: Any = None) -> dict[str, Any]:
+               traces: int = 0, monitor: Any = None,
+               stop: Callable[[], bool] | None = None) -> dict[str, Any]:
     """Learn ``config.task`` and evaluate it; returns a JSON-ready dict.
 
     Args:
         config: the run.
         report: called with ``{"kind": "point", "entry": ...}`` after each evaluation.
-        policy_out: save the learned policy there (readable Prolog).
+        policy_out: save the learned policy there (readable Prolog), before each
+            evaluation: whatever happens during one, the policy learned so far is kept.
         policy_in: start from this saved policy instead of from nothing.
         traces: keep this many greedy episodes of each test size with every step's state
             (for replay).
@@ -73,28 +76,89 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
             is given the progress (status), the curve (one point of the plot per
             evaluation: the fraction of optimal), the learned tree and the first greedy
             episode's last state; the evaluation's episodes are the same with or without it.
+        stop: asked between two crossings into Prolog; True stops the run (a stop signal,
+            which also interrupts the crossing that is running).
 
     The result holds ``curve`` (one entry per evaluation), ``test`` (per test size),
     ``memory``, ``timing`` (wall-clock figures; the caller keeps them out of results.json)
     and, with ``traces``, ``traces``.
+
+    Raises:
+        KeyboardInterrupt: stopped (a signal, or ``stop``).
+        RelrlError: a rule of the world failed, ran past its time limit ...
+        Either carries ``partial``: the result so far, marked ``"partial": true`` --
+        every evaluation point and test size that finished -- whose ``policy_episodes``
+        says which policy ``policy_out`` holds (the one saved before the evaluation that
+        was running).
     """
-    with World(config.world) as world:
+    from relrl.errors import RelrlError
+
+    with World(config.world, rule_seconds=config.rule_seconds) as world, \
+            tempfile.TemporaryDirectory(prefix="relrl-world-") as tmp:
+        run = _Run(config, world, Path(tmp) / "policy.pl", policy_out, stop)
+        try:
+            return run.learn(report, policy_in, traces, monitor)
+        except (KeyboardInterrupt, RelrlError) as exc:
+            exc.partial = run.partial(exc)  # type: ignore[attr-defined]
+            raise
+
+
+class _Run:
+    """One :func:`learn_task` run and what it has done so far (for a partial result)."""
+
+    def __init__(self, config: LearnConfig, world: World, saved: Path,
+                 policy_out: str | Path | None, stop: Callable[[], bool] | None) -> None:
+        self.config, self.world, self.saved = config, world, saved
+        self.policy_out, self.stop = policy_out, stop
+        self.curve: list[dict[str, Any]] = []
+        self.test: dict[str, Any] = {}
+        self.kept: dict[str, list[dict[str, Any]]] = {}
+        self.memory: dict[str, Any] = {}
+        self.learn_seconds, self.learn_steps, self.done = 0.0, 0, 0
+        self.policy_episodes: int | None = None     # learning episodes of the saved policy
+
+    def _go_on(self) -> None:
+        """Stop here when a stop was asked for."""
+        if self.stop is not None and self.stop():
+            raise KeyboardInterrupt
+
+    def _keep_policy(self) -> None:
+        """Save the policy as learned so far (to ``policy_out`` too), before an evaluation."""
+        config = self.config
+        header = (f"relrl policy: {config.learner} learner, world {Path(config.world).name}, "
+                  f"task {config.task}")
+        if self.done < config.episodes:
+            header += f" (after {self.done} of {config.episodes} learning episodes)"
+        self._go_on()
+        self.world.save_policy(self.saved, header)
+        if self.policy_out is not None:
+            from relrl.outdir import write_atomic
+
+            write_atomic(self.policy_out, self.saved.read_text(encoding="utf-8"))
+        self.policy_episodes = self.done
+
+    def learn(self, report: Callable[[dict[str, Any]], None] | None,
+              policy_in: str | Path | None, traces: int, monitor: Any) -> dict[str, Any]:
+        """The run itself (see :func:`learn_task`): its result when it finishes."""
+        config, world = self.config, self.world
         task = world.task(config.task)
         learner = world.learner(config.learner, **config.params)
         world.attach(learner, config.seed, task)
         if policy_in is not None:
             world.load_policy(policy_in)
-        curve: list[dict[str, Any]] = []
-        learn_seconds, learn_steps, done = 0.0, 0, 0
+        curve = self.curve
 
         def evaluate() -> None:
+            self._keep_policy()
+            self._go_on()
             eps = world.episodes(task, config.train_sizes, config.eval_episodes, "greedy",
                                  optimal=True, trace=monitor is not None,
                                  seed=evaluation_seed(config.seed, f"point {len(curve)}"))
             ev = score(eps)
             positions, details = world.size()
+            self.memory = {**details, "positions": positions}
             entry = {"point": len(curve), **ev, "eval_episodes": ev["episodes"],
-                     "episodes": done, "learning_steps": learn_steps,
+                     "episodes": self.done, "learning_steps": self.learn_steps,
                      "memory_positions": positions}
             curve.append(entry)
             if report is not None:
@@ -106,56 +170,76 @@ def learn_task(config: LearnConfig, *, report: Callable[[dict[str, Any]], None] 
             monitor.status("initial evaluation", f"{config.learner} on {config.task}: "
                            f"{config.eval_episodes} greedy episodes")
         evaluate()
-        while done < config.episodes:
+        while self.done < config.episodes:
             if monitor is not None:
                 monitor.status("learning", f"{config.learner} learns {config.task}: episodes "
-                               f"{done + 1}-{min(done + config.block, config.episodes)} of "
-                               f"{config.episodes}", done=done, total=config.episodes)
-            n = min(config.block, config.episodes - done)
+                               f"{self.done + 1}-{min(self.done + config.block, config.episodes)}"
+                               f" of {config.episodes}", done=self.done, total=config.episodes)
+            n = min(config.block, config.episodes - self.done)
+            self._go_on()
             t0 = time.perf_counter()
             eps = world.episodes(task, config.train_sizes, n, "learn", updates=config.updates)
-            learn_seconds += time.perf_counter() - t0
-            learn_steps += sum(e.steps for e in eps)
-            done += n
+            self.learn_seconds += time.perf_counter() - t0
+            self.learn_steps += sum(e.steps for e in eps)
+            self.done += n
             evaluate()
         positions, details = world.size()
-        test: dict[str, Any] = {}
-        kept: dict[str, list[dict[str, Any]]] = {}
         if monitor is not None:
             monitor.status("evaluating", "no further learning: sizes "
                            + ", ".join(map(str, config.test_sizes)))
         for size in config.test_sizes:
-            eps = world.episodes(task, [size], config.eval_episodes, "greedy", optimal=True,
-                                 trace=traces > 0,
-                                 seed=evaluation_seed(config.seed, f"size {size}"))
-            test[str(size)] = score(eps)
+            self._go_on()
+            # only the episodes kept for replay bring their steps back (an answer of 100
+            # traced episodes of 50 blocks is millions of terms); the rest follow from a
+            # stream of their own
+            kept = min(traces, config.eval_episodes)
+            eps = world.episodes(task, [size], kept, "greedy", optimal=True, trace=True,
+                                 seed=evaluation_seed(config.seed, f"size {size}")) \
+                if kept else []
+            if config.eval_episodes > kept:
+                eps += world.episodes(task, [size], config.eval_episodes - kept, "greedy",
+                                      optimal=True,
+                                      seed=evaluation_seed(config.seed,
+                                                           f"size {size} untraced"))
+            self.test[str(size)] = score(eps)
             if traces:
-                kept[str(size)] = [{"goal": e.goal, "steps": e.steps, "optimal": e.optimal,
-                                    "reached": e.reached, "trace": list(e.trace)}
-                                   for e in eps[:traces]]
-        with tempfile.TemporaryDirectory(prefix="relrl-world-") as tmp:
-            saved = Path(tmp) / "policy.pl"
-            world.save_policy(saved, f"relrl policy: {config.learner} learner, world "
-                                     f"{Path(config.world).name}, task {config.task}")
-            if policy_out is not None:
-                from relrl.outdir import write_atomic
-
-                write_atomic(policy_out, saved.read_text(encoding="utf-8"))
-            timing: dict[str, Any] = {
-                "learning_seconds": learn_seconds, "learning_steps": learn_steps,
-                "learning_steps_per_second": learn_steps / learn_seconds
-                if learn_seconds else None}
-            if config.speed:
-                sizes = config.cost_sizes or sorted({*config.train_sizes, *config.test_sizes})
-                timing["step_cost_by_size"] = step_cost_by_size(world, task, saved, sizes)
-                timing["shape"] = _shape(world, task, saved, config.train_sizes)
+                self.kept[str(size)] = [{"goal": e.goal, "steps": e.steps,
+                                         "optimal": e.optimal, "reached": e.reached,
+                                         "trace": list(e.trace)} for e in eps[:traces]]
+        timing = self._timing()
+        if config.speed:
+            sizes = config.cost_sizes or sorted({*config.train_sizes, *config.test_sizes})
+            timing["step_cost_by_size"] = step_cost_by_size(world, task, self.saved, sizes)
+            timing["shape"] = _shape(world, task, self.saved, config.train_sizes)
         out = {"world": Path(config.world).name, "task": config.task,
-               "learner": config.learner, "seed": config.seed, "curve": curve, "test": test,
-               "final": curve[-1], "memory": {**details, "positions": positions},
-               "timing": timing}
+               "learner": config.learner, "seed": config.seed, "curve": curve,
+               "test": self.test, "final": curve[-1],
+               "memory": {**details, "positions": positions}, "timing": timing}
         if traces:
-            out["traces"] = kept
+            out["traces"] = self.kept
             out["graph"] = world.engine.graph()
+        return out
+
+    def _timing(self) -> dict[str, Any]:
+        return {"learning_seconds": self.learn_seconds, "learning_steps": self.learn_steps,
+                "learning_steps_per_second": self.learn_steps / self.learn_seconds
+                if self.learn_seconds else None}
+
+    def partial(self, exc: BaseException) -> dict[str, Any]:
+        """What the run has done, for a stop or an error (no call into Prolog: the crossing
+        that was running may have been cut)."""
+        config = self.config
+        out = {"world": Path(config.world).name, "task": config.task,
+               "learner": config.learner, "seed": config.seed, "curve": self.curve,
+               "test": self.test, "final": self.curve[-1] if self.curve else None,
+               "memory": self.memory, "timing": self._timing(), "partial": True,
+               "stopped_by": "error" if not isinstance(exc, KeyboardInterrupt)
+               else "signal", "episodes_learned": self.done,
+               "policy_episodes": self.policy_episodes}
+        if not isinstance(exc, KeyboardInterrupt):
+            out["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        if self.kept:
+            out["traces"] = self.kept
         return out
 
 

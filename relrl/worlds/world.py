@@ -12,6 +12,7 @@ Example:
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from collections.abc import Sequence
@@ -20,8 +21,9 @@ from pathlib import Path
 from typing import Any
 
 from relrl.bridge.calls import display_path as _display_path
-from relrl.engine import Engine, call, call_semidet, one
-from relrl.errors import ConfigError, PrologError
+from relrl.bridge.calls import prolog
+from relrl.engine import Engine, EngineError, call, call_semidet, one
+from relrl.errors import ConfigError, PrologError, QueryTimeout
 from relrl.kb import KnowledgeBase
 from relrl.learners import Learner, make_world_learner
 from relrl.terms import Term, Var, format_term
@@ -32,6 +34,13 @@ __all__ = ["Episode", "World", "score"]
 #: Breadth-first search bound (states) for the optimal number of steps of a world that
 #: does not state it (optimal_steps/3).
 BFS_LIMIT = 20_000
+#: States a search visits, from each start state, to tell a task instance whose goal cannot
+#: be reached (:meth:`World.check_instance`).
+REACH_LIMIT = 2_000
+#: Seconds a world's rule may run (``--rule-seconds``): a step of the world, or a goal of it
+#: between two steps, that runs longer is stopped with an error naming the rule. A batch of
+#: episodes, a check or a search runs as long as it makes progress.
+RULE_SECONDS = 10.0
 
 
 @dataclass(frozen=True)
@@ -84,20 +93,35 @@ def score(episodes: Sequence[Episode]) -> dict[str, Any]:
 class World:
     """A world file loaded into a knowledge base of its own.
 
+    Every call that runs the world's rules (its check, episodes, searches) stops at Ctrl-C
+    (and SIGTERM or SIGHUP, when the command handles them) within a tenth of a second, and
+    stops a rule of the world that runs ``rule_seconds`` with a
+    :class:`~relrl.errors.QueryTimeout` naming it, however long the whole call runs.
+
     Args:
         path: the world file (Prolog; docs/worlds.md).
-        timeout: seconds one call (a batch of episodes) may run.
+        timeout: seconds a call that runs none of the world's rules may run (a learner's
+            save or load); loading the file has ``rule_seconds``.
+        rule_seconds: seconds a rule of the world may run (:data:`RULE_SECONDS`).
 
     Raises:
         PrologLoadError: the file is missing or does not load (file:line).
+        ConfigError: ``rule_seconds`` is not a positive number of seconds.
     """
 
-    def __init__(self, path: str | os.PathLike, *, timeout: float = 600.0) -> None:
+    def __init__(self, path: str | os.PathLike, *, timeout: float = 600.0,
+                 rule_seconds: float = RULE_SECONDS) -> None:
+        if not (isinstance(rule_seconds, (int, float)) and math.isfinite(rule_seconds)
+                and rule_seconds > 0):
+            raise ConfigError(f"the rule time limit must be a positive number of seconds, "
+                              f"not {rule_seconds!r}")
         self.path = Path(path)
-        self.kb = KnowledgeBase(timeout=timeout)
+        self.rule_seconds = float(rule_seconds)
+        self.kb = KnowledgeBase(timeout=self.rule_seconds)   # the file's directives too
         try:
             self.kb.load(self.path)
-            info = {item[0]: item[1:] for item in one(self.kb, "world_info", self.kb.module)}
+            self.kb.timeout = timeout
+            info = {item[0]: item[1:] for item in self._ask("world_info", self.kb.module)}
         except BaseException:
             self.kb.close()
             raise
@@ -126,7 +150,7 @@ class World:
         (prolog/world_check.pl)."""
         problems: list[str] = []
         warnings: list[str] = []
-        for kind, path, line, message in one(self.kb, "world_check", self.kb.module):
+        for kind, path, line, message in self._ask("world_check", self.kb.module):
             where = (f"{_display_path(path)}:{line}" if path
                      else _display_path(str(self.path)))
             if kind == "warning":
@@ -164,6 +188,29 @@ class World:
                               f"{_display_path(str(self.path))} (tasks: "
                               f"{', '.join(self.task_names())})")
         return out[0]
+
+    def check_instance(self, text: str, sizes: Sequence[int]) -> None:
+        """Refuse a task instance (``on(b1, b2)``; a task's name passes) whose goal cannot be
+        reached at one of ``sizes``: an object the world does not have (``on(b1, b99)``,
+        ``on(b1, shell(x))``) or a goal no state holds (``on(b1, b1)``), found by a
+        breadth-first search of at most :data:`REACH_LIMIT` states (larger sizes pass).
+
+        Raises:
+            ConfigError: naming the task and the size.
+        """
+        text = text.strip()
+        if re.fullmatch(r"[a-z][A-Za-z0-9_]*", text):
+            return
+        task = self.task(text)
+        for size in sorted(set(sizes)):
+            verdict = self._ask("world_reachable", self.kb.module, task, int(size),
+                                REACH_LIMIT)
+            if verdict == "unreachable":
+                raise ConfigError(f"--task {text!r}: its goal cannot be reached in a world of "
+                                  f"{size} objects (a search of every state reachable from "
+                                  f"its start states; tasks of "
+                                  f"{_display_path(str(self.path))}: "
+                                  f"{', '.join(self.task_names())})")
 
     def _task(self, task: Term | str) -> Term:
         return self.task(task) if isinstance(task, str) else task
@@ -219,7 +266,7 @@ class World:
             options.append(("random", int(seed)))
         spec = ("episodes", self._task(task), [int(s) for s in sizes], int(count), mode,
                 options)
-        raw = one(self.kb, "world_episodes", self.kb.module, spec)
+        raw = self._ask("world_episodes", self.kb.module, spec)
         return [_episode(e) for e in raw]
 
     def episodes_from(self, task: Term | str, starts: Sequence[tuple[list[Term], Term | None]],
@@ -249,15 +296,15 @@ class World:
         spec = ("from", self._task(task),
                 [("start", list(facts), "none" if inst is None else inst)
                  for facts, inst in starts], mode, options)
-        raw = one(self.kb, "world_episodes_from", self.kb.module, spec)
+        raw = self._ask("world_episodes_from", self.kb.module, spec)
         return [_episode(e) for e in raw]
 
     def verify_optimal(self, task: Term | str, size: int, count: int
                        ) -> list[tuple[int | None, int | None]]:
         """``(declared, searched)`` optimal steps for ``count`` random start states: the
         world's optimal_steps/3 against a breadth-first search of its own dynamics."""
-        pairs = one(self.kb, "world_verify", self.kb.module, self._task(task), int(size),
-                    int(count))
+        pairs = self._ask("world_verify", self.kb.module, self._task(task), int(size),
+                          int(count))
         return [(_int(p[1]), _int(p[2])) for p in pairs]
 
     def size(self) -> tuple[int, dict[str, int]]:
@@ -276,6 +323,38 @@ class World:
     def text(self) -> str:
         """The learner's knowledge as text (tg: its tree)."""
         return self.engine.text()
+
+    # -- calls that run the world's rules ----------------------------------------------------
+
+    def _ask(self, goal: str, *arguments: Term) -> Term:
+        """Call ``goal`` (a name of ``python_api/2``) with ``arguments`` and one more output
+        argument, under the rule time limit (counted from the world's last step) and
+        stopped by Ctrl-C; return the output's value.
+
+        Raises:
+            QueryTimeout: a rule of the world ran :attr:`rule_seconds` (named).
+            EngineError: the goal failed.
+        """
+        module, predicate = prolog().goal(goal)
+        watched, watcher = prolog().goal("watched")
+        out = Var()
+        inner = (":", module, (predicate, *arguments, out))
+        try:
+            with self.kb.interruptible():
+                values = prolog().run((":", watched, (watcher, self.rule_seconds, inner)),
+                                      self.rule_seconds, [1], watched=True)
+        except QueryTimeout as exc:
+            limit = (f"ran longer than {self.rule_seconds:g} s (a rule that never ends? "
+                     "--rule-seconds sets the limit)")
+            if exc.rule:
+                raise QueryTimeout(f"{exc.where}: rule {exc.rule} {limit}", exc.rule,
+                                   exc.where) from None
+            raise QueryTimeout(f"{_display_path(str(self.path))}: the world's goal {limit}") \
+                from None
+        if values is None:
+            raise EngineError(f"{module}:{predicate}/{len(arguments) + 1} failed in "
+                              f"{self.kb.module}")
+        return values[0][2][-1]
 
     # -- life -------------------------------------------------------------------------------
 

@@ -103,9 +103,32 @@ def test_halt_in_a_rule_is_an_error(tmp_path: Path) -> None:
     path = domain(tmp_path, BASE + "fact(leave(face)).\nleave(face) :- halt.\n")
     with KnowledgeBase(path) as kb:
         agent = Agent(kb, make_learner("etg"), seed=0)
-        with pytest.raises(RuleError, match="halt/0,1 called by a goal"):
+        with pytest.raises(RuleError, match=r"d\.pl:5: rule leave\(face\) called halt/0,1"):
             agent.step([("see", "face")])
         assert kb.holds("true")
+
+
+@pytest.mark.parametrize("goal", ["halt", "halt(3)", "system:halt", "call(halt)"])
+def test_halt_called_many_times_never_ends_relrl(tmp_path: Path, goal: str) -> None:
+    """SWI-Prolog honours a cancelled halt only nine times in a process: a rule that calls
+    halt/0,1 over and over (a world's precondition in every step of a check) must still
+    not end relrl, and each call is an error. (In a process of its own: the halt it guards
+    against would end the test run with status 0.)"""
+    import subprocess
+    import sys
+
+    path = domain(tmp_path, BASE + f"fact(leave(face)).\nleave(face) :- {goal}.\n"
+                  "many :- forall(between(1, 30, _), ignore(catch(leave(face), _, true))).\n")
+    script = ("import sys\nfrom relrl.errors import RuleError\nfrom relrl.kb import "
+              "KnowledgeBase\nwith KnowledgeBase(sys.argv[1]) as kb:\n"
+              "    for _ in range(12):\n        try:\n            kb.holds('many')\n"
+              "        except RuleError as exc:\n            print(exc)\n"
+              "    print('alive', kb.holds('true'))\n")
+    proc = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
+                          text=True, timeout=120, cwd=ROOT)
+    lines = proc.stdout.splitlines()
+    assert proc.returncode == 0 and lines[-1] == "alive True", (proc.stdout, proc.stderr)
+    assert len(lines) == 13 and all("halt/0,1" in line for line in lines[:-1])
 
 
 def test_abort_while_loading_is_a_load_error(tmp_path: Path) -> None:
@@ -245,7 +268,7 @@ def test_python_calls_only_the_declared_api_and_all_of_it() -> None:
     declared = {str(t[1]) for t in prolog().run(
         (":", "relrl_gateway", ("gw_api", Var())), 0, (0,))[0]}  # type: ignore[index]
     calls = re.compile(r'(?:\b(?:call|one|call_semidet|engine_call)\(\s*[\w.]+,\s*'
-                       r'|\.goal\(|\.api\()"(\w+)"')
+                       r'|\.goal\(|\.api\(|\._ask\()"(\w+)"')   # _ask: a world's, watched
     used = {m.group(1) for path in (ROOT / "relrl").rglob("*.py")
             for m in calls.finditer(path.read_text())}
     assert used <= declared, used - declared
