@@ -136,6 +136,19 @@ def _has_var(term: Term) -> bool:
     return isinstance(term, tuple) and any(_has_var(a) for a in term[1:])
 
 
+def _check_optima(eps: Sequence[Any], starts: list[Start] | None, label: str) -> None:
+    """Refuse an episode that reached its goal in fewer moves than its optimum: the optimum
+    (the world's optimal_steps/3) is then wrong for that state, most often a given state that
+    breaks the world's invariants (a block on two blocks), and every figure would be too."""
+    for i, e in enumerate(eps):
+        if e.reached and e.optimal is not None and e.steps < e.optimal:
+            where = starts[i].where if starts is not None else f"size {label}, episode {i + 1}"
+            raise ConfigError(f"{where}: the goal {e.goal} was reached in {e.steps} moves, "
+                              f"fewer than the optimum the world gives ({e.optimal}): not a "
+                              f"state the world's optimal_steps/3 describes (does it break "
+                              f"the world's invariants, e.g. a block on two blocks?)")
+
+
 def evaluate_policy(world_path: str | Path, policy: str | Path, task_text: str, *,
                     sizes: Sequence[int] = (), episodes: int = 100,
                     states: str | Path | None = None, seed: int = 0,
@@ -187,6 +200,7 @@ def evaluate_policy(world_path: str | Path, policy: str | Path, task_text: str, 
                                      actions=actions,
                                      seed=evaluation_seed(seed, f"size {size}"))
             cpu = time.process_time() - t0
+            _check_optima(eps, starts, label)
             summary[label] = {**score(eps), "cpu_seconds_per_episode": cpu / max(1, len(eps))}
             for i, e in enumerate(eps):
                 row = {"size": e.size, "state": i + 1 if starts is not None else None,

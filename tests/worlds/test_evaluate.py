@@ -145,3 +145,18 @@ def test_evaluate_never_runs_a_states_file(policies, tmp_path: Path) -> None:
     assert _evaluate(policies["stack"], "stack", "--states", str(states),
                      "--out", str(tmp_path / "out")) == 2
     assert not marker.exists()
+
+
+def test_evaluate_refuses_a_state_reached_below_its_optimum(policies, tmp_path: Path,
+                                                            capsys) -> None:
+    """A given state that breaks the world's invariants (b1 on both b2 and b3) made the
+    world's optimal_steps/3 overestimate, and the evaluation reported 1.5 of optimal."""
+    states = tmp_path / "two.pl"
+    states.write_text("[on(b1, b2), on(b1, b3), on(b2, floor), on(b3, floor), clear(b1)].\n")
+    out = tmp_path / "out"
+    code = _evaluate(policies["on"], "on", "--states", str(states), "--out", str(out))
+    err = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(err.splitlines()) == 1
+    assert f"{display_path(str(states))}:1: the goal" in err and "fewer than the optimum" in err
+    assert not (out / "results.json").exists()
