@@ -253,8 +253,8 @@ def _run1(s: dict[str, Any]) -> tuple[float | None, float | None]:
 def _sis_summary(run: Run) -> str:
     r = run.results
     cfg, summary = r["config"], r["summary"]
-    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), {cfg['points']} "
-            f"evaluation points of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
+    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), "
+            f"{cfg['points'] + 1} evaluation points (the first before learning) of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
             f"{cfg['block']} learning units between points; caregiver `{cfg['caregiver']}`"
             + (f", preset `{cfg['preset']}`" if cfg.get("preset") else "") + ".\n\n")
     rows = []

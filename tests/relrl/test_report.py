@@ -154,3 +154,12 @@ def test_experiment2_views_of_a_run_with_table1_for_one_reading_only(tmp_path: P
     assert "| success | — | 80.00 ± 3.00 |" in table1
     confusions = render(load_run(tmp_path), "confusions", "exp2")
     assert "| etg/interaction | apple | apple 90.0 %, nothing 10.0 % |" in confusions
+
+
+def test_the_summary_counts_the_evaluation_points_the_demo_counts(sis_run: Path) -> None:
+    """``--points 2`` evaluates three times (before learning, after each block): the summary
+    says 3, as ``relrl demo`` does of its own run and as the curve holds."""
+    text = render(load_run(sis_run), "summary", "exp1")
+    curve = next(iter(json.loads((sis_run / "results.json").read_text())["summary"].values()))
+    assert len(curve["curve"]) == 3
+    assert "3 evaluation points (the first before learning)" in text, text
