@@ -108,6 +108,12 @@ def table(header: list[str], rows: list[list[Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def shown_command(command: str) -> str:
+    """A run's command as a document shows it: an absolute output folder (a machine's own
+    path, which says nothing of the numbers) as ``DIR``."""
+    return re.sub(r"(--out[ =])/\S+", r"\1DIR", command)
+
+
 def provenance(run: Run, label: str) -> str:
     """The line that says where the numbers come from."""
     from relrl.machine import describe
@@ -118,7 +124,7 @@ def provenance(run: Run, label: str) -> str:
     when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
     line = f"*From `{label}/results.json`"
     if command:
-        line += f", made by `{command}`"
+        line += f", made by `{shown_command(command)}`"
     line += f" on {describe(machine)}" + (f", {when}" if when else "")
     if run.results.get("partial"):
         line += " (**a partial run**: stopped before the end)"
@@ -254,7 +260,8 @@ def _sis_summary(run: Run) -> str:
     r = run.results
     cfg, summary = r["config"], r["summary"]
     head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), "
-            f"{cfg['points'] + 1} evaluation points (the first before learning) of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
+            f"{cfg['points'] + 1} evaluation points (the first before learning) of "
+            f"{cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
             f"{cfg['block']} learning units between points; caregiver `{cfg['caregiver']}`"
             + (f", preset `{cfg['preset']}`" if cfg.get("preset") else "") + ".\n\n")
     rows = []

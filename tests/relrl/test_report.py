@@ -163,3 +163,16 @@ def test_the_summary_counts_the_evaluation_points_the_demo_counts(sis_run: Path)
     curve = next(iter(json.loads((sis_run / "results.json").read_text())["summary"].values()))
     assert len(curve["curve"]) == 3
     assert "3 evaluation points (the first before learning)" in text, text
+
+
+def test_a_machine_path_in_the_command_is_not_shown(sis_run: Path, tmp_path: Path) -> None:
+    """A run written into an absolute folder (``--out /home/me/runs/x``) is shown as made by
+    ``--out DIR``: no machine's path reaches a document."""
+    run = tmp_path / "abs"
+    shutil.copytree(sis_run, run)
+    record = json.loads((run / ".relrl-run.json").read_text())
+    record["command"] = "relrl experiment sis --workers 2 --out /home/me/scratch/exp1"
+    (run / ".relrl-run.json").write_text(json.dumps(record))
+    text = render(load_run(run), "short", "abs")
+    assert "made by `relrl experiment sis --workers 2 --out DIR`" in text, text
+    assert "/home/me" not in text
