@@ -16,11 +16,13 @@ BIN    := $(VENV)/bin
 #         test tools.
 DEMO_EXTRAS := plots
 TEST_EXTRAS := dev,speech,monitor,ray,mcap,foxglove
-# Stable-Baselines3 (`make sb3`), apart from the tests: torch's CPU build alone is 0.87 GB in
-# the environment (docs/rl-tools.md). It goes in first, pinned, so that Stable-Baselines3 does
-# not pull a CUDA build of several GB; elsewhere give the CPU build's index, e.g.
-#   make sb3 TORCH="torch --index-url https://download.pytorch.org/whl/cpu"
-TORCH ?= torch==2.13.0
+# Stable-Baselines3 (`make sb3`), apart from the tests and without their tools: the demo's
+# set-up, torch's CPU build, Stable-Baselines3 (docs/rl-tools.md). torch goes in first, pinned
+# to its CPU build by the local version `+cpu` (no CUDA build has it), so Stable-Baselines3
+# finds torch present and pulls no CUDA build of several GB. Where pip does not already see
+# the CPU wheel, give its index, e.g.
+#   make sb3 TORCH="torch==2.13.0+cpu --extra-index-url https://download.pytorch.org/whl/cpu"
+TORCH ?= torch==2.13.0+cpu
 
 .PHONY: demo test sb3 setup setup-demo setup-test debs-demo debs-test lint clean
 
@@ -71,9 +73,9 @@ test: setup-test
 	$(BIN)/python -m pytest
 
 # Stable-Baselines3's PPO and DQN trained on relrl/SharedAttention-v1, each checked to learn.
-sb3: setup-test
+sb3: setup-demo
 	$(BIN)/pip install -q $(TORCH)
-	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),$(TEST_EXTRAS),sb3]'
+	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),sb3]'
 	$(BIN)/python examples/sb3_shared_attention.py --algo ppo --steps 20000 --check --logdir runs/sb3
 	$(BIN)/python examples/sb3_shared_attention.py --algo dqn --steps 20000 --check --logdir runs/sb3
 

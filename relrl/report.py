@@ -126,6 +126,12 @@ def table(header: list[str], rows: list[list[Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def shown_command(command: str) -> str:
+    """A run's command as a document shows it: an absolute output folder (a machine's own
+    path, which says nothing of the numbers) as ``DIR``."""
+    return re.sub(r"(--out[ =])/\S+", r"\1DIR", command)
+
+
 def provenance(run: Run, label: str) -> str:
     """The line that says where the numbers come from."""
     from relrl.machine import describe
@@ -136,7 +142,7 @@ def provenance(run: Run, label: str) -> str:
     when = (run.manifest.get("ended") or run.manifest.get("started") or "")[:10]
     line = f"*From {code(f'{label}/results.json')}"
     if command:
-        line += f", made by {code(command)}"
+        line += f", made by {code(shown_command(command))}"
     line += f" on {text(describe(machine))}" + (f", {text(when)}" if when else "")
     if run.results.get("partial"):
         line += " (**a partial run**: stopped before the end)"
@@ -338,8 +344,9 @@ def _run1(s: dict[str, Any]) -> tuple[float | None, float | None]:
 def _sis_summary(run: Run) -> str:
     r = run.results
     cfg, summary = r["config"], r["summary"]
-    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), {cfg['points']} "
-            f"evaluation points of {cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
+    head = (f"{len(r['seeds'])} seed(s) ({', '.join(map(str, r['seeds']))}), "
+            f"{cfg['points'] + 1} evaluation points (the first before learning) of "
+            f"{cfg['eval_runs']} runs x {cfg['eval_steps']} time units, "
             f"{cfg['block']} learning units between points; caregiver {code(cfg['caregiver'])}"
             + (f", preset {code(cfg['preset'])}" if cfg.get("preset") else "") + ".\n\n")
     rows = []

@@ -15,7 +15,7 @@ def test_tg_md_shows_the_tree_the_example_learns(tmp_path: Path) -> None:
     text = (ROOT / "docs" / "tg.md").read_text(encoding="utf-8")
     section = text[text.index("**What tg learned**"):]
     command = re.search(r"\(`examples/tg_gaze_following.py ([^`]*)`", section)
-    shown = re.search(r"```\n(\[1\].*?)```", section, re.S)
+    shown = re.search(r"```text\n(\[1\].*?)```", section, re.S)
     assert command and shown
     proc = subprocess.run([sys.executable, str(ROOT / "examples" / "tg_gaze_following.py"),
                            *command[1].split()], capture_output=True, text=True, timeout=600,

@@ -85,14 +85,26 @@ def test_the_tests_install_every_extra_they_use() -> None:
 
 
 def test_stable_baselines3_is_apart_and_gets_torchs_cpu_build_first() -> None:
-    """SB3 is not in the tests' set-up (torch's CPU build alone is 0.87 GB); ``make sb3``
-    installs torch pinned before the extra, so the extra cannot pull a CUDA build."""
+    """SB3 is not in the tests' set-up (torch is large); ``make sb3`` installs torch's CPU
+    build (pinned by its ``+cpu`` local version) before the extra, so the extra cannot pull
+    a CUDA build."""
     assert "sb3" not in _pip_extras("setup-test")
     assert "sb3" in _pip_extras("sb3")
     proc = subprocess.run([_make(), "-n", "-B", "-C", str(ROOT), "sb3"], capture_output=True,
                           text=True, check=True)
     lines = proc.stdout.splitlines()
     torch = next(i for i, line in enumerate(lines) if "pip install -q torch==" in line)
+    assert re.search(r"torch==[\d.]+\+cpu\b", lines[torch]), lines[torch]
     extra = next(i for i, line in enumerate(lines) if "sb3]'" in line)
     assert torch < extra
     assert sum("sb3_shared_attention.py" in line and "--check" in line for line in lines) == 2
+
+
+def test_make_sb3_installs_torch_and_sb3_only_not_the_test_tools() -> None:
+    """``make sb3`` sets up the demo's environment, then torch and Stable-Baselines3: no test
+    tool chain (Ray, Chromium's driver, the monitor) comes with it."""
+    proc = subprocess.run([_make(), "-n", "-B", "-C", str(ROOT), "sb3"], capture_output=True,
+                          text=True, check=True)
+    assert {e for found in re.findall(r"pip install -q -e '\.\[([^\]]*)\]'", proc.stdout)
+            for e in found.split(",")} == {"plots", "sb3"}, proc.stdout
+    assert "debs-test" not in proc.stdout and "espeak-ng" not in proc.stdout, proc.stdout

@@ -440,15 +440,16 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
 
 def _close_tap(tap: SessionTap, *, quiet: bool) -> None:
     """Close the trace and the recording. After an error (``quiet``) an error of closing them
-    -- the recording's process stopped by the same full disk, say -- is logged, not raised:
-    the first error is the one to report, with what was kept."""
+    -- the recording's process stopped by the same full disk, say -- goes to the run's log
+    file only, not the console: the user reads one line, the first error with what was kept,
+    whichever of the session and the recording's process noticed the full disk first."""
     if not quiet:
         tap.close()
         return
     try:
         tap.close()
     except Exception as exc:  # noqa: BLE001 - the session already failed; report that one
-        log.warning("closing the session's outputs after the error: %s", exc)
+        log.debug("closing the session's outputs after the error: %s", exc)
 
 
 def _release(*things: Any, quiet: bool) -> None:

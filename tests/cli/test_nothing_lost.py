@@ -389,3 +389,33 @@ def test_deleting_out_mid_run_ends_in_one_line_not_a_success(capsys, tmp_path):
     assert "deleted" in lines[0] and str(out) in lines[0], lines[0]
     assert "wrote" not in captured.out
     assert not out.exists()
+
+
+def test_a_recording_stopped_by_the_same_full_disk_adds_no_second_line(capsys, tmp_path,
+                                                                      monkeypatch):
+    """The order a busy machine gives: the session's own write fails first, and the
+    recording's writer, stopped by the same full disk, fails only when it is closed. The
+    user reads one line (the first error, with what was kept), not a warning before it."""
+    from relrl.episodes.recording import SessionTap
+    from relrl.errors import OutputError
+
+    (tmp_path / "long.toml").write_text(LONG)
+    step, close = SessionTap.step, SessionTap.close
+
+    def full_step(self, record, phase, **kw):
+        if self.run.t >= 5:
+            raise OutputError(f"cannot write {self.out / 'trace.jsonl'}: "
+                              "No space left on device")
+        return step(self, record, phase, **kw)
+
+    def failed_close(self, *args, **kw):
+        close(self, *args, **kw)
+        raise OutputError("the recording's writer stopped: No space left on device")
+
+    monkeypatch.setattr(SessionTap, "step", full_step)
+    monkeypatch.setattr(SessionTap, "close", failed_close)
+    line = one_line_exit_2(capsys, ["run", str(tmp_path / "long.toml"), "--out",
+                                    str(tmp_path / "out"), "--no-plots"],
+                           "No space left on device", "(partial)")
+    assert "writer stopped" not in line, line
+    assert "recording's writer stopped" in (tmp_path / "out" / "run.log").read_text()

@@ -162,3 +162,25 @@ def test_experiment2_views_of_a_run_with_table1_for_one_reading_only(tmp_path: P
     assert "| success | — | 80.00 ± 3.00 |" in table1
     confusions = render(load_run(tmp_path), "confusions", "exp2")
     assert "| etg/interaction | apple | apple 90.0 %, nothing 10.0 % |" in confusions
+
+
+def test_the_summary_counts_the_evaluation_points_the_demo_counts(sis_run: Path) -> None:
+    """``--points 2`` evaluates three times (before learning, after each block): the summary
+    says 3, as ``relrl demo`` does of its own run and as the curve holds."""
+    text = render(load_run(sis_run), "summary", "exp1")
+    curve = next(iter(json.loads((sis_run / "results.json").read_text())["summary"].values()))
+    assert len(curve["curve"]) == 3
+    assert "3 evaluation points (the first before learning)" in text, text
+
+
+def test_a_machine_path_in_the_command_is_not_shown(sis_run: Path, tmp_path: Path) -> None:
+    """A run written into an absolute folder (``--out /home/me/runs/x``) is shown as made by
+    ``--out DIR``: no machine's path reaches a document."""
+    run = tmp_path / "abs"
+    shutil.copytree(sis_run, run)
+    record = json.loads((run / ".relrl-run.json").read_text())
+    record["command"] = "relrl experiment sis --workers 2 --out /home/me/scratch/exp1"
+    (run / ".relrl-run.json").write_text(json.dumps(record))
+    text = render(load_run(run), "short", "abs")
+    assert "made by `relrl experiment sis --workers 2 --out DIR`" in text, text
+    assert "/home/me" not in text
