@@ -197,50 +197,18 @@ relation(goal_clear(_)).
 relation(covers(_, _)).
 relation(highest(_)).
 
-% The language bias: blocks are variables (a test speaks of *a* block, never of b3), the
-% floor the one constant.
-rmode(action(move(-block, -block))).
-rmode(action(move(-block, floor))).
-rmode(on(+block, -block)).
-rmode(on(+block, +block)).
-rmode(on(+block, floor)).
-rmode(goal_on(+block, -block)).
-rmode(goal_on(-block, +block)).
-rmode(goal_on(+block, +block)).
-rmode(covers(+block, -block)).
-rmode(covers(+block, +block)).
-
-% Stacking needs the top of a tallest tower; for the other tasks it is a distraction (a tree
-% that splits on it values moves by the tower heights of 3-5 blocks), so only stack's bias
-% holds it.
-task_rmode(stack, highest(+block)).
-
-% Unstacking needs to know only what a move does to the block it moves: off a block onto the
-% floor is right in every state, any other move wrong. Tests of the towers tell states near
-% the goal from states far from it, and a Q-tree that splits on them ranks the moves of one
-% state by the values of different states (a move that is only legal near the goal looks
-% better than the right move far from it); so unstack has a bias of its own.
-task_rmode(unstack, action(move(-block, -block))).
-task_rmode(unstack, action(move(-block, floor))).
-task_rmode(unstack, on(+block, floor)).
-
-% on(A, B) likewise, with what a move does to the goal's blocks: is the moved block A (or
-% B), is it above A or B (covers/2: X above a goal block, a recursive relation of the
-% tower); is the destination B, A, the floor, above A or B, another block; are A and B
-% clear (goal_on(A, B), clear(A)), is A above B. No test follows on/2 from block to block,
-% so none counts the blocks above A or B: with the shared modes the Q-tree split on such
-% chains, which tell states near the goal from far ones, and valued moves by the tower
-% heights of 3-5 blocks (0.42 of optimal on 10 blocks; docs/worlds.md).
-task_rmode(on(_, _), action(move(-block, -block))).
-task_rmode(on(_, _), action(move(-block, floor))).
-task_rmode(on(_, _), goal_on(-block, -block)).
-task_rmode(on(_, _), goal_on(+block, +block)).
-task_rmode(on(_, _), goal_on(+block, -block)).
-task_rmode(on(_, _), goal_on(-block, +block)).
-task_rmode(on(_, _), covers(+block, -block)).
-task_rmode(on(_, _), clear(+block)).
-task_own_bias(unstack).
-task_own_bias(on(_, _)).
+% The types of the relations and of the action: relrl generates the language bias from
+% them (docs/worlds.md, A bias from declarations). Blocks are objects, never named by a
+% test (a test speaks of *a* block, never of b3); the floor is the one constant.
+signature(move(block, place)).
+signature(on(block, place)).
+signature(clear(block)).
+signature(goal_on(block, block)).
+signature(goal_clear(block)).
+signature(covers(block, block)).
+signature(highest(block)).
+subtype(block, place).
+type(floor, place).
 
 % ---- the optimal number of moves (verified against a breadth-first search by relrl check) --
 

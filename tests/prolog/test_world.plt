@@ -234,47 +234,105 @@ bias_modes(KB, Task, Modes) :-
     world_for_task(KB, Task),
     relrl_tg_bias:tg_bias(KB, bias(Modes, _)).
 
-test(only_stack_sees_highest) :-
-    blocks(KB),
-    bias_modes(KB, stack, Stack),
-    bias_modes(KB, unstack, Unstack),
-    bias_modes(KB, on(b1, b2), On),
-    assertion(memberchk(highest(+block), Stack)),
-    assertion(\+ memberchk(highest(+block), Unstack)),
-    assertion(\+ memberchk(highest(+block), On)),
-    findall(M, relrl_declarations:declared(KB, rmode(M)), Shared),
-    subtract(Stack, [highest(+block)], Rest),
-    assertion(Rest == Shared).                      % stack: the shared modes and highest/1
+%   A world with shared modes, a mode for one task (task_rmode/2) and a task with a bias of
+%   its own (task_own_bias/1): options a world may use, blocks.pl needs neither.
+task_bias_kb(KB) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "task(u(_)).", "task(w).",
+             "action(go(_)).", "precondition(go(X), S) :- member(p(X), S).",
+             "effect(go(_), _, [], []).", "goal(_, _) :- fail.", "relation(p(_)).",
+             "relation(q(_)).",
+             "rmode(action(go(-x))).", "rmode(p(+x)).",
+             "task_rmode(t, q(+x)).",
+             "task_rmode(w, action(go(-x))).", "task_own_bias(w)."],
+            KB, _).
 
-test(unstack_has_a_bias_of_its_own, [Unstack == [action(move(-block, -block)),
-                                                 action(move(-block, floor)),
-                                                 on(+block, floor)]]) :-
-    % task_own_bias(unstack): its task_rmode/2 modes alone, none of the shared rmode/1
-    blocks(KB),
-    bias_modes(KB, unstack, Unstack),
-    bias_modes(KB, stack, Stack),
-    assertion(memberchk(on(+block, -block), Stack)).  % the shared modes: stack keeps them
+test(task_rmode_joins_its_task_only) :-
+    task_bias_kb(KB),
+    bias_modes(KB, t, T),
+    bias_modes(KB, u(a), U),
+    assertion(T == [action(go(-x)), p(+x), q(+x)]),
+    assertion(U == [action(go(-x)), p(+x)]).
 
-test(on_has_a_bias_of_its_own, [On == [action(move(-block, -block)),
-                                       action(move(-block, floor)),
-                                       goal_on(-block, -block), goal_on(+block, +block),
-                                       goal_on(+block, -block), goal_on(-block, +block),
-                                       covers(+block, -block), clear(+block)]]) :-
-    % task_own_bias(on(_, _)), for every instance of the task: the moved block and its
-    % destination against the goal's blocks, and no on/2 from block to block (nothing that
-    % counts the blocks above A or B)
-    blocks(KB),
-    bias_modes(KB, on(b1, b2), On),
-    assertion(\+ memberchk(on(+block, -block), On)).
+test(own_bias_is_its_task_rmodes_alone, [W == [action(go(-x))]]) :-
+    task_bias_kb(KB),
+    bias_modes(KB, w, W).
 
 test(a_domain_keeps_its_rmodes) :-
     % no task configured (a domain's knowledge base): the bias is rmode/1
-    blocks(KB),
+    task_bias_kb(KB),
     relrl_tg_bias:tg_bias(KB, bias(Modes, _)),
-    findall(M, relrl_declarations:declared(KB, rmode(M)), Declared),
-    assertion(Modes == Declared).
+    assertion(Modes == [action(go(-x)), p(+x)]).
+
+test(blocks_has_one_bias_for_every_task) :-
+    % blocks.pl declares types, no rmode/1 and no task_rmode/2: every task learns from
+    % the one generated bias
+    blocks(KB),
+    assertion(\+ relrl_declarations:declared(KB, rmode(_))),
+    assertion(\+ relrl_declarations:declared(KB, task_rmode(_, _))),
+    bias_modes(KB, stack, Stack),
+    forall(member(T, [unstack, on(b1, b2), clear(b1)]),
+           ( bias_modes(KB, T, M), assertion(M == Stack) )).
 
 :- end_tests(world_task_bias).
+
+:- begin_tests(world_generated_bias).
+
+generated(KB, Modes) :-
+    relrl_world_bias:world_bias_modes(KB, Modes).
+
+test(blocks_bias_from_types, [Modes == [action(move(-block, -block)), action(move(-block, floor)),
+                                       on(+block, +block), on(+block, -block),
+                                       on(+block, floor), on(-block, +block), clear(+block),
+                                       goal_on(+block, +block), goal_on(+block, -block),
+                                       goal_on(-block, +block), goal_clear(+block),
+                                       covers(+block, +block), covers(+block, -block),
+                                       covers(-block, +block), highest(+block)]]) :-
+    % place = block (a subtype: variables) + floor (a constant); a mode needs a + (linked
+    % to the path): no on(-block, -block), no on(-block, floor)
+    blocks(KB),
+    generated(KB, Modes).
+
+test(delivery_bias_from_types, [Modes == [action(go(-dir)), action(pick), action(drop),
+                                          closer(+dir, parcel), closer(+dir, dock),
+                                          here(parcel), here(dock), carried]]) :-
+    % dir: an enumerated type an action names (go(-dir), closer(+dir, ...), never north);
+    % thing: enumerated, named by no action (its constants); here(parcel): ground, kept
+    world_kb('examples/worlds/delivery.pl', KB),
+    generated(KB, Modes).
+
+test(unbindable_plus_dropped, [Modes == [action(go(-x)), p(+x), p(k), q(+x)]]) :-
+    % r(+y): no mode introduces a y; q(-x): new variables and no +; both left out
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(_, _) :- fail.", "relation(p(_)).", "relation(q(_)).", "relation(r(_)).",
+             "signature(go(x)).", "signature(p(xk)).", "signature(q(x)).",
+             "signature(r(y)).", "subtype(x, xk).", "type(k, xk)."],
+            KB, _),
+    generated(KB, Modes).
+
+test(subtypes_transitive, [Modes == [action(go(-b)), on(+b, +b), on(+b, -b), on(+b, f),
+                                     on(+b, t), on(-b, +b)]]) :-
+    % b < p < q: b's variables and the constants of q (f, its own first) and p (t)
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(_, _) :- fail.", "relation(on(_, _)).",
+             "signature(go(b)).", "signature(on(b, q)).", "subtype(b, p).",
+             "subtype(p, q).", "type(t, p).", "type(f, q)."],
+            KB, _),
+    generated(KB, Modes).
+
+test(declared_rmodes_win) :-
+    % a world that writes rmode/1 keeps its own bias; its signatures generate nothing
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(_, _) :- fail.", "relation(p(_)).", "signature(go(x)).",
+             "signature(p(x)).", "rmode(action(go(-x)))."],
+            KB, _),
+    world_for_task(KB, t),
+    relrl_tg_bias:tg_bias(KB, bias(Modes, _)),
+    assertion(Modes == [action(go(-x))]).
+
+:- end_tests(world_generated_bias).
 
 :- begin_tests(world_episodes).
 
