@@ -162,13 +162,37 @@ effect(move(X, Y), State, [on(X, Z)|Del], [on(X, Y)|Add]) :-
 % over every pair would grow with the square of a tower's height): covers(X, Y), X above Y
 % in Y's tower, for the blocks Y the goal names; highest(T), T the top of a tallest tower.
 derived(covers(X, Y), Facts) :-
-    goal_block(Facts, Y),
-    member(on(X, _), Facts),
-    below(Facts, X, Y).
+    findall(Y0, goal_block(Facts, Y0), Ys),
+    Ys \== [],
+    above_map(Facts, Above),
+    member(Y, Ys),
+    above(Above, Y, X).
 derived(highest(T), State) :-
-    findall(H-T0, ( member(clear(T0), State), height(State, T0, H) ), Pairs),
+    above_map(State, Above),
+    findall(H-Top, ( member(on(B, floor), State), tower_top(Above, B, 1, H, Top) ), Pairs),
     max_member(Max-_, Pairs),
     member(Max-T, Pairs).
+
+% The view is computed at every step: the towers are read through one map from each block
+% to the block on it (n log n for n blocks), not by searching the state's list at every
+% level of a tower (which grows with the square of the blocks).
+above_map(Facts, Above) :-
+    findall(Y-X, ( member(on(X, Y), Facts), Y \== floor ), Pairs),
+    list_to_assoc(Pairs, Above).
+
+above(Above, Y, X) :-
+    get_assoc(Y, Above, Z),
+    (   X = Z
+    ;   above(Above, Z, X)
+    ).
+
+tower_top(Above, B, H0, H, Top) :-
+    (   get_assoc(B, Above, C)
+    ->  H1 is H0 + 1,
+        tower_top(Above, C, H1, H, Top)
+    ;   H = H0,
+        Top = B
+    ).
 
 goal_block(Facts, Y) :-
     member(goal_on(A, B), Facts),
