@@ -906,7 +906,7 @@ relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
 relrl_engine:learner_parameter(tg, action_gap, 0.0, unit).
 relrl_engine:learner_serves(tg, domains, []).
 relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
-                                         action_gap=0.5]).
+                                         action_gap=0.9]).
 
 relrl_engine:learner_forget(tg, KB) :-
     tg_forget(KB).

@@ -185,14 +185,16 @@ def _add_worlds(sub) -> None:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     w.add_argument("--worlds", default=None, metavar="FILE,FILE",
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
-    w.add_argument("--tasks", default="stack,unstack,on",
-                   help="tasks of each world (default stack,unstack,on)")
+    w.add_argument("--tasks", default=None,
+                   help="comma-separated tasks, each run in the worlds that declare it "
+                        "(default: every task of each world)")
     w.add_argument("--learners", default=None,
                    help="comma-separated learners (default: every learner of worlds)")
-    w.add_argument("--seeds", default=None, help="comma-separated seeds (default 0,1,2)")
+    w.add_argument("--seeds", default=None,
+                   help="comma-separated seeds or ranges, 0-9 (default 0,1,2)")
     w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
-    w.add_argument("--test-sizes", default="6,8,10",
-                   help="sizes evaluated with no further learning (default 6,8,10)")
+    w.add_argument("--test-sizes", default="10,20,50",
+                   help="sizes evaluated with no further learning (default 10,20,50)")
     w.add_argument("--episodes", type=int, default=None,
                    help="learning episodes per job (default 1000; --quick 200)")
     w.add_argument("--block", type=int, default=None,
@@ -207,8 +209,25 @@ def _add_worlds(sub) -> None:
                    help="local worker processes (default) or a Ray cluster")
     w.add_argument("--address", default=None, help="with --engine ray: the cluster to join")
     w.add_argument("--quick", action="store_true", help="a short run (one seed, tg)")
+    w.add_argument("--no-speed", action="store_true",
+                   help="skip each job's step-cost measurement by size")
     add_out_options(w, default="runs/worlds",
                     what="output folder: results.json, CSVs, figures")
+
+
+def _seeds(text: str) -> list[int]:
+    """``--seeds``: comma-separated seeds and ranges (``0-9``)."""
+    from relrl.errors import ConfigError
+
+    seeds: list[int] = []
+    for part in (p.strip() for p in text.split(",") if p.strip()):
+        lo, sep, hi = part.partition("-")
+        try:
+            seeds += list(range(int(lo), int(hi) + 1)) if sep and lo else [int(part)]
+        except ValueError:
+            raise ConfigError(f"--seeds {text!r}: {part!r} is not a seed or a range "
+                              "such as 0-9") from None
+    return seeds
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -423,9 +442,9 @@ def build_worlds_config(args: argparse.Namespace):
     from relrl.worlds import World
     from relrl.worlds.experiment import WorldsConfig
 
-    config = WorldsConfig(seeds=_ints(args.seeds or "0,1,2", "--seeds"))
+    config = WorldsConfig(seeds=_seeds(args.seeds or "0,1,2"))
     if args.quick:
-        config.seeds = _ints(args.seeds or "0", "--seeds")
+        config.seeds = _seeds(args.seeds or "0")
     if args.worlds:
         config.worlds = [w.strip() for w in args.worlds.split(",") if w.strip()]
     else:
@@ -435,14 +454,15 @@ def build_worlds_config(args: argparse.Namespace):
         if not Path(path).is_file():
             raise ConfigError(f"--worlds {path}: no such world file")
         config.worlds[i] = str(Path(path).resolve())
-    config.tasks = [t.strip() for t in args.tasks.split(",") if t.strip()]
+    config.tasks = [t.strip() for t in (args.tasks or "").split(",") if t.strip()]
+    config.speed = not args.no_speed
     names = ",".join(learners(WORLDS)) if args.learners is None else args.learners
     config.learners = [x.strip() for x in names.split(",") if x.strip()]
     for name in config.learners:
         if name not in learners(WORLDS):
             raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "
                               f"{', '.join(learners(WORLDS))})")
-    if not config.tasks or not config.learners:
+    if (args.tasks is not None and not config.tasks) or not config.learners:
         raise ConfigError("--tasks and --learners must name at least one each")
     config.train_sizes = _ints(args.sizes, "--sizes")
     config.test_sizes = _ints(args.test_sizes, "--test-sizes")
@@ -469,8 +489,21 @@ def build_worlds_config(args: argparse.Namespace):
             if problems:
                 raise ConfigError("\n".join([*problems, f"{len(problems)} problem(s) in "
                                              f"{path} (relrl check --world {path})"]))
-            for task in config.tasks:
-                world.task(task)
+            names = [t.split("(")[0] for t in world.task_names()]
+            if args.tasks is None:
+                config.world_tasks[path] = names
+            else:
+                config.world_tasks[path] = [t for t in config.tasks
+                                            if t.split("(")[0] in names]
+                for task in config.world_tasks[path]:
+                    world.task(task)
+    if args.tasks is None:
+        config.tasks = list(dict.fromkeys(t for ts in config.world_tasks.values() for t in ts))
+    missing = [t for t in config.tasks
+               if not any(t in ts for ts in config.world_tasks.values())]
+    if missing:
+        raise ConfigError(f"--tasks {','.join(missing)}: no world of --worlds declares "
+                          f"{'it' if len(missing) == 1 else 'them'}")
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     return config

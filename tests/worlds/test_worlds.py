@@ -76,7 +76,7 @@ def test_same_seed_same_episodes() -> None:
 
 def test_task_names_and_instances() -> None:
     with World(BLOCKS) as world:
-        assert world.task_names() == ["stack", "unstack", "on(_, _)"]
+        assert world.task_names() == ["stack", "unstack", "on(_, _)", "clear(_)"]
         assert world.task("on(b1, b2)") == ("on", "b1", "b2")
         with pytest.raises(ConfigError, match="no such task"):
             world.task("fly")
