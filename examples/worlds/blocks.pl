@@ -265,4 +265,4 @@ count_above(State, X, N) :-
     aggregate_all(count, ( member(on(Y, _), State), below(State, Y, X) ), N).
 
 sizes(train, [3, 4, 5]).
-sizes(test, [6, 8, 10]).
+sizes(test, [10, 20, 50]).

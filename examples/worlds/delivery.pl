@@ -166,4 +166,4 @@ optimal_steps(deliver, State, N) :-
     ).
 
 sizes(train, [3, 4, 5]).
-sizes(test, [6, 8, 10]).
+sizes(test, [10, 20, 50]).

@@ -29,6 +29,18 @@ def test_tg_learns_3_block_stack_to_optimal() -> None:
     assert after["exactly_optimal"] == 1.0
 
 
+def test_tg_learns_stack_with_the_shared_bias_and_acts_optimally_on_8() -> None:
+    """One bias for every task: blocks.pl's generated bias (no rmode, no task_rmode), tg
+    learns stack on 3-5 blocks and, with no further learning, every greedy episode on 8
+    blocks takes the optimal number of moves."""
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=0, task="stack")
+        world.episodes("stack", [3, 4, 5], 200, "learn")
+        on8 = score(world.episodes("stack", [8], 30, "greedy", optimal=True))
+    assert on8["success"] == 1.0
+    assert on8["exactly_optimal"] == 1.0
+
+
 def test_ptg_learns_3_block_unstack_to_optimal_and_acts_on_6() -> None:
     """P-learning: learned on 3 blocks only, the P-tree's greedy choices are optimal on 3
     blocks and, with no further learning, on 6."""
