@@ -209,7 +209,7 @@ test(start_states_are_not_goals) :-
 
 test(shipped_worlds_are_valid) :-
     forall(member(F, ['examples/worlds/blocks.pl', 'examples/worlds/blocks_moves.pl',
-                      'examples/worlds/delivery.pl']),
+                      'examples/worlds/delivery.pl', 'examples/worlds/gripper.pl']),
            ( world_kb(F, KB),
              world_problems(KB, Ps),
              assertion(Ps == []) )).
@@ -354,6 +354,15 @@ test(delivery_bias_from_types, [Modes == [action(go(-dir)), action(pick), action
     % dir: an enumerated type an action names (go(-dir), closer(+dir, ...), never north);
     % thing: enumerated, named by no action (its constants); here(parcel): ground, kept
     world_kb('examples/worlds/delivery.pl', KB),
+    generated(KB, Modes).
+
+test(gripper_bias_from_types, [Modes == [action(move), action(pick(-ball)),
+                                         action(drop(-ball)), robby(rooma), robby(roomb),
+                                         at(+ball, rooma), at(+ball, roomb),
+                                         carry(+ball, left), carry(+ball, right),
+                                         free(left), free(right)]]) :-
+    % an action without arguments; rooms and grippers constants named by no action
+    world_kb('examples/worlds/gripper.pl', KB),
     generated(KB, Modes).
 
 test(unbindable_plus_dropped, [Modes == [action(go(-x)), p(+x), p(k), q(+x)]]) :-
