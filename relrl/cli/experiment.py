@@ -502,8 +502,8 @@ def build_worlds_config(args: argparse.Namespace):
     missing = [t for t in config.tasks
                if not any(t in ts for ts in config.world_tasks.values())]
     if missing:
-        raise ConfigError(f"--tasks {','.join(missing)}: no world of --worlds declares "
-                          f"{'it' if len(missing) == 1 else 'them'}")
+        raise ConfigError(f"--tasks {','.join(missing)}: no such task in any world of "
+                          "--worlds")
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     return config

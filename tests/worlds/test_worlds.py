@@ -201,3 +201,25 @@ def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
                  "--overwrite"]) == 2
     assert "link" in capsys.readouterr().err
     assert victim.read_text() == "keep me"
+
+
+def test_experiment_worlds_runs_each_worlds_own_tasks(tmp_path: Path) -> None:
+    """Without --tasks every world runs the tasks it declares (blocks' four, delivery's
+    one); --seeds takes a range; the summary has the worst seed and the share reaching the
+    goal per test size."""
+    delivery = ROOT / "examples" / "worlds" / "delivery.pl"
+    out = tmp_path / "exp"
+    assert main(["experiment", "worlds", "--worlds", f"{BLOCKS},{delivery}", "--learners",
+                 "tg", "--seeds", "0-1", "--episodes", "2", "--block", "2",
+                 "--eval-episodes", "1", "--sizes", "3", "--test-sizes", "4", "--no-speed",
+                 "--workers", "1", "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    jobs = sorted((j["world"], j["task"].split("(")[0], j["seed"]) for j in results["jobs"])
+    assert jobs == sorted([(w, t, s) for w, ts in [("blocks.pl", ["stack", "unstack", "on",
+                                                                   "clear"]),
+                                                   ("delivery.pl", ["deliver"])]
+                           for t in ts for s in (0, 1)])
+    row = results["summary"][0]["test"]["4"]
+    assert {"optimality", "optimality_min", "success", "success_min"} <= set(row)
+    timing = json.loads((out / "timing.json").read_text())
+    assert all("step_cost_by_size" not in t for t in timing["jobs"])
