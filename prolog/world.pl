@@ -30,6 +30,7 @@
 :- use_module(rules).
 :- use_module(engine).
 :- use_module(kbstate).
+:- use_module(world_bias).
 
 /** <module> Worlds written in Prolog
 
@@ -56,6 +57,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | task_own_bias(Task)                   | optional: Task's bias is its task_rmode/2 modes alone, without rmode/1 |
   | discount(Gamma)                       | optional: the task's discount, the learners' gamma (default theirs) |
   | relation/1, rmode/1, rconst/2         | the learner's view and language bias, as in a domain (docs/tg.md) |
+  | signature/1, subtype/2, type/2        | optional: argument types of relations and actions; with no rmode/1 the bias is generated from them (world_bias.pl) |
 
 The learner's view of a state is the state's facts, the goal's facts and the derived ones
 (world_view/4), sorted: what a relational learner (tg) reads, and the ground state a table
@@ -101,6 +103,9 @@ world_predicate(sizes/2, optional).
 world_predicate(discount/1, optional).
 world_predicate(task_rmode/2, optional).
 world_predicate(task_own_bias/1, optional).
+world_predicate(signature/1, optional).
+world_predicate(subtype/2, optional).
+world_predicate(type/2, optional).
 
 %!  world_defines(+KB, +PI) is semidet.
 %
@@ -613,6 +618,14 @@ relrl_tg_bias:extra_rmode(KB, Mode) :-
     Task \== none,
     declared(KB, task_rmode(T, Mode)),
     subsumes_term(T, Task).
+
+%   A world that declares no rmode/1: the bias generated from its signature/1, subtype/2
+%   and type/2 declarations (world_bias.pl), shared by all its tasks.
+relrl_tg_bias:extra_rmode(KB, Mode) :-
+    atom(KB),
+    \+ declared(KB, rmode(_)),
+    world_bias_modes(KB, Modes),
+    member(Mode, Modes).
 
 relrl_tg_bias:own_rmodes(KB) :-
     atom(KB),

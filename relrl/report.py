@@ -533,19 +533,24 @@ def _worlds_summary(run: Run) -> str:
 @view("worlds", "short")
 def _worlds_short(run: Run) -> str:
     """One row per world and task, one column per learner: the fraction of optimal on the
-    training sizes (worst seed) and on the largest test size, with no learning."""
+    training sizes and on the largest test size, with no learning, each with its worst
+    seed."""
     r = run.results
     train, test = r["config"]["train_sizes"], r["config"]["test_sizes"]
     learners = list(dict.fromkeys(x["learner"] for x in r["summary"]))
     cells: dict[str, dict[str, str]] = {}
     for x in r["summary"]:
         row = cells.setdefault(f"{Path(x['world']).stem}: {x['task']}", {})
+        big = x["test"][str(max(test))]
+        worst = big.get("optimality_min")
         row[x["learner"]] = (f"{x['train_optimality']:.3f} ({x['train_optimality_min']:.3f})"
-                             f" → {_f(x['test'][str(max(test))]['optimality'], 3)}")
+                             f" → {_f(big['optimality'], 3)}"
+                             + (f" ({_f(worst, 3)})" if worst is not None else ""))
     rows = [[task] + [row.get(learner, "—") for learner in learners]
             for task, row in cells.items()]
-    return (f"Fraction of optimal on {min(train)}–{max(train)} blocks (worst seed) → on "
-            f"{max(test)} blocks with no learning, mean of {len(r['seeds'])} seeds.\n\n"
+    return (f"Fraction of optimal on {min(train)}–{max(train)} objects (worst seed) → on "
+            f"{max(test)} objects with no learning (worst seed), mean of {len(r['seeds'])} "
+            "seeds.\n\n"
             + table(["world: task", *learners], rows))
 
 

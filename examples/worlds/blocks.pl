@@ -10,19 +10,30 @@
     block (Y a block or floor) and clear(X) for each block with nothing on it. One action,
     move(X, Y): a clear block X onto a clear block Y, or onto the floor when X is not on it.
     Tasks: stack (all blocks in one tower), unstack (all on the floor), on(A, B) (block A on
-    block B, two blocks drawn for each episode and shown to the learner as goal_on(A, B)).
+    block B, two blocks drawn for each episode and shown to the learner as goal_on(A, B)),
+    clear(A) (nothing on block A, drawn for each episode, shown as goal_clear(A)).
+    Start states are uniform over all the states of N blocks.
     Reward 1 when the goal is reached, within a step bound of three moves per block.
 */
 
 % ---- states ------------------------------------------------------------------------------
 
-% A random state of Size blocks: the blocks in a random order, each put on the floor or on
-% top of one of the towers built so far, the floor and each tower equally likely.
+% A random state of Size blocks, uniform over all the states of Size blocks (the method of
+% Slaney & Thiebaux, "Blocks World revisited", AIJ 125, 2001): a state is a set of towers.
+% Of the N! orders of the blocks cut into K towers at K-1 of the N-1 gaps, each state of K
+% towers is made by exactly K! (the K! orders of its towers), so there are
+% N! * C(N-1, K-1) / K! states of K towers (the Lah numbers). Draw K with those weights,
+% then an order and K-1 cuts uniformly: every state of N blocks is equally likely.
 initial_state(Size, State) :-
     blocks(Size, Blocks),
+    tower_count(Size, K),
     random_permutation(Blocks, Order),
-    foldl(place_block, Order, []-[], Towers-Facts0),
-    foldl(top_clear, Towers, Facts0, State).
+    Gaps is Size - 1,
+    Cuts is K - 1,
+    randseq(Cuts, Gaps, Cut0),
+    msort(Cut0, CutAt),
+    towers(Order, 1, CutAt, Towers),
+    foldl(tower_facts, Towers, [], State).
 
 blocks(Size, Blocks) :-
     numlist(1, Size, Is),
@@ -31,24 +42,60 @@ blocks(Size, Blocks) :-
 block_name(I, B) :-
     atom_concat(b, I, B).
 
-% Towers: a list of the blocks on top of each tower.
-place_block(B, Towers0-Facts0, Towers-[on(B, Under)|Facts0]) :-
-    length(Towers0, K),
-    random_between(0, K, J),
-    (   J =:= 0
-    ->  Under = floor,
-        Towers = [B|Towers0]
-    ;   nth1(J, Towers0, Under, Rest),
-        Towers = [B|Rest]
+% K, the number of towers, drawn with weight the number of states of N blocks in K towers.
+tower_count(N, K) :-
+    numlist(1, N, Ks),
+    maplist(states_in_towers(N), Ks, Counts),
+    sum_list(Counts, Total),
+    random_between(1, Total, R),
+    pick_count(Ks, Counts, R, K).
+
+states_in_towers(N, K, Count) :-
+    factorial(N - 1, F1),
+    factorial(K - 1, FK1),
+    factorial(N - K, FNK),
+    factorial(N, FN),
+    factorial(K, FK),
+    Count is F1 // (FK1 * FNK) * FN // FK.
+
+factorial(E, F) :-
+    N is E,
+    factorial(N, 1, F).
+
+factorial(0, F, F) :- !.
+factorial(N, F0, F) :-
+    F1 is F0 * N,
+    N1 is N - 1,
+    factorial(N1, F1, F).
+
+pick_count([K|Ks], [C|Cs], R, Pick) :-
+    (   R =< C
+    ->  Pick = K
+    ;   R1 is R - C,
+        pick_count(Ks, Cs, R1, Pick)
     ).
 
-top_clear(B, Facts, [clear(B)|Facts]).
+% Towers (each bottom first): Order cut after the positions in CutAt (ascending).
+towers(Order, _, [], [Order]) :- !.
+towers(Order, I, [C|Cs], [Tower|Towers]) :-
+    Len is C - I + 1,
+    length(Tower, Len),
+    append(Tower, Rest, Order),
+    I1 is C + 1,
+    towers(Rest, I1, Cs, Towers).
+
+tower_facts([Bottom|Above], Facts0, Facts) :-
+    foldl(stack_on, Above, Bottom-[on(Bottom, floor)|Facts0], Top-Facts1),
+    Facts = [clear(Top)|Facts1].
+
+stack_on(B, Under-Facts, B-[on(B, Under)|Facts]).
 
 % ---- tasks and goals ---------------------------------------------------------------------
 
 task(stack).
 task(unstack).
 task(on(_, _)).
+task(clear(_)).
 
 % on(A, B): two distinct blocks of the state, drawn at random, unless the task names them.
 task_goal(on(A, B), State, on(A, B)) :-
@@ -59,6 +106,14 @@ task_goal(on(A, B), State, on(A, B)) :-
         random_member(B, Others)
     ;   true
     ).
+% clear(A): a block of the state drawn at random, unless the task names it.
+task_goal(clear(A), State, clear(A)) :-
+    !,
+    (   var(A)
+    ->  findall(X, member(on(X, _), State), Blocks),
+        random_member(A, Blocks)
+    ;   true
+    ).
 task_goal(Task, _, Task).
 
 goal(stack, State) :-
@@ -67,8 +122,11 @@ goal(unstack, State) :-
     \+ ( member(on(_, Y), State), Y \== floor ).
 goal(on(A, B), State) :-
     memberchk(on(A, B), State).
+goal(clear(A), State) :-
+    memberchk(clear(A), State).
 
 goal_fact(on(A, B), goal_on(A, B)).
+goal_fact(clear(A), goal_clear(A)).
 
 step_bound(_, State, Bound) :-
     aggregate_all(count, member(on(_, _), State), N),
@@ -104,14 +162,43 @@ effect(move(X, Y), State, [on(X, Z)|Del], [on(X, Y)|Add]) :-
 % over every pair would grow with the square of a tower's height): covers(X, Y), X above Y
 % in Y's tower, for the blocks Y the goal names; highest(T), T the top of a tallest tower.
 derived(covers(X, Y), Facts) :-
-    member(goal_on(A, B), Facts),
-    member(Y, [A, B]),
-    member(on(X, _), Facts),
-    below(Facts, X, Y).
+    findall(Y0, goal_block(Facts, Y0), Ys),
+    Ys \== [],
+    above_map(Facts, Above),
+    member(Y, Ys),
+    above(Above, Y, X).
 derived(highest(T), State) :-
-    findall(H-T0, ( member(clear(T0), State), height(State, T0, H) ), Pairs),
+    above_map(State, Above),
+    findall(H-Top, ( member(on(B, floor), State), tower_top(Above, B, 1, H, Top) ), Pairs),
     max_member(Max-_, Pairs),
     member(Max-T, Pairs).
+
+% The view is computed at every step: the towers are read through one map from each block
+% to the block on it (n log n for n blocks), not by searching the state's list at every
+% level of a tower (which grows with the square of the blocks).
+above_map(Facts, Above) :-
+    findall(Y-X, ( member(on(X, Y), Facts), Y \== floor ), Pairs),
+    list_to_assoc(Pairs, Above).
+
+above(Above, Y, X) :-
+    get_assoc(Y, Above, Z),
+    (   X = Z
+    ;   above(Above, Z, X)
+    ).
+
+tower_top(Above, B, H0, H, Top) :-
+    (   get_assoc(B, Above, C)
+    ->  H1 is H0 + 1,
+        tower_top(Above, C, H1, H, Top)
+    ;   H = H0,
+        Top = B
+    ).
+
+goal_block(Facts, Y) :-
+    member(goal_on(A, B), Facts),
+    member(Y, [A, B]).
+goal_block(Facts, A) :-
+    member(goal_clear(A), Facts).
 
 below(State, T, X) :-
     memberchk(on(T, Y), State),
@@ -130,53 +217,22 @@ height(State, B, H) :-
 relation(on(_, _)).
 relation(clear(_)).
 relation(goal_on(_, _)).
+relation(goal_clear(_)).
 relation(covers(_, _)).
 relation(highest(_)).
 
-% The language bias: blocks are variables (a test speaks of *a* block, never of b3), the
-% floor the one constant.
-rmode(action(move(-block, -block))).
-rmode(action(move(-block, floor))).
-rmode(on(+block, -block)).
-rmode(on(+block, +block)).
-rmode(on(+block, floor)).
-rmode(goal_on(+block, -block)).
-rmode(goal_on(-block, +block)).
-rmode(goal_on(+block, +block)).
-rmode(covers(+block, -block)).
-rmode(covers(+block, +block)).
-
-% Stacking needs the top of a tallest tower; for the other tasks it is a distraction (a tree
-% that splits on it values moves by the tower heights of 3-5 blocks), so only stack's bias
-% holds it.
-task_rmode(stack, highest(+block)).
-
-% Unstacking needs to know only what a move does to the block it moves: off a block onto the
-% floor is right in every state, any other move wrong. Tests of the towers tell states near
-% the goal from states far from it, and a Q-tree that splits on them ranks the moves of one
-% state by the values of different states (a move that is only legal near the goal looks
-% better than the right move far from it); so unstack has a bias of its own.
-task_rmode(unstack, action(move(-block, -block))).
-task_rmode(unstack, action(move(-block, floor))).
-task_rmode(unstack, on(+block, floor)).
-
-% on(A, B) likewise, with what a move does to the goal's blocks: is the moved block A (or
-% B), is it above A or B (covers/2: X above a goal block, a recursive relation of the
-% tower); is the destination B, A, the floor, above A or B, another block; are A and B
-% clear (goal_on(A, B), clear(A)), is A above B. No test follows on/2 from block to block,
-% so none counts the blocks above A or B: with the shared modes the Q-tree split on such
-% chains, which tell states near the goal from far ones, and valued moves by the tower
-% heights of 3-5 blocks (0.42 of optimal on 10 blocks; docs/worlds.md).
-task_rmode(on(_, _), action(move(-block, -block))).
-task_rmode(on(_, _), action(move(-block, floor))).
-task_rmode(on(_, _), goal_on(-block, -block)).
-task_rmode(on(_, _), goal_on(+block, +block)).
-task_rmode(on(_, _), goal_on(+block, -block)).
-task_rmode(on(_, _), goal_on(-block, +block)).
-task_rmode(on(_, _), covers(+block, -block)).
-task_rmode(on(_, _), clear(+block)).
-task_own_bias(unstack).
-task_own_bias(on(_, _)).
+% The types of the relations and of the action: relrl generates the language bias from
+% them (docs/worlds.md, A bias from declarations). Blocks are objects, never named by a
+% test (a test speaks of *a* block, never of b3); the floor is the one constant.
+signature(move(block, place)).
+signature(on(block, place)).
+signature(clear(block)).
+signature(goal_on(block, block)).
+signature(goal_clear(block)).
+signature(covers(block, block)).
+signature(highest(block)).
+subtype(block, place).
+type(floor, place).
 
 % ---- the optimal number of moves (verified against a breadth-first search by relrl check) --
 
@@ -202,8 +258,11 @@ optimal_steps(on(A, B), State, N) :-
         )
     ).
 
+optimal_steps(clear(A), State, N) :-
+    count_above(State, A, N).
+
 count_above(State, X, N) :-
     aggregate_all(count, ( member(on(Y, _), State), below(State, Y, X) ), N).
 
 sizes(train, [3, 4, 5]).
-sizes(test, [6, 8, 10]).
+sizes(test, [10, 20, 50]).

@@ -185,14 +185,16 @@ def _add_worlds(sub) -> None:
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     w.add_argument("--worlds", default=None, metavar="FILE,FILE",
                    help="world files (default: the shipped blocks.pl and blocks_moves.pl)")
-    w.add_argument("--tasks", default="stack,unstack,on",
-                   help="tasks of each world (default stack,unstack,on)")
+    w.add_argument("--tasks", default=None,
+                   help="comma-separated tasks, each run in the worlds that declare it "
+                        "(default: every task of each world)")
     w.add_argument("--learners", default=None,
                    help="comma-separated learners (default: every learner of worlds)")
-    w.add_argument("--seeds", default=None, help="comma-separated seeds (default 0,1,2)")
+    w.add_argument("--seeds", default=None,
+                   help="comma-separated seeds or ranges, 0-9 (default 0,1,2)")
     w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
-    w.add_argument("--test-sizes", default="6,8,10",
-                   help="sizes evaluated with no further learning (default 6,8,10)")
+    w.add_argument("--test-sizes", default="10,20,50",
+                   help="sizes evaluated with no further learning (default 10,20,50)")
     w.add_argument("--episodes", type=int, default=None,
                    help="learning episodes per job (default 1000; --quick 200)")
     w.add_argument("--block", type=int, default=None,
@@ -212,8 +214,25 @@ def _add_worlds(sub) -> None:
     w.add_argument("--quick", action="store_true",
                    help="a short run: seed 0, learner tg, 200 episodes in blocks of 50, 30 "
                         "greedy episodes per evaluation (each overridden by its option)")
+    w.add_argument("--no-speed", action="store_true",
+                   help="skip each job's step-cost measurement by size")
     add_out_options(w, default="runs/worlds",
                     what="output folder: results.json, CSVs, figures")
+
+
+def _seeds(text: str) -> list[int]:
+    """``--seeds``: comma-separated seeds and ranges (``0-9``)."""
+    from relrl.errors import ConfigError
+
+    seeds: list[int] = []
+    for part in (p.strip() for p in text.split(",") if p.strip()):
+        lo, sep, hi = part.partition("-")
+        try:
+            seeds += list(range(int(lo), int(hi) + 1)) if sep and lo else [int(part)]
+        except ValueError:
+            raise ConfigError(f"--seeds {text!r}: {part!r} is not a seed or a range "
+                              "such as 0-9") from None
+    return seeds
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -450,7 +469,9 @@ def build_worlds_config(args: argparse.Namespace):
     from relrl.worlds.experiment import WorldsConfig
 
     seeds = args.seeds if args.seeds is not None else ("0" if args.quick else "0,1,2")
-    config = WorldsConfig(seeds=_ints(seeds, "--seeds"))
+    config = WorldsConfig(seeds=_seeds(seeds))
+    if not config.seeds:
+        raise ConfigError(f"--seeds must name at least one seed, not {seeds!r}")
     if args.worlds is not None:
         config.worlds = [w.strip() for w in args.worlds.split(",") if w.strip()]
         if not config.worlds:
@@ -465,7 +486,8 @@ def build_worlds_config(args: argparse.Namespace):
         config.worlds[i] = str(Path(path).resolve())
     _distinct("--worlds", [Path(w).name for w in config.worlds],
               "results are kept by the world's file name")
-    config.tasks = split_terms(args.tasks)  # on(b1,b2) is one task
+    config.tasks = split_terms(args.tasks) if args.tasks is not None else []
+    config.speed = not args.no_speed
     names = (args.learners if args.learners is not None
              else "tg" if args.quick else ",".join(learners(WORLDS)))
     config.learners = [x.strip() for x in names.split(",") if x.strip()]
@@ -475,7 +497,7 @@ def build_worlds_config(args: argparse.Namespace):
         if name not in learners(WORLDS):
             raise ConfigError(f"unknown learner {name!r} in --learners (learners of worlds: "
                               f"{', '.join(learners(WORLDS))})")
-    if not config.tasks or not config.learners:
+    if (args.tasks is not None and not config.tasks) or not config.learners:
         raise ConfigError("--tasks and --learners must name at least one each")
     config.train_sizes = _ints(args.sizes, "--sizes")
     config.test_sizes = _ints(args.test_sizes, "--test-sizes")
@@ -505,8 +527,23 @@ def build_worlds_config(args: argparse.Namespace):
             if problems:
                 raise ConfigError("\n".join([*problems, f"{len(problems)} problem(s) in "
                                              f"{path} (relrl check --world {path})"]))
-            for task in config.tasks:
+            names = [t.split("(")[0] for t in world.task_names()]
+            if args.tasks is None:
+                config.world_tasks[path] = names
+            else:
+                config.world_tasks[path] = [t for t in config.tasks
+                                            if t.split("(")[0] in names]
+                for task in config.world_tasks[path]:
+                    world.task(task)
+            for task in config.world_tasks[path]:
                 world.check_instance(task, [*config.train_sizes, *config.test_sizes])
+    if args.tasks is None:
+        config.tasks = list(dict.fromkeys(t for ts in config.world_tasks.values() for t in ts))
+    missing = [t for t in config.tasks
+               if not any(t in ts for ts in config.world_tasks.values())]
+    if missing:
+        raise ConfigError(f"--tasks {','.join(missing)}: no such task in any world of "
+                          "--worlds")
     if args.workers < 1:
         raise ConfigError(f"--workers must be at least 1, not {args.workers}")
     return config

@@ -46,12 +46,14 @@ class WorldsConfig:
     """Everything that determines a worlds run (written into results.json)."""
 
     worlds: list[str] = field(default_factory=list)           #: world files
-    tasks: list[str] = field(default_factory=lambda: ["stack", "unstack", "on"])
+    tasks: list[str] = field(default_factory=lambda: ["stack", "unstack", "on", "clear"])
+    #: per world file, the tasks of ``tasks`` it declares (empty: every world runs them all)
+    world_tasks: dict[str, list[str]] = field(default_factory=dict)
     learners: list[str] = field(default_factory=lambda: list(learners(WORLDS)))
     seeds: list[int] = field(default_factory=lambda: [0, 1, 2])
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
-    test_sizes: list[int] = field(default_factory=lambda: [6, 8, 10])
+    test_sizes: list[int] = field(default_factory=lambda: [10, 20, 50])
     episodes: int = 1000
     block: int = 100
     eval_episodes: int = 100
@@ -59,11 +61,16 @@ class WorldsConfig:
     verify_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
     verify_states: int = 30
     rule_seconds: float = RULE_SECONDS      #: how long a rule of a world may run
+    speed: bool = True                      #: measure each job's step cost by size
 
     def jobs(self) -> list[tuple[str, str, str, int]]:
         """Every (world, task, learner, seed) job."""
-        return [(w, t, lr, s) for w in self.worlds for t in self.tasks for lr in self.learners
-                for s in self.seeds]
+        return [(w, t, lr, s) for w in self.worlds for t in self.tasks_of(w)
+                for lr in self.learners for s in self.seeds]
+
+    def tasks_of(self, world: str) -> list[str]:
+        """The tasks run in ``world``: those of ``tasks`` it declares."""
+        return self.world_tasks.get(world, self.tasks)
 
     def learn_config(self, world: str, task: str, learner: str, seed: int) -> LearnConfig:
         """The :class:`LearnConfig` of one job."""
@@ -72,12 +79,14 @@ class WorldsConfig:
                            train_sizes=list(self.train_sizes),
                            test_sizes=list(self.test_sizes), episodes=self.episodes,
                            block=self.block, eval_episodes=self.eval_episodes, seed=seed,
-                           updates=self.updates, rule_seconds=self.rule_seconds)
+                           updates=self.updates, rule_seconds=self.rule_seconds,
+                           speed=self.speed)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (world files by name: the folder is the machine's)."""
         out = asdict(self)
         out["worlds"] = [Path(w).name for w in self.worlds]
+        out["world_tasks"] = {Path(w).name: ts for w, ts in self.world_tasks.items()}
         return out
 
 
@@ -144,7 +153,7 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
     from relrl import __version__
 
     out = Path(out_dir)
-    checks = [(config, w, t) for w in config.worlds for t in config.tasks]
+    checks = [(config, w, t) for w in config.worlds for t in config.tasks_of(w)]
     tasks = checks + [(config, *job) for job in config.jobs()]
     outcome = run_jobs(_job, tasks, workers=workers, engine=engine, address=address,
                        units=config.episodes // config.block + 1, label=_label)
@@ -222,6 +231,7 @@ def summarize(jobs: list[dict[str, Any]], config: WorldsConfig) -> list[dict[str
                "train_optimality": _mean([j["final"]["optimality"] for j in js]),
                "train_optimality_min": min(j["final"]["optimality"] for j in js),
                "train_success": _mean([j["final"]["success"] for j in js]),
+               "train_success_min": min(j["final"]["success"] for j in js),
                "memory_positions": _mean([j["memory"]["positions"] for j in js]),
                "episodes_to_095": _mean([_first(j["curve"], 0.95) for j in js]),
                "test": {}}
@@ -230,7 +240,8 @@ def summarize(jobs: list[dict[str, Any]], config: WorldsConfig) -> list[dict[str
             row["test"][str(size)] = {
                 "optimality": _mean([v["optimality"] for v in vals]),
                 "optimality_min": min((v["optimality"] for v in vals), default=None),
-                "success": _mean([v["success"] for v in vals])}
+                "success": _mean([v["success"] for v in vals]),
+                "success_min": min((v["success"] for v in vals), default=None)}
         rows.append(row)
     return rows
 
@@ -254,11 +265,14 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
     files.append(_csv(out / "summary.csv",
                       ["world", "task", "learner", "seeds", "train_optimality",
                        "train_optimality_min", "train_success", "episodes_to_095",
-                       "memory_positions", *(f"test_{s}_optimality" for s in sizes)],
+                       "memory_positions",
+                       *(f"test_{s}_{k}" for s in sizes
+                         for k in ("optimality", "optimality_min", "success_min"))],
                       [[r["world"], r["task"], r["learner"], r["seeds"],
                         r["train_optimality"], r["train_optimality_min"], r["train_success"],
                         r["episodes_to_095"], r["memory_positions"],
-                        *(r["test"][str(s)]["optimality"] for s in sizes)]
+                        *(r["test"][str(s)].get(k) for s in sizes
+                          for k in ("optimality", "optimality_min", "success_min"))]
                        for r in results["summary"]]))
     files.append(_csv(out / "curves.csv",
                       ["world", "task", "learner", "seed", "point", "episodes",
@@ -349,23 +363,34 @@ def plot(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Pat
 
 
 def worlds_table(results: dict[str, Any]) -> str:
-    """The summary as a Markdown table (what ``relrl report``'s worlds view renders; names
-    shown as the text they are)."""
+    """The summary as a Markdown table (what ``relrl report``'s worlds view renders): per
+    size the mean over seeds of the fraction of optimal and, in brackets, the worst seed's;
+    a share of greedy episodes that reached the goal below 1 in any seed is marked."""
     from relrl.markdown import text
 
     sizes = results["config"]["test_sizes"]
     train = results["config"]["train_sizes"]
     head = (f"| world | task | learner | seeds | of optimal, sizes {min(train)}–{max(train)} "
-            "(worst seed) | " + " | ".join(f"size {s}" for s in sizes)
-            + " | episodes to 0.95 | positions |")
-    lines = [head, "|" + "---|" * (8 + len(sizes) - 1)]
+            "(worst seed) | " + " | ".join(f"size {s} (worst)" for s in sizes)
+            + " | all reached the goal | episodes to 0.95 | positions |")
+    lines = [head, "|" + "---|" * (9 + len(sizes) - 1)]
     for r in results["summary"]:
+        tests = [r["test"][str(s)] for s in sizes]
+        reached = [t.get("success_min") for t in tests]
+        if any(x is None for x in reached):
+            all_reached = "—"
+        elif all(x >= 1 for x in reached):
+            all_reached = "yes"
+        else:
+            all_reached = "no: worst " + ", ".join(_f(x) for x in reached)
         lines.append(
             f"| {text(Path(r['world']).stem)} | {text(r['task'])} | {text(r['learner'])} | "
             f"{r['seeds']} | "
             f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
-            + " | ".join(_f(r["test"][str(s)]["optimality"]) for s in sizes)
-            + f" | {_f(r['episodes_to_095'], 0)} | {_f(r['memory_positions'], 0)} |")
+            + " | ".join(f"{_f(t['optimality'])} ({_f(t.get('optimality_min'))})"
+                         for t in tests)
+            + f" | {all_reached} | {_f(r['episodes_to_095'], 0)} | "
+            f"{_f(r['memory_positions'], 0)} |")
     return "\n".join(lines)
 
 

@@ -227,9 +227,9 @@ class World:
 
     def attach(self, learner: Learner, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a learner of worlds: :func:`relrl.learners.learners`
-        ``("worlds")``) afresh in this world, seeded; for
-        ``task``, its language bias holds the task's own modes too (task_rmode/2), or them
-        alone (task_own_bias/1)."""
+        ``("worlds")``) afresh in this world, seeded; for ``task``, a world that declares
+        task_rmode/2 modes adds that task's to its bias (or, with task_own_bias/1, uses
+        them alone); a world without rmode/1 has the bias generated from its types."""
         if task is not None:
             call(self.kb, "world_for_task", self.kb.module, self._task(task))
         learner.attach(self.engine, seed)

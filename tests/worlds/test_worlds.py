@@ -29,6 +29,18 @@ def test_tg_learns_3_block_stack_to_optimal() -> None:
     assert after["exactly_optimal"] == 1.0
 
 
+def test_tg_learns_stack_with_the_shared_bias_and_acts_optimally_on_8() -> None:
+    """One bias for every task: blocks.pl's generated bias (no rmode, no task_rmode), tg
+    learns stack on 3-5 blocks and, with no further learning, every greedy episode on 8
+    blocks takes the optimal number of moves."""
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=0, task="stack")
+        world.episodes("stack", [3, 4, 5], 200, "learn")
+        on8 = score(world.episodes("stack", [8], 30, "greedy", optimal=True))
+    assert on8["success"] == 1.0
+    assert on8["exactly_optimal"] == 1.0
+
+
 def test_ptg_learns_3_block_unstack_to_optimal_and_acts_on_6() -> None:
     """P-learning: learned on 3 blocks only, the P-tree's greedy choices are optimal on 3
     blocks and, with no further learning, on 6."""
@@ -76,7 +88,7 @@ def test_same_seed_same_episodes() -> None:
 
 def test_task_names_and_instances() -> None:
     with World(BLOCKS) as world:
-        assert world.task_names() == ["stack", "unstack", "on(_, _)"]
+        assert world.task_names() == ["stack", "unstack", "on(_, _)", "clear(_)"]
         assert world.task("on(b1, b2)") == ("on", "b1", "b2")
         with pytest.raises(ConfigError, match="no such task"):
             world.task("fly")
@@ -236,3 +248,25 @@ def test_experiment_worlds_policies_do_not_depend_on_evaluation(tmp_path: Path) 
         assert main([*common, *flags, "--out", str(tmp_path / name)]) == 0
         texts.append((tmp_path / name / "policies" / "blocks-on-tg-s1.pl").read_bytes())
     assert texts[0] == texts[1]
+
+
+def test_experiment_worlds_runs_each_worlds_own_tasks(tmp_path: Path) -> None:
+    """Without --tasks every world runs the tasks it declares (blocks' four, delivery's
+    one); --seeds takes a range; the summary has the worst seed and the share reaching the
+    goal per test size."""
+    delivery = ROOT / "examples" / "worlds" / "delivery.pl"
+    out = tmp_path / "exp"
+    assert main(["experiment", "worlds", "--worlds", f"{BLOCKS},{delivery}", "--learners",
+                 "tg", "--seeds", "0-1", "--episodes", "2", "--block", "2",
+                 "--eval-episodes", "1", "--sizes", "3", "--test-sizes", "4", "--no-speed",
+                 "--workers", "1", "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    jobs = sorted((j["world"], j["task"].split("(")[0], j["seed"]) for j in results["jobs"])
+    assert jobs == sorted([(w, t, s) for w, ts in [("blocks.pl", ["stack", "unstack", "on",
+                                                                   "clear"]),
+                                                   ("delivery.pl", ["deliver"])]
+                           for t in ts for s in (0, 1)])
+    row = results["summary"][0]["test"]["4"]
+    assert {"optimality", "optimality_min", "success", "success_min"} <= set(row)
+    timing = json.loads((out / "timing.json").read_text())
+    assert all("step_cost_by_size" not in t for t in timing["jobs"])

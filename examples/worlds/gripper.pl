@@ -1,0 +1,116 @@
+/*  Gripper: a robot with two grippers carries balls from room a to room b (the gripper
+    domain of the planning competitions), stated in relrl's world vocabulary
+    (docs/worlds.md). A third world shape: objects carried two at a time, a trip's worth
+    of moves, and no hand-written language bias: relrl generates it from the declared
+    types (signature/1, type/2).
+
+        relrl check --world examples/worlds/gripper.pl
+        relrl learn examples/worlds/gripper.pl --task deliver --episodes 500
+
+    A world of size N has balls o1 ... oN. The state holds robby(R) (the robot's room,
+    rooma or roomb), at(O, R) for each ball on the floor of room R, carry(O, G) for a ball
+    held by gripper G (left or right) and free(G) for each empty gripper. Actions: move (to
+    the other room), pick(O) (a ball in the robot's room into the first free gripper, left
+    before right), drop(O) (a held ball onto the floor of the robot's room). Task deliver: every ball on the floor
+    of roomb. Start states: each ball in either room and the robot in either, uniformly,
+    the grippers empty. Reward 1 when the goal is reached (discount 0.9, tg's default), as in
+    blocks.pl.
+*/
+
+% ---- states ------------------------------------------------------------------------------
+
+initial_state(Size, State) :-
+    numlist(1, Size, Is),
+    maplist(ball_at, Is, Balls),
+    random_member(R, [rooma, roomb]),
+    append(Balls, [robby(R), free(left), free(right)], State).
+
+ball_at(I, at(O, R)) :-
+    atom_concat(o, I, O),
+    random_member(R, [rooma, roomb]).
+
+% ---- tasks -------------------------------------------------------------------------------
+
+task(deliver).
+
+goal(deliver, State) :-
+    \+ memberchk(carry(_, _), State),
+    \+ memberchk(at(_, rooma), State).
+
+step_bound(_, State, Bound) :-
+    aggregate_all(count, ( member(F, State), ball_fact(F) ), N),
+    Bound is 8 * N + 4.
+
+ball_fact(at(_, _)).
+ball_fact(carry(_, _)).
+
+% ---- actions -----------------------------------------------------------------------------
+
+action(move).
+action(pick(_O)).
+action(drop(_O)).
+
+precondition(move, _).
+precondition(pick(O), State) :-
+    memberchk(free(_), State),
+    memberchk(robby(R), State),
+    member(at(O, R), State).
+precondition(drop(O), State) :-
+    member(carry(O, _), State).
+
+effect(move, State, [robby(R)], [robby(R1)]) :-
+    memberchk(robby(R), State),
+    other_room(R, R1).
+effect(pick(O), State, [at(O, R), free(G)], [carry(O, G)]) :-
+    memberchk(at(O, R), State),
+    memberchk(free(G), State).               % the first free gripper (left before right)
+effect(drop(O), State, [carry(O, G)], [at(O, R), free(G)]) :-
+    memberchk(carry(O, G), State),
+    memberchk(robby(R), State).
+
+other_room(rooma, roomb).
+other_room(roomb, rooma).
+
+% ---- what the learner sees ---------------------------------------------------------------
+
+relation(robby(_)).
+relation(at(_, _)).
+relation(carry(_, _)).
+relation(free(_)).
+
+% The types: relrl generates the language bias from them (no rmode/1). Balls are objects
+% (a test speaks of *a* ball); rooms and grippers are named constants (robby(rooma),
+% free(left)).
+signature(move).
+signature(pick(ball)).
+signature(drop(ball)).
+signature(robby(room)).
+signature(at(ball, room)).
+signature(carry(ball, gripper)).
+signature(free(gripper)).
+type(rooma, room).
+type(roomb, room).
+type(left, gripper).
+type(right, gripper).
+
+% ---- the optimal number of steps (verified against a breadth-first search by relrl check) --
+
+% K balls still in room a (none held at the start): K picks, K drops, and a trip over and
+% back for every two balls but the last trip's way back; one move more when the robot
+% starts in room b. Held balls (a state inside an episode) are not covered: no optimum.
+optimal_steps(deliver, State, N) :-
+    \+ memberchk(carry(_, _), State),
+    aggregate_all(count, member(at(_, rooma), State), K),
+    memberchk(robby(R), State),
+    (   K =:= 0
+    ->  N = 0
+    ;   Trips is (K + 1) // 2,
+        (   R == rooma
+        ->  Moves is 2 * Trips - 1
+        ;   Moves is 2 * Trips
+        ),
+        N is 2 * K + Moves
+    ).
+
+sizes(train, [1, 2, 3]).
+sizes(test, [10, 20, 50]).
