@@ -205,10 +205,6 @@ class KnowledgeBase:
         """The stimuli and facts whose bits are set in ``code``."""
         return engine_call(self, "state_decode", self.module, code, Var())[0]
 
-    def encode_state(self, terms: list[Term]) -> int:
-        """The state code of ``terms`` (``("stimulus", S)`` / ``("fact", F)`` features)."""
-        return engine_call(self, "state_encode", self.module, terms, Var())[0]
-
     def features(self) -> list[Term]:
         """Every stimulus and fact in code order (position x has code 2^x)."""
         return engine_call(self, "state_features", self.module, Var())[0]

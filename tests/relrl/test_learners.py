@@ -12,7 +12,6 @@ from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase
 from relrl.learners import DOMAINS, WORLDS, learners, make_learner, make_world_learner
 from relrl.loop import Agent, run
-from relrl.terms import Var
 from tests.conftest import ROOT
 from tests.relrl.tasks import BEST, LightDark
 
@@ -45,10 +44,10 @@ def test_contingency_prefers_the_rewarded_responses() -> None:
     assert greedy_accuracy(agent) > 0.9
     rules = agent.learner.rules()
     fitness = {(ante[1], resp): f for ante, resp, _, f in rules}
-    light = agent.kb.call("relrl_state:state_encode", agent.kb.module,
-                          [("stimulus", "light")], Var())[0]
-    fed_dark = agent.kb.call("relrl_state:state_encode", agent.kb.module,
-                             [("stimulus", "dark"), ("stimulus", "food")], Var())[0]
+    features = agent.kb.features()
+    light = 1 << features.index(("stimulus", "light"))
+    fed_dark = (1 << features.index(("stimulus", "dark"))) | \
+        (1 << features.index(("stimulus", "food")))
     assert fitness[(light, "a")] > 5 > max(fitness.get((light, r), 1.0) for r in "bc")
     assert fitness[(fed_dark, "c")] > 5 > max(fitness.get((fed_dark, r), 1.0) for r in "ab")
     agent.kb.close()
