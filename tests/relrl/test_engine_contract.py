@@ -245,7 +245,7 @@ def test_python_calls_only_the_declared_api_and_all_of_it() -> None:
     declared = {str(t[1]) for t in prolog().run(
         (":", "relrl_gateway", ("gw_api", Var())), 0, (0,))[0]}  # type: ignore[index]
     calls = re.compile(r'(?:\b(?:call|one|call_semidet|engine_call)\(\s*[\w.]+,\s*'
-                       r'|\.goal\(|\.api\()"(\w+)"')
+                       r'|\.goal\(|\.api(?:_det|_goal)?\(|\blayer_api\()"(\w+)"')
     used = {m.group(1) for path in (ROOT / "relrl").rglob("*.py")
             for m in calls.finditer(path.read_text())}
     assert used <= declared, used - declared
