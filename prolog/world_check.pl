@@ -12,6 +12,7 @@
 :- use_module(check, [body_goal/2, clause_location/3]).
 :- use_module(tg_bias, [bias_problem/2]).
 :- use_module(world).
+:- use_module(guard, [message_text/2]).
 
 /** <module> Validating a world file
 
@@ -260,13 +261,9 @@ rule_problem(Goal, Where, E, found(problem(File, Line, Msg))) :-
     where_file_line(Where, File, Line),
     (   E = error(domain_error(world_vocabulary, Text), _)
     ->  Msg = Text
-    ;   message_to_codes(E, Text),
+    ;   message_text(E, Text),
         format(string(Msg), "~q raised: ~s", [Goal, Text])
     ).
-
-message_to_codes(E, Codes) :-
-    '$messages':translate_message(E, Lines, []),
-    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).
 
 where_file_line(Where, File, Line) :-
     (   Where = File:Line
