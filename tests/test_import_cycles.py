@@ -11,6 +11,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 from tests.conftest import ROOT
 
 PACKAGES = ("relrl", "perception", "head")
@@ -95,6 +97,7 @@ def cycle(graph: dict[str, set[str]]) -> list[str] | None:
     return None
 
 
+@pytest.mark.slow
 def test_no_import_cycles() -> None:
     known = modules()
     graph = {name: imported(name, path, known) for name, path in known.items()}

@@ -26,6 +26,8 @@ from relrl.recording.channels import CHANNELS
 from relrl.recording.reader import McapRecording
 from tests.monitor.conftest import episode
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

@@ -32,12 +32,14 @@ def greedy_accuracy(agent: Agent, steps: int = 400) -> float:
 
 
 @pytest.mark.parametrize("name", ["etg", "qlearning"])
+@pytest.mark.slow
 def test_value_learners_reach_the_optimum(name: str) -> None:
     agent = trained(name, epsilon=0.2)
     assert greedy_accuracy(agent) == 1.0
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_contingency_prefers_the_rewarded_responses() -> None:
     agent = trained("contingency")
     # Roulette-wheel choice stays stochastic, but the rewarded rules dominate.
@@ -53,6 +55,7 @@ def test_contingency_prefers_the_rewarded_responses() -> None:
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_contingency_as_execution_probabilities_reaches_its_cap() -> None:
     """With fitness read as an execution probability (max_fitness 1, the paper-2012 preset)
     no rule rises above 1, wrong responses fall to the lower bound, and the right response
@@ -187,6 +190,7 @@ def test_memory_positions() -> None:
     q.kb.close()
 
 
+@pytest.mark.slow
 def test_explanations() -> None:
     agent = trained("etg", steps=600, epsilon=0.2)
     agent.step([("see", "dark")], learning=False)
