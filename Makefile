@@ -2,8 +2,8 @@
 #   make demo   set up what the demo needs, then run the main job on the simulator
 #   make test   set up what the tests need too, then run the whole test suite
 # and, once set up, the loop while editing:
-#   make check  lint and the fast tests (those not marked slow), in about a minute
-# Each installs only what is missing; both are quick the second time.
+#   make check  lint and the fast tests (those not marked slow)
+# Each installs only what is missing; each is quick the second time.
 PYTHON ?= python3.11
 VENV   := .venv
 BIN    := $(VENV)/bin
