@@ -1,7 +1,9 @@
 # Two commands do everything on a fresh Debian machine (Python 3.11, root):
 #   make demo   set up what the demo needs, then run the main job on the simulator
 #   make test   set up what the tests need too, then run the whole test suite
-# Each installs only what is missing; both are quick the second time.
+# and, once set up, the loop while editing:
+#   make check  lint and the fast tests (those not marked slow)
+# Each installs only what is missing; each is quick the second time.
 PYTHON ?= python3.11
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -24,7 +26,7 @@ TEST_EXTRAS := dev,speech,monitor,ray,mcap,foxglove
 #   make sb3 TORCH="torch==2.13.0+cpu --extra-index-url https://download.pytorch.org/whl/cpu"
 TORCH ?= torch==2.13.0+cpu
 
-.PHONY: demo test sb3 setup setup-demo setup-test debs-demo debs-test lint clean
+.PHONY: demo test check sb3 setup setup-demo setup-test debs-demo debs-test lint clean
 
 setup: setup-test
 setup-demo: debs-demo $(VENV)/.installed-demo
@@ -71,6 +73,11 @@ demo: setup-demo
 
 test: setup-test
 	$(BIN)/python -m pytest
+
+# Lint, then every test not marked slow (pyproject.toml's `slow` marker; docs/development.md).
+check: setup-test
+	$(BIN)/ruff check relrl perception head tests bench
+	$(BIN)/python -m pytest -m "not slow"
 
 # Stable-Baselines3's PPO and DQN trained on relrl/SharedAttention-v1, each checked to learn.
 sb3: setup-demo

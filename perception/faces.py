@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import threading
 from concurrent.futures import Executor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -341,8 +341,3 @@ class FaceTracker:
 def detect_face(frame: np.ndarray, params: FaceParams = FaceParams()) -> Face | None:
     """Detect the face in one frame with a full search (no tracking state)."""
     return FaceTracker(params).detect(frame)
-
-
-def with_params(params: FaceParams, **changes: float) -> FaceParams:
-    """A copy of ``params`` with some fields changed."""
-    return replace(params, **changes)

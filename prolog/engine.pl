@@ -39,6 +39,7 @@
 :- use_module(motivation).
 :- use_module(rules).
 :- use_module(kbstate).
+:- use_module(guard, [call_context/2, set_call_context/2]).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The control step, inside Prolog
@@ -173,7 +174,7 @@ set_eng(KB, eng(Prev, Random)) :-
 %   KB's stream is now Random (the generator loads it when KB next needs it).
 set_stream(KB, Engine, Random) :-
     (   random_owner(KB)                % first: an interrupt between the two writes
-    ->  nb_setval(relrl_random_owner, none)     % must not let a later park overwrite
+    ->  set_call_context(random_owner, none)     % must not let a later park overwrite
     ;   true                                    % Random with the generator's state
     ),
     nb_setarg(3, Engine, Random).
@@ -181,9 +182,7 @@ set_stream(KB, Engine, Random) :-
 %   The generator holds Owner's stream (the KB that stepped last), or that of none: the
 %   one process-wide global of the engine (there is one generator per thread).
 random_owner(Owner) :-
-    nb_current(relrl_random_owner, Owner).
-
-:- initialization(nb_setval(relrl_random_owner, none)).
+    call_context(random_owner, Owner).
 
 %!  engine_pause is det.
 %
@@ -208,7 +207,7 @@ park :-
             nb_setarg(3, Engine, Random)
         ;   true
         ),
-        nb_setval(relrl_random_owner, none)
+        set_call_context(random_owner, none)
     ;   true
     ).
 
@@ -229,7 +228,7 @@ claim_random(KB, Engine) :-
     ;   park,
         arg(3, Engine, Random),
         set_random(state(Random)),
-        nb_setval(relrl_random_owner, KB)
+        set_call_context(random_owner, KB)
     ).
 
 %!  engine_learner(+KB, -Learner) is det.
@@ -419,7 +418,7 @@ engine_forget(KB) :-
     must_be(atom, KB),
     forget_learner(KB),
     (   random_owner(KB)
-    ->  nb_setval(relrl_random_owner, none)
+    ->  set_call_context(random_owner, none)
     ;   true
     ),
     kb_forget(KB),

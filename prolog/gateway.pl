@@ -123,7 +123,6 @@ python_api(learners, relrl_learners:learner_catalogue/1).
 python_api(state_code, relrl_state:state_code/2).
 python_api(state_terms, relrl_state:state_terms/2).
 python_api(state_decode, relrl_state:state_decode/3).
-python_api(state_encode, relrl_state:state_encode/3).
 python_api(state_features, relrl_state:state_features/2).
 python_api(allowed_responses, relrl_responses:allowed_responses/2).
 python_api(necessity_inputs, relrl_declarations:necessity_inputs/3).

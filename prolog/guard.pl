@@ -5,7 +5,10 @@
             gw_take_abort/1,      % -Where
             text_failed/1,        % +Error
             progress_watch/2,     % +Limit, :Goal
-            progress_mark/0
+            progress_mark/0,
+            message_text/2,       % +Message, -Text
+            call_context/2,       % ?Key, ?Value
+            set_call_context/2    % +Key, +Value
           ]).
 :- use_module(library(error)).
 :- use_module(library(lists)).
@@ -34,9 +37,68 @@ nothing. Under progress_watch/2 (a batch of a world's episodes, which may rightl
 an hour) the limit is the time since the last progress_mark/0 (a world's step): a rule
 that loops is stopped once it has run Limit seconds, however long the batch. The host deregisters the OS handlers of both signals: only Prolog's signal table
 knows them.
+
+What a call needs to know beyond its arguments lives in one record, the call context,
+owned here and read and written only through call_context/2 and set_call_context/2: its
+keys are declared once, by context_key/3.
 */
 
 :- meta_predicate guarded(0, -), once_result(0, -), progress_watch(+, 0).
+
+%!  call_context(?Key, ?Value) is semidet.
+%
+%   Value is the call context's Key (one of context_key/3's; its default until set):
+%
+%     - active: `true` while a guarded call runs (the signal and halt handlers act);
+%     - halt: where a cancelled halt/0,1 came from (File:Line or `goal`), or `none`;
+%     - abort: where abort/0 was called in the last call, or `none`;
+%     - timeout_where: where a file was being loaded when the time limit passed;
+%     - answer_mode, answer_again: how a user's open query writes its answers
+%       (toplevel.pl);
+%     - random_owner: the knowledge base whose random stream the generator holds
+%       (engine.pl), or `none`;
+%     - state_touch: how many times the rules may have changed (state.pl).
+%
+%   The context is per thread and survives backtracking, as nb_setval/2 does.
+
+call_context(Key, Value) :-
+    context_key(Key, I, _),
+    context_record(Record),
+    arg(I, Record, Value).
+
+%!  set_call_context(+Key, +Value) is det.
+%
+%   The call context's Key is Value from now on (a copy of it; not undone on
+%   backtracking).
+
+set_call_context(Key, Value) :-
+    (   context_key(Key, I, _)
+    ->  context_record(Record),
+        nb_setarg(I, Record, Value)
+    ;   must_be(atom, Key),
+        domain_error(call_context_key, Key)
+    ).
+
+%   context_key(?Key, ?Position, ?Default): the record's fields, the one list of them.
+context_key(active,        1, false).
+context_key(halt,          2, none).
+context_key(abort,         3, none).
+context_key(timeout_where, 4, none).
+context_key(answer_mode,   5, print).
+context_key(answer_again,  6, none).
+context_key(random_owner,  7, none).
+context_key(state_touch,   8, 0).
+
+%   This thread's record (a global variable's term: nb_setarg/3 changes it in place),
+%   made with the defaults on first use.
+context_record(Record) :-
+    (   nb_current(relrl_call_context, Record)
+    ->  true
+    ;   findall(Default, context_key(_, _, Default), Defaults),
+        Fresh =.. [context|Defaults],
+        nb_setval(relrl_call_context, Fresh),
+        nb_getval(relrl_call_context, Record)
+    ).
 
 %!  guarded(:Goal, -Result) is det.
 %
@@ -49,20 +111,17 @@ knows them.
 %   handler before it unwinds on.
 
 guarded(Goal, Result) :-
-    (   nb_current(relrl_active, Was)
-    ->  true
-    ;   Was = false
-    ),
+    call_context(active, Was),
     catch(guarded_call(Goal, Was, Result0), E, guarded_error(E, Was, Result0)),
     halt_result(Result0, Result).
 
 guarded_call(Goal, Was, Result) :-
-    nb_setval(relrl_active, true),
+    set_call_context(active, true),
     once_result(Goal, Result),
-    nb_setval(relrl_active, Was).
+    set_call_context(active, Was).
 
 guarded_error(E, Was, Result) :-
-    call_cleanup(error_result(E, Result), nb_setval(relrl_active, Was)).
+    call_cleanup(error_result(E, Result), set_call_context(active, Was)).
 
 once_result(Goal, Result) :-
     (   call(Goal)
@@ -73,9 +132,9 @@ once_result(Goal, Result) :-
 %   Result0, or the error for a halt/0,1 called while the call ran (Result0 itself when it
 %   is already that error, naming the rule).
 halt_result(Result0, Result) :-
-    (   nb_current(relrl_halt, Where),
+    (   call_context(halt, Where),
         Where \== none
-    ->  nb_setval(relrl_halt, none),
+    ->  set_call_context(halt, none),
         (   halt_error(Result0)
         ->  Result = Result0
         ;   halt_message(Where, Message),
@@ -106,9 +165,9 @@ halt_message(Where, Message) :-
 %   reports it at its line) or throw relrl_halt_called (a goal: it stops).
 :- meta_predicate guarded_halt(+, 0).
 guarded_halt(_Status, Halt) :-
-    (   nb_current(relrl_active, true)
+    (   call_context(active, true)
     ->  load_location(Where),
-        nb_setval(relrl_halt, Where),
+        set_call_context(halt, Where),
         Where == goal,
         throw(relrl_halt_called)
     ;   call(Halt)
@@ -118,9 +177,9 @@ guarded_halt(_Status, Halt) :-
 
 %   at_halt/1 hook: inside a guarded call, cancel the halt and remember where it came from.
 halt_hook :-
-    (   nb_current(relrl_active, true)
+    (   call_context(active, true)
     ->  load_location(Where),
-        nb_setval(relrl_halt, Where),
+        set_call_context(halt, Where),
         cancel_halt(relrl_guard)
     ;   true
     ).
@@ -140,9 +199,9 @@ load_location(Where) :-
 %   The running call's time limit passed: remember where a file being loaded was (a
 %   directive that never ends), then throw as call_with_time_limit/2 does.
 time_up(_Signal) :-
-    (   nb_current(relrl_active, true)
+    (   call_context(active, true)
     ->  load_location(Where),
-        nb_setval(relrl_timeout_where, Where),
+        set_call_context(timeout_where, Where),
         throw(time_limit_exceeded)
     ;   true
     ).
@@ -151,7 +210,7 @@ time_up(_Signal) :-
 %   watched goal has run its limit since its last progress mark; nothing outside the goal
 %   (the moments before progress_watch/2 sets the watch and after it ends).
 tick(_Signal) :-
-    (   nb_current(relrl_active, true),
+    (   call_context(active, true),
         nb_current(relrl_watch, watch(Limit, Seen, Since)),
         flag(relrl_progress, N, N),
         get_time(Now),
@@ -190,7 +249,7 @@ progress_mark :-
     flag(relrl_progress, N, N + 1).
 
 interrupt(_Signal) :-
-    (   nb_current(relrl_active, true)
+    (   call_context(active, true)
     ->  throw(relrl_interrupted)
     ;   true
     ).
@@ -243,9 +302,9 @@ error_result(error(relrl_policy_error(File, Line, Text), _),
 error_result(relrl_halt_called, error(halt_called(goal), Message)) :- !,
     halt_message(goal, Message).
 error_result('$aborted', error(aborted, "abort/0 called")) :- !,
-    (   nb_current(relrl_abort, W), W \== none
+    (   call_context(abort, W), W \== none
     ->  true
-    ;   nb_setval(relrl_abort, goal)
+    ;   set_call_context(abort, goal)
     ).
 error_result(E0, error(E, Message)) :-
     strip_context(E0, E),
@@ -267,11 +326,8 @@ one_line(Text, Line) :-
 %   loaded, goal otherwise, none when no abort happened); forgets it.
 
 gw_take_abort(Where) :-
-    (   nb_current(relrl_abort, Where0)
-    ->  Where = Where0
-    ;   Where = none
-    ),
-    nb_setval(relrl_abort, none).
+    call_context(abort, Where),
+    set_call_context(abort, none).
 
 %   The alarm's context is noise for a user; keep the error itself.
 strip_context(error(Formal, context(time:_, _)), error(Formal, _)) :- !.
@@ -297,12 +353,18 @@ must_pass(unwind(_)).
 must_pass(error(resource_error(_), _)).
 
 message_string(E, Message) :-
-    (   catch(message_to_codes(E, Codes), Error, text_failed(Error))
-    ->  string_codes(Message0, Codes)
+    (   catch(message_text(E, Message0), Error, text_failed(Error))
+    ->  true
     ;   format(string(Message0), "~q", [E])
     ),
     one_line(Message0, Message).
 
-message_to_codes(E, Codes) :-
-    '$messages':translate_message(E, Lines, []),
-    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).
+%!  message_text(+Message, -Text:string) is det.
+%
+%   Text is Message (an error term, query(more(...)), any message term) as print_message/2
+%   writes it, without a prefix: its lines from SWI-Prolog's public translation,
+%   prolog:translate_message//1, written by print_message_lines/3.
+
+message_text(Message, Text) :-
+    phrase(prolog:translate_message(Message), Lines),
+    with_output_to(string(Text), print_message_lines(current_output, '', Lines)).

@@ -93,7 +93,7 @@ gw_load(File, Module, Problems) :-
     ->  absolute_file_name(File, Abs),
         atomic_list_concat([Abs, '#', Module], Id),
         gensym(load_, Key),
-        nb_setval(relrl_timeout_where, none),
+        set_call_context(timeout_where, none),
         setup_call_cleanup(
             asserta(collecting(Key)),
             guarded(load_stream(Abs, Id, Module), Result),
@@ -120,7 +120,7 @@ note_result(true, _, _).
 note_result(false, _, _).
 note_result(error(Kind, Message), Key, File) :-
     (   Kind == time_limit_exceeded
-    ->  nb_getval(relrl_timeout_where, Where),
+    ->  call_context(timeout_where, Where),
         (   Where = F:L
         ->  true
         ;   F = File, L = 0
@@ -129,7 +129,7 @@ note_result(error(Kind, Message), Key, File) :-
     ;   Kind = halt_called(F:L)
     ->  Msg = "halt/0,1 called while loading (a loaded file cannot end relrl)"
     ;   Kind == aborted
-    ->  nb_setval(relrl_abort, File:0),
+    ->  set_call_context(abort, File:0),
         F = File, L = 0, Msg = "abort/0 called while loading"
     ;   Kind = error(_, Context), nonvar(Context), Context = file(F, L, _, _)
     ->  Msg = Message

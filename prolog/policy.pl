@@ -11,6 +11,7 @@
 :- use_module(library(apply)).
 :- use_module(library(occurs)).
 :- use_module(engine).
+:- use_module(guard, [message_text/2]).
 
 /** <module> Reading a saved policy as data
 
@@ -343,7 +344,7 @@ restore_error(File, Terms, Formal) :-
         ->  culprit_line(Terms, Culprit, Line)
         ;   Line = 0
         ),
-        message_to_codes_(Formal, Text),
+        message_text(error(Formal, _), Text),
         policy_error(File, Line, "bad policy: ~s", [Text])
     ;   throw(error(Formal, _))
     ).
@@ -358,10 +359,6 @@ culprit_line(Terms, Culprit, Line) :-
     ->  Line = Line0
     ;   Line = 0
     ).
-
-message_to_codes_(Formal, Codes) :-
-    '$messages':translate_message(error(Formal, _), Lines, []),
-    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).
 
 policy_error(File, Line, Format, Args) :-
     format(string(Message), Format, Args),

@@ -16,6 +16,7 @@
 :- use_module(library(pairs)).
 :- use_module(library(random)).
 :- use_module(tg).
+:- use_module(learner_hooks).
 :- use_module(tg_tree, [tg_data/2, tg_get_tree/2, tg_forget/1, tg_leaf/3, tg_leaves_/3,
                          tg_sort_/5]).
 :- use_module(kbstate, [kb_nest/3, kb_get/3, kb_forget/1]).
@@ -300,38 +301,13 @@ relrl_engine:learner_forget(ptg, KB) :-
     tg_forget(PK),
     kb_forget(PK).
 
-relrl_engine:learner_init(ptg, KB, Params) :-
-    ptg_init(KB, Params).
+:- learner_hooks(ptg, [init-ptg_init, choose-ptg_choose, update-ptg_update,
+                      explain-ptg_explain, size-ptg_size, save-ptg_save,
+                      policy_info-tg_policy_info, policy_term-policy_term,
+                      restore-ptg_restore, text-ptg_text]).
 
 relrl_engine:learner_state(ptg, KB, _Code, Facts) :-
     tg_state(KB, Facts).
-
-relrl_engine:learner_choose(ptg, KB, Facts, N, Allowed, Mode, Action) :-
-    ptg_choose(KB, Facts, N, Allowed, Mode, Action).
-
-relrl_engine:learner_update(ptg, KB, Transition) :-
-    ptg_update(KB, Transition).
-
-relrl_engine:learner_explain(ptg, KB, Facts, N, Explanation) :-
-    ptg_explain(KB, Facts, N, Explanation).
-
-relrl_engine:learner_size(ptg, KB, Size) :-
-    ptg_size(KB, Size).
-
-relrl_engine:learner_save(ptg, KB, Stream) :-
-    ptg_save(KB, Stream).
-
-relrl_engine:learner_policy_info(ptg, KB, Info) :-
-    tg_policy_info(KB, Info).
-
-relrl_engine:learner_policy_term(ptg, Term) :-
-    policy_term(Term).
-
-relrl_engine:learner_restore(ptg, KB, Terms) :-
-    ptg_restore(KB, Terms).
-
-relrl_engine:learner_text(ptg, KB, Text) :-
-    ptg_text(KB, Text).
 
 relrl_engine:learner_graph(ptg, KB, Graph) :-
     ptg_key(KB, PK),

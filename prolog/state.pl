@@ -26,6 +26,7 @@
 :- use_module(rules).
 :- use_module(memory).
 :- use_module(kbstate, [kb_record/2]).
+:- use_module(guard, [call_context/2, set_call_context/2]).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The state code
@@ -243,13 +244,10 @@ reads_memory(Body, Body, any) :-
 state_touch :-
     touched(T0),
     T is T0 + 1,
-    nb_setval(relrl_state_touch, T).
+    set_call_context(state_touch, T).
 
 touched(T) :-
-    (   nb_current(relrl_state_touch, T0)
-    ->  T = T0
-    ;   T = 0
-    ).
+    call_context(state_touch, T).
 
 %   Plan Id's memory facts are memory facts still: checked(Touch, Hold) says so (Hold)
 %   until state_touch/0 moves on from Touch; then they are checked again.

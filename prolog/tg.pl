@@ -20,6 +20,7 @@
 :- use_module(library(pairs)).
 :- use_module(declarations).
 :- use_module(engine).
+:- use_module(learner_hooks).
 :- use_module(tg_bias).
 :- use_module(tg_stats).
 :- use_module(tg_tree).
@@ -909,41 +910,10 @@ relrl_engine:learner_serves(tg, domains, []).
 relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
                                          action_gap=0.9]).
 
-relrl_engine:learner_forget(tg, KB) :-
-    tg_forget(KB).
-
-relrl_engine:learner_init(tg, KB, Params) :-
-    tg_init(KB, Params).
+:- learner_hooks(tg, [forget-tg_forget, init-tg_init, choose-tg_choose, update-tg_update,
+                     explain-tg_explain, size-tg_size, save-tg_save,
+                     policy_info-tg_policy_info, policy_term-tg_policy_term,
+                     restore-tg_restore, text-tg_text, graph-tg_graph]).
 
 relrl_engine:learner_state(tg, KB, _Code, Facts) :-
     tg_state(KB, Facts).
-
-relrl_engine:learner_choose(tg, KB, Facts, N, Allowed, Mode, Action) :-
-    tg_choose(KB, Facts, N, Allowed, Mode, Action).
-
-relrl_engine:learner_update(tg, KB, Transition) :-
-    tg_update(KB, Transition).
-
-relrl_engine:learner_explain(tg, KB, Facts, N, Explanation) :-
-    tg_explain(KB, Facts, N, Explanation).
-
-relrl_engine:learner_size(tg, KB, Size) :-
-    tg_size(KB, Size).
-
-relrl_engine:learner_save(tg, KB, Stream) :-
-    tg_save(KB, Stream).
-
-relrl_engine:learner_policy_info(tg, KB, Info) :-
-    tg_policy_info(KB, Info).
-
-relrl_engine:learner_policy_term(tg, Term) :-
-    tg_policy_term(Term).
-
-relrl_engine:learner_restore(tg, KB, Terms) :-
-    tg_restore(KB, Terms).
-
-relrl_engine:learner_text(tg, KB, Text) :-
-    tg_text(KB, Text).
-
-relrl_engine:learner_graph(tg, KB, Graph) :-
-    tg_graph(KB, Graph).

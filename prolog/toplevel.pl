@@ -35,8 +35,8 @@ KnowledgeBase.query/2 takes its answers from here too, as values.
 gw_answer(Module, Text, Mode, Answer) :-
     must_be(atom, Module),
     must_be(oneof([write, print, values]), Mode),
-    nb_setval(relrl_answer_mode, Mode),
-    nb_setval(relrl_answer_again, none),
+    set_call_context(answer_mode, Mode),
+    set_call_context(answer_again, none),
     catch(term_string(Goal, Text, [variable_names(Bindings), module(Module)]), E, true),
     (   var(E)
     ->  catch(answer(Module:Goal, Bindings, Answer), E0,
@@ -64,7 +64,7 @@ answer(Goal, Bindings, Answer) :-
 %   answer, go on and fail into the goal (the cuts stay in this clause).
 deliver(Bindings, Det, Answer) :-
     repeat,
-    nb_getval(relrl_answer_mode, Mode),
+    call_context(answer_mode, Mode),
     answer_term(Mode, Bindings, Det, Answer0),
     pause(Halt),
     (   Halt \== none
@@ -72,7 +72,7 @@ deliver(Bindings, Det, Answer) :-
         halt_message(Halt, Message),
         Answer = error(halt_called(Halt), Message)
     ;   Answer = Answer0
-    ;   nb_getval(relrl_answer_again, Again),
+    ;   call_context(answer_again, Again),
         Again \== none
     ->  resume,
         fail
@@ -99,16 +99,13 @@ toplevel_error(E, E).
 %   time limit stop it); between answers, none does and what the goal wrote is flushed.
 resume :-
     engine_pause,                       % a step may have run between two answers
-    nb_setval(relrl_active, true).
+    set_call_context(active, true).
 
 pause(Halt) :-
     flush_output(user_output),          % the goal's output comes before the answer
-    nb_setval(relrl_active, false),
-    (   nb_current(relrl_halt, Halt0)
-    ->  Halt = Halt0
-    ;   Halt = none
-    ),
-    nb_setval(relrl_halt, none).
+    set_call_context(active, false),
+    call_context(halt, Halt),
+    set_call_context(halt, none).
 
 %!  gw_answer_again(+Mode) is det.
 %
@@ -118,8 +115,8 @@ pause(Halt) :-
 
 gw_answer_again(Mode) :-
     must_be(oneof([write, print]), Mode),
-    nb_setval(relrl_answer_mode, Mode),
-    nb_setval(relrl_answer_again, Mode).
+    set_call_context(answer_mode, Mode),
+    set_call_context(answer_again, Mode).
 
 anonymous(Name=_) :-
     sub_atom(Name, 0, _, _, '_').
@@ -151,7 +148,7 @@ depth_within(Term, Max) :-
     ).
 
 answer_text(Bindings0, Text) :-
-    nb_setval(relrl_answer_again, none),
+    set_call_context(answer_again, none),
     exclude(anonymous, Bindings0, Bindings1),
     prolog:translate_bindings(Bindings1, Bindings, [], [], _:Residuals),
     name_variables(Bindings-Residuals),
@@ -164,7 +161,7 @@ answer_text(Bindings0, Text) :-
     split_string(Text0, "", " \n", [Text]).
 
 answer_options(Options) :-
-    (   nb_current(relrl_answer_mode, write)
+    (   call_context(answer_mode, write)
     ->  Options = [quoted(true), numbervars(true), spacing(next_argument),
                    max_depth(MaxDepth)],
         safe_write_depth(MaxDepth)
@@ -183,9 +180,8 @@ toplevel_text(Bindings, Residuals, Options, Text) :-
     ),
     setup_call_cleanup(
         create_prolog_flag(answer_write_options, Options, [type(term)]),
-        '$messages':translate_message(query(more(Bindings, true, Residuals)), Lines, []),
-        Restore),
-    with_output_to(string(Text), print_message_lines(current_output, '', Lines)).
+        message_text(query(more(Bindings, true, Residuals)), Text),
+        Restore).
 
 %   As the toplevel does: a variable that occurs once is written _, the others _A, _B, ...
 name_variables(Term) :-

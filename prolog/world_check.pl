@@ -12,6 +12,7 @@
 :- use_module(check, [body_goal/2, clause_location/3]).
 :- use_module(tg_bias, [bias_problem/2]).
 :- use_module(world).
+:- use_module(guard, [message_text/2]).
 
 /** <module> Validating a world file
 
@@ -389,23 +390,19 @@ rule_problem(Goal, Where, E, found(problem(File, Line, Msg))) :-
     ->  Msg = Text
     ;   E = error(resource_error(Resource), _)
     ->  format(string(Msg), "~q ran out of ~w (a recursion without end?)", [Goal, Resource])
-    ;   message_to_codes(E, Codes),
-        first_line(Codes, Text),
+    ;   message_text(E, Text0),
+        first_line(Text0, Text),
         format(string(Msg), "~q raised: ~s", [Goal, Text])
     ).
 
 %   A message's first line that holds text: a problem is one line.
-first_line(Codes, Line) :-
-    split_string(Codes, "\n", " \t", Lines),
+first_line(Text0, Line) :-
+    split_string(Text0, "\n", " \t", Lines),
     (   member(Line, Lines),
         Line \== ""
     ->  true
     ;   Line = ""
     ).
-
-message_to_codes(E, Codes) :-
-    '$messages':translate_message(E, Lines, []),
-    with_output_to(codes(Codes), print_message_lines(current_output, '', Lines)).
 
 where_file_line(Where, File, Line) :-
     (   Where = File:Line

@@ -65,12 +65,11 @@ def stepbench() -> ModuleType:
 
 def measure_call_cost(n: int = 2000) -> float:
     """Seconds per gateway call with one binding (``relrl_state:state_code``-sized work)."""
-    from relrl.bridge.calls import prolog
     from relrl.kb import KnowledgeBase
     from relrl.terms import Var
 
     with KnowledgeBase() as kb:
-        goal = ":".join(prolog().goal("wm_clock"))
+        goal = ":".join(kb.api_goal("wm_clock"))
         kb.call(goal, kb.module, Var())
         t0 = time.perf_counter()
         for _ in range(n):

@@ -31,9 +31,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from relrl.bridge.calls import prolog
 from relrl.bridge.marshal import Cached
-from relrl.errors import PolicyError, PrologError, QueryTimeout, RelrlError
+from relrl.errors import EngineError, PolicyError, PrologError, QueryTimeout
 from relrl.outdir import write_atomic
 from relrl.terms import Term, Var
 
@@ -61,10 +60,6 @@ MODES = ("learn", "explore", "greedy")
 WANTS = ("memory", "memory_size", "explain")
 
 _slots = itertools.count()
-
-
-class EngineError(RelrlError):
-    """A goal of relrl's engine failed where it must succeed (a bug, not a user error)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -107,17 +102,13 @@ def call(kb: KnowledgeBase, goal: str, *arguments: Term, timeout: float | None =
     Raises:
         EngineError: the goal failed.
     """
-    out = call_semidet(kb, goal, *arguments, timeout=timeout)
-    if out is None:
-        module, name = prolog().goal(goal)
-        raise EngineError(f"{module}:{name}/{len(arguments)} failed in {kb.module}")
-    return out
+    return kb.api_det(goal, *arguments, timeout=timeout)
 
 
 def call_semidet(kb: KnowledgeBase, goal: str, *arguments: Term,
                  timeout: float | None = None) -> list | None:
     """:func:`call` for a goal that may fail: None when it does."""
-    return prolog().api(goal, *arguments, timeout=kb.timeout if timeout is None else timeout)
+    return kb.api(goal, *arguments, timeout=timeout)
 
 
 def one(kb: KnowledgeBase, goal: str, *arguments: Term) -> Term:

@@ -22,6 +22,7 @@ __all__ = [
     "PrologMissing",
     "JobFailed",
     "JobCrashed",
+    "EngineError",
     "PrologError",
     "AnswerTooLarge",
     "PrologLoadError",
@@ -50,6 +51,10 @@ class JobFailed(UserError):
 class JobCrashed(RuntimeError):
     """An experiment job raised something that is not a relrl error: a bug; carries the
     traceback."""
+
+
+class EngineError(RelrlError):
+    """A goal of relrl's engine failed where it must succeed (a bug, not a user error)."""
 
 
 class PrologError(RelrlError):

@@ -20,13 +20,12 @@ from pathlib import Path
 
 from relrl.bridge.calls import Aborted, display_path, prolog, strip_kb_module
 from relrl.bridge.marshal import Cached
-from relrl.engine import call as engine_call
-from relrl.errors import PrologLoadError
+from relrl.errors import EngineError, PrologLoadError
 from relrl.query import OpenQuery
 from relrl.resources import prolog_dir
 from relrl.terms import Term, Var
 
-__all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls",
+__all__ = ["KnowledgeBase", "Problem", "Cached", "PROLOG_DIR", "gateway_calls", "layer_api",
            "DEFAULT_TIMEOUT"]
 
 #: Where the knowledge layer's .pl files live: package data (override with RELRL_PROLOG_DIR).
@@ -52,6 +51,14 @@ class Problem:
 def gateway_calls() -> int:
     """Number of calls into Prolog made through the gateway so far in this process."""
     return prolog().calls
+
+
+def layer_api(goal: str, *arguments: Term, timeout: float) -> list | None:
+    """Call the goal of the knowledge layer that ``python_api/2`` names ``goal`` once, for
+    what concerns no knowledge base (the learners' catalogue is asked before any knowledge
+    base exists): the one door to Prolog besides :class:`KnowledgeBase`. Returns the values
+    of its :class:`Var` arguments, or None when it fails."""
+    return prolog().api(goal, *arguments, timeout=timeout)
 
 
 class KnowledgeBase:
@@ -137,6 +144,34 @@ class KnowledgeBase:
                                self.timeout if timeout is None else timeout)
         return out is not None
 
+    def api(self, goal: str, *arguments: Term, timeout: float | None = None) -> list | None:
+        """Call the goal of the knowledge layer that ``python_api/2`` (prolog/gateway.pl)
+        names ``goal`` once, under this knowledge base's time limit unless ``timeout`` is
+        given: the values of its :class:`Var` arguments, in order, or None when it fails.
+        :class:`relrl.engine.Engine` and the methods below call the layer through it."""
+        return self._prolog.api(goal, *arguments,
+                                timeout=self.timeout if timeout is None else timeout)
+
+    def api_det(self, goal: str, *arguments: Term, timeout: float | None = None) -> list:
+        """:meth:`api` for a goal that must succeed.
+
+        Raises:
+            EngineError: the goal failed (a bug of the layer, not a user's error).
+        """
+        out = self.api(goal, *arguments, timeout=timeout)
+        if out is None:
+            module, name = self.api_goal(goal)
+            raise EngineError(f"{module}:{name}/{len(arguments)} failed in {self.module}")
+        return out
+
+    def api_goal(self, goal: str) -> tuple[str, str]:
+        """``(module, predicate)`` of the goal ``python_api/2`` names ``goal``.
+
+        Raises:
+            RelrlError: the layer declares no goal of that name.
+        """
+        return self._prolog.goal(goal)
+
     def step(self, percepts: Cached, emitted: int, mode: str, want: list[str]) -> tuple | None:
         """The control step of this knowledge base's engine in one gateway call (see
         :class:`relrl.engine.Engine`, which decodes it); None when the step failed."""
@@ -174,8 +209,8 @@ class KnowledgeBase:
         """Open a query typed by a user (Prolog syntax) to take its answers one at a time,
         as swipl's toplevel does (``relrl shell``; see :class:`relrl.query.OpenQuery`).
         ``timeout``: seconds each answer may take (default: this knowledge base's)."""
-        return OpenQuery(self.module, text, self.timeout if timeout is None else timeout,
-                         mode)
+        return OpenQuery(self._prolog, self.module, text,
+                         self.timeout if timeout is None else timeout, mode)
 
     def interruptible(self) -> AbstractContextManager[None]:
         """A context in which Ctrl-C stops the running goal at once (a user's queries at a
@@ -189,40 +224,36 @@ class KnowledgeBase:
 
     def insert(self, elements: Iterable[Term]) -> None:
         """One insertion of ``elements`` into working memory (they get age 0)."""
-        engine_call(self, "wm_insert", self.module, list(elements))
+        self.api_det("wm_insert", self.module, list(elements))
 
     def memory(self) -> list[tuple[int, Term]]:
         """Working memory as ``(age, element)`` pairs, youngest first."""
-        pairs = engine_call(self, "wm_elements", self.module, Var())[0]
+        pairs = self.api_det("wm_elements", self.module, Var())[0]
         return [(age, element) for (_, age, element) in pairs]
 
     def clear_memory(self) -> None:
         """Forget every element of working memory."""
-        engine_call(self, "wm_clear", self.module)
+        self.api_det("wm_clear", self.module)
 
     def state_code(self) -> int:
         """The current state code: sum of 2^x over the stimuli and facts that hold now."""
-        return engine_call(self, "state_code", self.module, Var())[0]
+        return self.api_det("state_code", self.module, Var())[0]
 
     def state_terms(self) -> list[Term]:
         """The stimuli and facts that hold now, as ``("stimulus", S)`` / ``("fact", F)``."""
-        return engine_call(self, "state_terms", self.module, Var())[0]
+        return self.api_det("state_terms", self.module, Var())[0]
 
     def decode_state(self, code: int) -> list[Term]:
         """The stimuli and facts whose bits are set in ``code``."""
-        return engine_call(self, "state_decode", self.module, code, Var())[0]
-
-    def encode_state(self, terms: list[Term]) -> int:
-        """The state code of ``terms`` (``("stimulus", S)`` / ``("fact", F)`` features)."""
-        return engine_call(self, "state_encode", self.module, terms, Var())[0]
+        return self.api_det("state_decode", self.module, code, Var())[0]
 
     def features(self) -> list[Term]:
         """Every stimulus and fact in code order (position x has code 2^x)."""
-        return engine_call(self, "state_features", self.module, Var())[0]
+        return self.api_det("state_features", self.module, Var())[0]
 
     def allowed_responses(self) -> list[Term]:
         """The responses the constraint rules allow now, in declaration order."""
-        return engine_call(self, "allowed_responses", self.module, Var())[0]
+        return self.api_det("allowed_responses", self.module, Var())[0]
 
     def declarations(self, kind: str) -> list[Term]:
         """All ``kind`` declarations (``stimulus``, ``fact``, ``response``, ``necessity``)."""
@@ -231,7 +262,7 @@ class KnowledgeBase:
     def find(self, name: str, *arguments: Term) -> list[Term]:
         """Every declaration ``name(arguments...)`` of the domain, as terms (a template with
         :class:`~relrl.terms.Var` arguments; nothing but the domain's own clauses is run)."""
-        return engine_call(self, "findall", self.module, (name, *arguments), Var())[0]
+        return self.api_det("findall", self.module, (name, *arguments), Var())[0]
 
     # -- life cycle ------------------------------------------------------------------------
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from relrl.bridge.calls import Query, check_result, prolog
+from relrl.bridge.calls import Prolog, Query, check_result
 from relrl.errors import ConfigError
 from relrl.terms import Term
 
@@ -42,6 +42,7 @@ class OpenQuery:
     :meth:`relrl.kb.KnowledgeBase.open_query`). Close it, or use it as a context manager.
 
     Args:
+        transport: the process's Prolog, as the knowledge base holds it.
         module: the knowledge base's module.
         text: the query, with or without its final full stop.
         timeout: seconds each answer may take (positive: a user's query is always
@@ -50,7 +51,8 @@ class OpenQuery:
             ``"values"`` gives the bindings as values instead of text.
     """
 
-    def __init__(self, module: str, text: str, timeout: float, mode: str = "print") -> None:
+    def __init__(self, transport: Prolog, module: str, text: str, timeout: float,
+                 mode: str = "print") -> None:
         if mode not in _MODES:
             raise ValueError(f"mode {mode!r}: use one of {', '.join(_MODES)}")
         if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
@@ -58,8 +60,9 @@ class OpenQuery:
             raise ConfigError(f"time limit {timeout!r}: use a positive number of seconds")
         self.timeout = float(timeout)
         text = text.strip()
-        self._query: Query = prolog().open(("relrl_gateway", "gw_answer"),
-                                           [module, text.removesuffix("."), mode])
+        self._prolog = transport
+        self._query: Query = transport.open(("relrl_gateway", "gw_answer"),
+                                            [module, text.removesuffix("."), mode])
 
     @property
     def closed(self) -> bool:
@@ -93,7 +96,7 @@ class OpenQuery:
             raise ValueError(f"mode {mode!r}: use 'write' or 'print'")
         if self.closed:
             return None
-        prolog().api("answer_again", mode, timeout=self.timeout)
+        self._prolog.api("answer_again", mode, timeout=self.timeout)
         return self.next()
 
     def close(self) -> None:

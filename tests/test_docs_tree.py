@@ -8,7 +8,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from tests.conftest import ROOT
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def test_tg_md_shows_the_tree_the_example_learns(tmp_path: Path) -> None:

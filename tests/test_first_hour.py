@@ -41,6 +41,7 @@ def first_hour_commands() -> list[str]:
     return [line for line in _first_hour_block("sh").splitlines() if line.strip()]
 
 
+@pytest.mark.slow
 def test_the_first_hour_python_runs_as_written(tmp_path: Path) -> None:
     """The README's own-code example learns gaze following (tg's first test) in 2,000 units."""
     (tmp_path / "examples").symlink_to(ROOT / "examples")

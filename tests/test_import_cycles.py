@@ -1,12 +1,17 @@
 """No import cycles in relrl, perception and head: the graph of every import of their modules
-(at the top of a module or inside a function; those under ``if TYPE_CHECKING:`` are for the
-type checker only and left out) is acyclic, so no function-local import is there to break a
-cycle."""
+(at the top of a module, inside a function, or under ``if TYPE_CHECKING:``) is acyclic, so no
+function-local import is there to break a cycle and no cycle hides behind the type checker.
+
+And one way in: above the transport (relrl/bridge), only the facade (relrl/kb.py) reaches
+the process's Prolog (``relrl.bridge.calls.prolog``); everything else goes through a
+:class:`~relrl.kb.KnowledgeBase` or :func:`relrl.kb.layer_api`."""
 
 from __future__ import annotations
 
 import ast
 from pathlib import Path
+
+import pytest
 
 from tests.conftest import ROOT
 
@@ -30,9 +35,11 @@ def _type_checking(test: ast.expr) -> bool:
         (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
 
 
-def imported(name: str, path: Path, known: dict[str, Path]) -> set[str]:
-    """The modules of ``known`` that module ``name`` imports anywhere but under
-    ``if TYPE_CHECKING:`` (``from P import m`` names module ``P.m`` when there is one)."""
+def imported(name: str, path: Path, known: dict[str, Path], *,
+             type_checking: bool = True) -> set[str]:
+    """The modules of ``known`` that module ``name`` imports anywhere (with
+    ``type_checking`` False, not under ``if TYPE_CHECKING:``; ``from P import m`` names
+    module ``P.m`` when there is one)."""
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
 
     def owner(dotted: str) -> str | None:
@@ -43,7 +50,7 @@ def imported(name: str, path: Path, known: dict[str, Path]) -> set[str]:
     out: set[str] = set()
 
     def visit(node: ast.AST) -> None:
-        if isinstance(node, ast.If) and _type_checking(node.test):
+        if not type_checking and isinstance(node, ast.If) and _type_checking(node.test):
             for child in node.orelse:
                 visit(child)
             return
@@ -90,6 +97,7 @@ def cycle(graph: dict[str, set[str]]) -> list[str] | None:
     return None
 
 
+@pytest.mark.slow
 def test_no_import_cycles() -> None:
     known = modules()
     graph = {name: imported(name, path, known) for name, path in known.items()}
@@ -102,3 +110,35 @@ def test_the_cycle_finder_finds_one() -> None:
     """The check can fail: a cycle through a function-local import is found."""
     assert cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == ["a", "b", "c", "a"]
     assert cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_type_checking_imports_count() -> None:
+    """An import under ``if TYPE_CHECKING:`` is an edge of the graph: a cycle behind it is
+    found."""
+    known = modules()
+    assert "relrl.kb" in imported("relrl.engine", known["relrl.engine"], known)
+    assert "relrl.kb" not in imported("relrl.engine", known["relrl.engine"], known,
+                                      type_checking=False)
+
+
+def reaches_the_transport(path: Path) -> bool:
+    """True when the module at ``path`` imports ``prolog`` from relrl.bridge.calls or
+    calls ``relrl.bridge.calls.prolog`` by its dotted name."""
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").endswith("bridge.calls") \
+                and any(alias.name == "prolog" for alias in node.names):
+            return True
+        if isinstance(node, ast.Attribute) and node.attr == "prolog" and \
+                ast.unparse(node.value).endswith("bridge.calls"):
+            return True
+    return False
+
+
+def test_one_way_in() -> None:
+    facade = {ROOT / "relrl" / "kb.py"}
+    bridge = ROOT / "relrl" / "bridge"
+    above = [path for path in modules().values()
+             if bridge not in path.parents and path not in facade]
+    found = sorted(str(p.relative_to(ROOT)) for p in above if reaches_the_transport(p))
+    assert not found, f"modules that reach Prolog past relrl.kb: {found}"
+    assert reaches_the_transport(ROOT / "relrl" / "kb.py"), "the check finds no use"

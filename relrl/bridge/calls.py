@@ -235,14 +235,16 @@ class Prolog:
             self._flush()
 
     def _step_rest(self, a: int, timeout: float) -> tuple | None:
-        """The step's result and fields read as terms from its arguments at ``a``."""
+        """The step's result and fields read as terms from its arguments at ``a`` (their
+        positions: :data:`relrl.bridge.stepkernel.STEP_ARGUMENTS`)."""
+        k = self._kernel[0]
         get = self.marshal.get
-        result = get(a + 5)
+        result = get(a + k.RESULT)
         if result == "false":
             return None
         check_result(result, timeout)
         code, necessity, outputs, reward, reinforced, mask, action, extras = (
-            get(a + i) for i in range(6, 14))
+            get(a + i) for i in range(*k.FIELDS))
         return (code, necessity, outputs, reward, reinforced == "true", mask, action,
                 extras or None)
 

@@ -33,50 +33,95 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from ctypes import POINTER, c_char_p, c_double, c_int, c_int64, c_size_t, c_uint, c_void_p
+from typing import Any
 
 from relrl.errors import PrologMissing
 
-__all__ = ["Lib", "start", "STACK_LIMIT"]
+__all__ = ["Lib", "start", "STACK_LIMIT", "BUILT_FOR", "FOREIGN", "RUNS_PROLOG", "CTYPES",
+           "check_version"]
 
 #: Bytes of Prolog stack (all stacks together) before a rule raises a resource error:
 #: a runaway recursion ends in about 1.5 s (SWI-Prolog's default, 1 GB, takes 3).
 STACK_LIMIT = 512 * 1024 * 1024
+
+#: The SWI-Prolog major version whose foreign interface the constants and signatures below
+#: are SWI-Prolog.h's (:func:`check_version` refuses another).
+BUILT_FOR = 9
 
 # SWI-Prolog 9 foreign-interface constants.
 VARIABLE, ATOM, INTEGER, RATIONAL, FLOAT, STRING, TERM, NIL, BLOB, LIST_PAIR = range(1, 11)
 REP_UTF8 = 0x00100000
 CVT_ATOM, CVT_STRING, CVT_INTEGER, CVT_VARIABLE, CVT_WRITEQ = 0x1, 0x2, 0x8, 0x40, 0xC0
 Q_FLAGS = 0x04 | 0x08          # PL_Q_NODEBUG | PL_Q_CATCH_EXCEPTION
+PL_VERSION_SYSTEM = 1
 
-_T = c_size_t                   # term_t, atom_t, functor_t, fid_t, qid_t: uintptr_t
-_QUICK = {  # name: (result, arguments) of the calls that keep the GIL
-    "PL_new_term_refs": (_T, c_size_t), "PL_new_term_ref": (_T,),
-    "PL_put_int64": (c_int, _T, c_int64), "PL_put_float": (c_int, _T, c_double),
-    "PL_put_nil": (c_int, _T), "PL_put_variable": (c_int, _T), "PL_put_term": (c_int, _T, _T),
-    "PL_put_atom": (c_int, _T, _T), "PL_cons_list": (c_int, _T, _T, _T),
-    "PL_cons_functor_v": (c_int, _T, _T, _T),
-    "PL_new_atom_mbchars": (_T, c_int, c_size_t, c_char_p), "PL_unregister_atom": (None, _T),
-    "PL_new_functor_sz": (_T, _T, c_size_t), "PL_chars_to_term": (c_int, c_char_p, _T),
-    "PL_term_type": (c_int, _T),
-    "PL_get_nchars": (c_int, _T, POINTER(c_size_t), POINTER(c_char_p), c_uint),
-    "PL_get_int64": (c_int, _T, POINTER(c_int64)), "PL_get_float": (c_int, _T, POINTER(c_double)),
-    "PL_get_name_arity_sz": (c_int, _T, POINTER(_T), POINTER(c_size_t)),
-    "PL_atom_mbchars": (c_int, _T, POINTER(c_size_t), POINTER(c_char_p), c_uint),
-    "PL_get_arg_sz": (c_int, c_size_t, _T, _T), "PL_get_list": (c_int, _T, _T, _T),
-    "PL_predicate": (c_void_p, c_char_p, c_int, c_char_p),
-    "PL_open_foreign_frame": (_T,), "PL_discard_foreign_frame": (None, _T),
-    "PL_exception": (_T, _T), "PL_clear_exception": (None,),
-    "PL_record": (c_void_p, _T), "PL_recorded": (c_int, c_void_p, _T), "PL_erase": (None, c_void_p),
-    "PL_mark_string_buffers": (None, POINTER(c_size_t)),
-    "PL_release_string_buffers_from_mark": (None, c_size_t),
-    "PL_thread_raise": (c_int, c_int, c_int), "PL_thread_self": (c_int,),
+#: Every foreign function relrl calls, the one table of their signatures: name: (result,
+#: arguments), in kinds of SWI-Prolog.h's C types. Both the ctypes calls (:class:`Lib`, by
+#: :data:`CTYPES`) and the compiled step (:mod:`relrl.bridge.stepkernel`, by its own map
+#: of the kinds) are built from it. Kinds: ``term`` (term_t, atom_t, functor_t, fid_t: an
+#: uintptr_t handle), ``handle`` (module_t, predicate_t, qid_t, record_t: a pointer),
+#: ``int``, ``uint``, ``int64``, ``double``, ``size``, ``text`` (char *); ``K*`` a pointer
+#: to a K; None for void.
+FOREIGN: dict[str, tuple[str | None, ...]] = {
+    "PL_new_term_refs": ("term", "size"), "PL_new_term_ref": ("term",),
+    "PL_put_int64": ("int", "term", "int64"), "PL_put_float": ("int", "term", "double"),
+    "PL_put_nil": ("int", "term"), "PL_put_variable": ("int", "term"),
+    "PL_put_term": ("int", "term", "term"), "PL_put_atom": ("int", "term", "term"),
+    "PL_cons_list": ("int", "term", "term", "term"),
+    "PL_cons_functor_v": ("int", "term", "term", "term"),
+    "PL_new_atom_mbchars": ("term", "int", "size", "text"), "PL_unregister_atom": (None, "term"),
+    "PL_new_functor_sz": ("term", "term", "size"), "PL_chars_to_term": ("int", "text", "term"),
+    "PL_term_type": ("int", "term"),
+    "PL_get_nchars": ("int", "term", "size*", "text*", "uint"),
+    "PL_get_int64": ("int", "term", "int64*"), "PL_get_float": ("int", "term", "double*"),
+    "PL_get_atom": ("int", "term", "term*"), "PL_get_nil": ("int", "term"),
+    "PL_get_name_arity_sz": ("int", "term", "term*", "size*"),
+    "PL_atom_mbchars": ("int", "term", "size*", "text*", "uint"),
+    "PL_get_arg_sz": ("int", "size", "term", "term"),
+    "PL_get_list": ("int", "term", "term", "term"),
+    "PL_predicate": ("handle", "text", "int", "text"),
+    "PL_open_foreign_frame": ("term",), "PL_discard_foreign_frame": (None, "term"),
+    "PL_exception": ("term", "term"), "PL_clear_exception": (None,),
+    "PL_record": ("handle", "term"), "PL_recorded": ("int", "handle", "term"),
+    "PL_erase": (None, "handle"),
+    "PL_mark_string_buffers": (None, "size*"),
+    "PL_release_string_buffers_from_mark": (None, "size"),
+    "PL_thread_raise": ("int", "int", "int"), "PL_thread_self": ("int",),
+    "PL_version_info": ("uint", "int"),
+    "PL_call_predicate": ("int", "handle", "int", "handle", "term"),
+    "PL_open_query": ("handle", "handle", "int", "handle", "term"),
+    "PL_next_solution": ("int", "handle"), "PL_close_query": ("int", "handle"),
+    "PL_handle_signals": ("int",),
 }
-_RUNS_PROLOG = {  # the calls that release the GIL: they run goals
-    "PL_call_predicate": (c_int, c_void_p, c_int, c_void_p, _T),
-    "PL_open_query": (c_void_p, c_void_p, c_int, c_void_p, _T),
-    "PL_next_solution": (c_int, c_void_p), "PL_close_query": (c_int, c_void_p),
-    "PL_handle_signals": (c_int,),
+#: The functions of :data:`FOREIGN` that run Prolog goals: called with the GIL released (the
+#: others keep it: they take microseconds, and handing the GIL over would let a busy thread
+#: take it each time).
+RUNS_PROLOG = frozenset({"PL_call_predicate", "PL_open_query", "PL_next_solution",
+                         "PL_close_query", "PL_handle_signals"})
+
+_T = c_size_t
+#: :data:`FOREIGN`'s kinds as ctypes types.
+CTYPES: dict[str | None, Any] = {
+    None: None, "term": _T, "handle": c_void_p, "int": c_int, "uint": c_uint,
+    "int64": c_int64, "double": c_double, "size": c_size_t, "text": c_char_p,
+    "term*": POINTER(_T), "size*": POINTER(c_size_t), "int64*": POINTER(c_int64),
+    "double*": POINTER(c_double), "text*": POINTER(c_char_p),
 }
+
+
+def check_version(version: int, path: str) -> None:
+    """Refuse a libswipl (``version`` as ``PL_version_info`` gives it, 90004 for 9.0.4) of
+    another major version than the one the bridge's constants were taken from.
+
+    Raises:
+        PrologMissing: ``version`` is not SWI-Prolog :data:`BUILT_FOR`'s.
+    """
+    if version // 10000 != BUILT_FOR:
+        found = f"{version // 10000}.{version // 100 % 100}.{version % 100}"
+        raise PrologMissing(f"SWI-Prolog {found} ({path}): relrl's bridge is built for "
+                            f"SWI-Prolog {BUILT_FOR} (its foreign interface's constants); "
+                            f"install SWI-Prolog {BUILT_FOR} or point LIBSWIPL_PATH and "
+                            "SWI_HOME_DIR at one")
 
 
 class Lib:
@@ -93,11 +138,10 @@ class Lib:
         self.thread = threading.get_ident()
         self.segv: ctypes.Array[ctypes.c_char] | None = None
         quick = ctypes.PyDLL(path, handle=cdll._handle)
-        for table, view in ((_QUICK, quick), (_RUNS_PROLOG, cdll)):
-            for name, (restype, *argtypes) in table.items():
-                f = getattr(view, name)
-                f.restype, f.argtypes = restype, argtypes
-                setattr(self, name[3:], f)
+        for name, (result, *arguments) in FOREIGN.items():
+            f = getattr(cdll if name in RUNS_PROLOG else quick, name)
+            f.restype, f.argtypes = CTYPES[result], [CTYPES[a] for a in arguments]
+            setattr(self, name[3:], f)
 
     def keep_c_stack_guard(self) -> None:
         """Put SWI-Prolog's C-stack guard back in SIGSEGV if a library installed another
@@ -144,6 +188,7 @@ def start(boot: Callable[[Lib], None]) -> Lib:
                     f"--stack-limit={STACK_LIMIT}".encode()]
             cdll.PL_initialise.argtypes = [c_int, POINTER(c_char_p)]
             lib = Lib(cdll, path)
+            check_version(lib.version_info(PL_VERSION_SYSTEM), path)
             with _python_signals():
                 if not cdll.PL_initialise(len(argv), (c_char_p * len(argv))(*argv)):
                     raise PrologMissing(f"SWI-Prolog ({path}) did not start")

@@ -26,8 +26,8 @@ import functools
 from collections.abc import Mapping
 from typing import Any, TypeVar
 
-from relrl.bridge.calls import prolog
 from relrl.errors import ConfigError, PrologError, RelrlError
+from relrl.kb import layer_api
 from relrl.learners.base import DOMAINS, FAMILIES, WORLDS, Learner, LearnerSpec, Parameter
 from relrl.terms import Term, Var, format_term
 
@@ -69,7 +69,7 @@ def catalogue() -> list[Term]:
         ConfigError: a learner's declarations are wrong (names the learner and what).
     """
     try:
-        out = prolog().api("learners", Var(), timeout=_TIMEOUT)
+        out = layer_api("learners", Var(), timeout=_TIMEOUT)
     except PrologError as exc:
         formal = exc.term[1] if isinstance(exc.term, tuple) and exc.term[0] == "error" \
             else exc.term

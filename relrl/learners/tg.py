@@ -23,31 +23,13 @@ __all__ = ["TGLearner", "explanation"]
 class TGLearner(Learner):
     """A first-order Q-tree; choices, updates and splits run in Prolog (one call a step).
 
-    Its parameters are declared beside its hooks in prolog/tg.pl, with their defaults in
-    the domains and in worlds (chosen by measurement, see docs/tg.md): alpha (0: a leaf's
-    Q is the mean of its Q-targets; otherwise the step size is max(1/n, alpha)), gamma,
-    temperature (> 0: Boltzmann exploration, P(a) proportional to exp(Q(s, a) / T), while
-    learning and in the behaviour evaluation), epsilon (used only with temperature 0:
-    epsilon-greedy), q_init (Q of the first, empty leaf), significance (of the F-test of
-    the best of a leaf's candidates, Bonferroni-corrected for their number; the leaves keep
-    the statistics of the TD errors), min_examples (a split must leave at least this many
-    examples on each side), stale_bonus (while learning, a leaf no example has reached for
-    the last k examples counts Q + stale_bonus * sqrt(k): Dyna-Q+'s exploration bonus, per
-    leaf; 0 turns it off), half_life (an example counts half in the split statistics once
-    this many more examples have been inserted; 0: never forget), novelty_bonus and
-    novelty_confidence (directed exploration while learning: Q(s, a) counts as Q + the
-    largest upper confidence bound, mean TD error + novelty_confidence standard errors, of
-    the regions (s, a) falls in — its leaf and the yes-side of each candidate test of the
-    leaf that succeeds on it — capped at novelty_bonus, which is also the bound of a region
-    fewer than two examples reached; novelty_bonus 0 turns it off), keep_examples (each
-    leaf keeps its last examples so that a split's children start with statistics; 0: they
-    start empty), action_gap (advantage learning: each Q-target is lowered by action_gap
-    times the gap between the best Q of the example's state and the example's own Q, so
-    that a leaf's value ranks moves within a state rather than states; 0 in the domains,
-    0.5 in worlds). Explore and greedy choices and the Q-targets never include the bonuses.
-    Choices are over classes of responses no test of the bias tells apart in the state
-    (scored by one representative, uniform within a class). This class reads its
-    explanations.
+    Its parameters, their defaults and the worlds' defaults are declared once, beside its
+    hooks in prolog/tg.pl (``learner_parameter/4`` and ``learner_serves/3``, read by
+    :func:`relrl.learners.learner_spec`); docs/tg.md's table says what each does (a test
+    holds the table to the declarations). Explore and greedy choices and the Q-targets
+    never include the exploration bonuses. Choices are over classes of responses no test
+    of the bias tells apart in the state (scored by one representative, uniform within a
+    class). This class reads its explanations.
     """
 
     name = "tg"

@@ -18,12 +18,30 @@ from __future__ import annotations
 
 import textwrap
 from dataclasses import fields
-from typing import TYPE_CHECKING
+from typing import Any, Protocol
 
-if TYPE_CHECKING:
-    from relrl.sim.world import World
+from relrl.sim.places import Layout
 
-__all__ = ["domain_text"]
+__all__ = ["domain_text", "DomainWorld"]
+
+
+class DomainWorld(Protocol):
+    """What the template reads of a world (:class:`relrl.sim.world.World`, a dataclass whose
+    default is the paper's world; the world module imports this one, not the reverse)."""
+
+    __dataclass_fields__: dict[str, Any]
+    toys: int
+    scene: bool
+    field: float
+
+    @property
+    def layout(self) -> Layout: ...
+    @property
+    def colour_names(self) -> tuple[str, ...]: ...
+    @property
+    def kind_names(self) -> tuple[str, ...]: ...
+    @property
+    def name(self) -> str: ...
 
 
 _RULE = "-" * 88
@@ -46,8 +64,8 @@ def _section(title: str) -> str:
     return f"% ---- {title} {_RULE[:_WIDTH - 8 - len(title)]}\n"
 
 
-def _args(world: World) -> str:
-    default = type(world)()
+def _args(world: DomainWorld) -> str:
+    default = type(world)()  # type: ignore[call-arg]
     changed = [f"{f.name}={getattr(world, f.name)!r}" for f in fields(world)
                if getattr(world, f.name) != getattr(default, f.name)]
     return ", ".join(changed)
@@ -58,7 +76,7 @@ def _listing(names: tuple[str, ...], limit: int = 8) -> str:
         f"{', '.join(names[:3])}, ..., {', '.join(names[-2:])}"
 
 
-def domain_text(world: World) -> str:
+def domain_text(world: DomainWorld) -> str:
     """The domain file of ``world`` (Prolog source text)."""
     lay = world.layout
     places, toy_places = lay.places, lay.toy_places
@@ -121,7 +139,7 @@ def domain_text(world: World) -> str:
     return "".join(out)
 
 
-def _relational(world: World) -> str:
+def _relational(world: DomainWorld) -> str:
     """The relational view and language bias sections (the syntax of docs/tg.md)."""
     lay = world.layout
     kinds = world.kind_names

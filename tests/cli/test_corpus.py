@@ -358,6 +358,7 @@ CASES: list[tuple[str, list[str], list[str]]] = [
 
 
 @pytest.mark.parametrize("argv, needles", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+@pytest.mark.slow
 def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, needles):
     monkeypatch.setattr(sys, "stdin", io.StringIO(""))  # nothing typed, nothing jogged
     argv = [a.format(d=corpus, fruits=FRUITS) for a in argv]

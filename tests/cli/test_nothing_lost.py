@@ -81,6 +81,7 @@ def test_a_lost_serial_port_keeps_the_summary_and_the_policy(capsys, tmp_path, p
     assert pty.port in summary["error"] and f"time unit {summary['steps']} of 100000" in line
 
 
+@pytest.mark.slow
 def test_a_deleted_camera_folder_keeps_the_summary_and_the_policy(capsys, tmp_path):
     import cv2
 
@@ -168,6 +169,7 @@ def test_a_second_ctrl_c_still_writes_what_was_learned(tmp_path):
 
 
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+@pytest.mark.slow
 def test_a_signal_stops_after_the_time_unit_with_everything_written(tmp_path, signum):
     (tmp_path / "long.toml").write_text(LONG)
     out = tmp_path / "out"
@@ -246,6 +248,7 @@ def _no_leftovers(out: Path) -> None:
 
 
 @pytest.mark.parametrize("gap", [0.0, 0.05])
+@pytest.mark.slow
 def test_two_ctrl_c_in_a_row_keep_the_summary_timing_and_policy(tmp_path, gap):
     """Real SIGINTs to a real ``relrl run``: the second comes while the first one's outputs
     are being written, and waits for them."""
@@ -277,6 +280,7 @@ def _read_all(fd: int, into: list[bytes]) -> None:
         into.append(chunk)
 
 
+@pytest.mark.slow
 def test_sighup_stops_an_experiment_keeping_every_finished_point(tmp_path):
     """The terminal closed (a real SIGHUP): the experiment stops like on Ctrl-C, writing
     the points that finished, marked partial; exit 128 + 1."""
@@ -333,6 +337,7 @@ def _on_a_small_disk(tmp_path: Path, argv: list[str], size: str = "200k"
 
 @pytest.mark.parametrize("flags", [[], ["--record", "--camera", "synthetic://?size=160x120",
                                         "--record-rate", "0"]], ids=["trace", "frames"])
+@pytest.mark.slow
 def test_a_full_disk_ends_in_one_line_with_what_fits_written(tmp_path, flags):
     """A real 200 KB tmpfs fills up: one line, exit 2, the summary and the policy written in
     the space held back, the record says partial, no temporary file anywhere."""
@@ -351,6 +356,7 @@ def test_a_full_disk_ends_in_one_line_with_what_fits_written(tmp_path, flags):
     _no_leftovers(out)
 
 
+@pytest.mark.slow
 def test_an_experiment_on_a_full_disk_keeps_its_results(tmp_path):
     """The figures do not fit: results.json does (one line, exit 2, the record partial)."""
     proc, copy = _on_a_small_disk(tmp_path, [

@@ -76,6 +76,7 @@ def _relrl(*argv: str) -> subprocess.Popen:
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
+@pytest.mark.slow
 def test_overwrite_after_kill_9_keeps_a_file_added_after_the_crash(tmp_path):
     """The killed run's journal names what it wrote: NOTES.txt, added after the crash, and
     draft.tex, there before the run, are kept; the killed run's files are replaced."""
@@ -159,6 +160,7 @@ def _wait_for(path: Path, timeout: float = 60) -> None:
         time.sleep(0.005)
 
 
+@pytest.mark.slow
 def test_a_second_command_on_a_folder_in_use_is_refused(capsys, tmp_path):
     """One command per folder: an experiment cannot start in the folder of a running one
     (whose folder holds only its record), nor can --overwrite take it from under it."""
@@ -227,6 +229,7 @@ def test_experiment_writes_a_fresh_timestamped_folder_by_default(capsys, tmp_pat
     assert all(f"files to {f.relative_to(tmp_path)}/:" in out for f in folders)
 
 
+@pytest.mark.slow
 def test_run_outputs_are_0644_and_the_policy_may_go_in_a_subfolder(tmp_path, umask_022):
     script = tmp_path / "e.toml"
     script.write_text(episode_text(head='policy_save = "policies/etg/p.pl"'))

@@ -47,6 +47,7 @@ def _learning(tmp_path: Path, text: str, name: str) -> tuple[list[dict], bytes, 
 
 @pytest.mark.parametrize("time_unit", TIME_UNITS)
 @pytest.mark.parametrize("learner", learners(DOMAINS))
+@pytest.mark.slow
 def test_learning_is_identical_whatever_the_evaluation_interval(tmp_path, learner,
                                                                 time_unit) -> None:
     base = script(PHASES, learner=learner, time_unit=time_unit)
@@ -63,6 +64,7 @@ def test_learning_is_identical_whatever_the_evaluation_interval(tmp_path, learne
     assert [p["units"] for p in got["every3"][2]["evaluation"]] == [0, 3, 6, 9, 12, 15, 18]
 
 
+@pytest.mark.slow
 def test_learning_is_identical_on_rendered_frames(tmp_path) -> None:
     body = ('[[phase]]\nname = "no objects"\nsteps = 3\nobjects = false\n'
             '[[phase]]\nname = "fruits"\nsteps = 5\n')
@@ -198,6 +200,7 @@ def test_symbolic_run_without_features_says_so(tmp_path) -> None:
     assert all(e["missed"] > 0 for e in s["table1"]["executions"])
 
 
+@pytest.mark.slow
 def test_sweep_writes_tables_and_plots(tmp_path) -> None:
     from relrl.experiments.exp2 import main
 

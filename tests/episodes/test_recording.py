@@ -44,6 +44,7 @@ def test_frames_round_trip_through_jpeg(tmp_path: Path) -> None:
         assert err < 3 and psnr > 30, (err, psnr)
 
 
+@pytest.mark.slow
 def test_the_rate_limits_recorded_frames(tmp_path: Path) -> None:
     """--record-rate 1 on a session far shorter than a second: one frame."""
     script = episode(tmp_path, steps=30)
@@ -56,6 +57,7 @@ def test_the_rate_limits_recorded_frames(tmp_path: Path) -> None:
     assert sum(1 for r in rec.rows if r.get("frame")) == len(rec.frames)
 
 
+@pytest.mark.slow
 def test_recorded_frames_are_perceived_again(tmp_path: Path) -> None:
     script = episode(tmp_path, steps=40)
     out = tmp_path / "rec"
@@ -97,6 +99,7 @@ def test_not_a_recording_is_a_clear_error(tmp_path: Path) -> None:
     assert main(["replay", str(tmp_path)]) == 2
 
 
+@pytest.mark.slow
 def test_device_runs_label_simulated_evaluations(tmp_path: Path, capsys) -> None:
     script = episode(tmp_path, steps=20, extra="[evaluation]\nevery = 10\nruns = 1\n"
                                                "steps = 10\n")

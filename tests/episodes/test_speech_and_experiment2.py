@@ -37,6 +37,7 @@ def test_speaker_prints_without_espeak(capsys) -> None:
     assert 'robot says: "this is an apple"' in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_experiment2_small_on_rendered_frames(tmp_path: Path) -> None:
     text = (ROOT / "examples" / "episodes" / "experiment2.toml").read_text()
     text = text.replace('"../domains/fruits.pl"', f'"{ROOT / "examples/domains/fruits.pl"}"')

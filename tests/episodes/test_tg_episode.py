@@ -6,7 +6,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from relrl.episodes import RunOptions, parse_episode, run_episode
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 ROOT = Path(__file__).resolve().parents[2]
 FRUITS = ROOT / "examples" / "domains" / "fruits.pl"

@@ -11,6 +11,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from relrl.cli import main
 from relrl.episodes import EpisodeWorld, RunOptions, StopRequest, parse_episode, run_episode
 
@@ -94,6 +96,7 @@ remove = "all"
     assert info["scene"]["objects"] == {}
 
 
+@pytest.mark.slow
 def test_run_writes_trace_summary_policy_and_is_deterministic(tmp_path: Path) -> None:
     ep = parse_episode(PROTOCOL, tmp_path / "p.toml")
     a = run_episode(ep, RunOptions(out=tmp_path / "a", plots=False))
@@ -138,6 +141,7 @@ def test_stop_request_ends_cleanly(tmp_path: Path) -> None:
     assert json.loads((tmp_path / "summary.json").read_text())["steps"] == 7
 
 
+@pytest.mark.slow
 def test_ctrl_c_in_a_real_process(tmp_path: Path) -> None:
     path = tmp_path / "long.toml"
     path.write_text(script('[caregiver]\ncontact_hold = 1\n[[phase]]\nsteps = 100000\n'))

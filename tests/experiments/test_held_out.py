@@ -16,6 +16,7 @@ from relrl.experiments.sis import SISConfig, run_job
 SMALL = ["--points", "1", "--eval-runs", "2", "--eval-steps", "150", "--block", "300"]
 
 
+@pytest.mark.slow
 def test_held_out_places_reported_apart(tmp_path: Path, capsys) -> None:
     out = tmp_path / "held"
     assert main(["experiment", "sis", *SMALL, "--learners", "tg,qlearning", "--out", str(out),
@@ -35,6 +36,7 @@ def test_held_out_places_reported_apart(tmp_path: Path, capsys) -> None:
     assert (out / "cgi_places.png").stat().st_size > 1000
 
 
+@pytest.mark.slow
 def test_tg_learns_gaze_following_in_the_simulator() -> None:
     """Issue 10's first-run target on the default task (attention once per opportunity, at
     eye contact): CGI >= 0.9 after the first 500 learning units, with a small tree."""

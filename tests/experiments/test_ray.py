@@ -12,6 +12,8 @@ from relrl.cli import main
 from relrl.experiments.runner import run_jobs
 from tests.experiments import jobs
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 
 @pytest.fixture(scope="module")
 def local_ray():

@@ -24,6 +24,7 @@ def _summary(points: int = 5) -> dict:
 
 
 @pytest.mark.parametrize("points", [2, 5, 21])
+@pytest.mark.slow
 def test_fig5_legend_covers_no_curve_and_runs_are_whole(points: int) -> None:
     import matplotlib
 
@@ -42,6 +43,7 @@ def test_fig5_legend_covers_no_curve_and_runs_are_whole(points: int) -> None:
     plt.close(fig)
 
 
+@pytest.mark.slow
 def test_the_figures_are_written(tmp_path: Path) -> None:
     files = plot(tmp_path, _summary())
     assert [f.name for f in files] == ["fig5_cgi.png", "fig4_eye_contacts.png"]

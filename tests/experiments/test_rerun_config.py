@@ -37,6 +37,7 @@ def _record(tmp_path: Path, config, experiment: str = "sis", name: str = "r.json
     return path
 
 
+@pytest.mark.slow
 def test_sis_run_again_gives_the_same_results_byte_for_byte(tmp_path: Path) -> None:
     a, b, c = tmp_path / "a", tmp_path / "b", tmp_path / "c"
     assert main(["experiment", "sis", *SIS, "--workers", "1", "--out", str(a)]) == 0
@@ -47,6 +48,7 @@ def test_sis_run_again_gives_the_same_results_byte_for_byte(tmp_path: Path) -> N
     assert (c / "results.json").read_bytes() == (a / "results.json").read_bytes()
 
 
+@pytest.mark.slow
 def test_scaling_run_again_gives_the_same_results_byte_for_byte(tmp_path: Path) -> None:
     a, b = tmp_path / "a", tmp_path / "b"
     assert main(["experiment", "scaling", *SCALING, "--workers", "1", "--out", str(a)]) == 0
@@ -67,6 +69,7 @@ SIS_CONFIGS = [
 
 
 @pytest.mark.parametrize("config", SIS_CONFIGS, ids=["fixed", "preset", "places-params"])
+@pytest.mark.slow
 def test_a_recorded_sis_configuration_comes_back_field_for_field(tmp_path, config) -> None:
     assert _config("sis", "--config", str(_record(tmp_path, config))).to_dict() == \
         config.to_dict()

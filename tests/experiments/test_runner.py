@@ -10,6 +10,7 @@ from tests.experiments import jobs
 
 
 @pytest.mark.parametrize("workers", [1, 2])
+@pytest.mark.slow
 def test_results_in_order_with_their_events(workers: int) -> None:
     seen = []
     out = run_jobs(jobs.square, [(x,) for x in range(5)], workers=workers, units=3,
@@ -21,6 +22,7 @@ def test_results_in_order_with_their_events(workers: int) -> None:
     assert len({r["pid"] for r in out.results}) == workers      # jobs ran in the workers
 
 
+@pytest.mark.slow
 def test_a_relrl_error_in_a_job_stops_the_run_keeping_what_finished() -> None:
     out = run_jobs(jobs.bad_value, [(1,)])
     assert out.error == "x=1: not a good value" and out.results == [None]
@@ -29,11 +31,13 @@ def test_a_relrl_error_in_a_job_stops_the_run_keeping_what_finished() -> None:
     assert mixed.error == "x=2: not a good value" and not mixed.complete
 
 
+@pytest.mark.slow
 def test_a_bug_in_a_job_keeps_its_traceback() -> None:
     with pytest.raises(JobCrashed, match=r"(?s)IndexError.*Traceback.*tests/experiments/jobs"):
         run_jobs(jobs.bug, [(0,), (5,)], workers=2)
 
 
+@pytest.mark.slow
 def test_a_worker_that_vanishes_stops_the_run_naming_the_job() -> None:
     out = run_jobs(jobs.vanish, [(7,)])
     assert "running (7,) ended without a result (exit status 3)" in out.error

@@ -16,6 +16,7 @@ TINY = ["--learners", "qlearning,etg", "--sizes", "5,9", "--seeds", "0", "--budg
         "--block", "500", "--eval-runs", "2", "--eval-steps", "100", "--transfer-sizes", "5"]
 
 
+@pytest.mark.slow
 def test_outputs_and_same_seeds_same_results(tmp_path: Path, capsys) -> None:
     a, b = tmp_path / "a", tmp_path / "b"
     assert main(["experiment", "scaling", *TINY, "--workers", "1", "--out", str(a)]) == 0
@@ -43,6 +44,7 @@ def test_outputs_and_same_seeds_same_results(tmp_path: Path, capsys) -> None:
     assert len(speed) == 6 and all(float(r["learning_steps_per_second"]) > 0 for r in speed)
 
 
+@pytest.mark.slow
 def test_time_to_threshold_is_the_first_evaluation_that_reaches_it() -> None:
     cfg = ScalingConfig(learners=["qlearning"], sizes=[5], seeds=[0], budget=3000, block=500,
                         eval_runs=2, eval_steps=150, threshold=0.5, patience=0)
@@ -64,6 +66,7 @@ def test_held_out_places_are_spread_and_leave_some_to_learn(n: int) -> None:
     assert held_out_places(layout(5).toy_places, 0.4) == ("left_down", "right_down")
 
 
+@pytest.mark.slow
 def test_a_transfer_job_never_sees_a_toy_at_the_held_out_places() -> None:
     cfg = ScalingConfig(learners=["etg"], sizes=[9], seeds=[1], budget=1000, block=500,
                         eval_runs=2, eval_steps=100, transfer_sizes=[9])
@@ -93,6 +96,7 @@ def test_kinds_transfer_holds_out_toy_kinds(tmp_path: Path) -> None:
     assert job["transfer"]["trained"] == ["ball", "car"]
 
 
+@pytest.mark.slow
 def test_sizes_transfer_acts_in_larger_worlds_with_no_learning(tmp_path: Path,
                                                               capsys) -> None:
     """tg learns at P = 5 and its policy, which names no place, acts at P = 9 and 33; ETG's

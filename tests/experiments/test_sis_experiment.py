@@ -16,6 +16,7 @@ from relrl.experiments.sis import SISConfig, run_job
 SMALL = ["--points", "2", "--eval-runs", "2", "--eval-steps", "100", "--block", "300"]
 
 
+@pytest.mark.slow
 def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
     a, b = tmp_path / "a", tmp_path / "b"
     assert main(["experiment", "sis", *SMALL, "--out", str(a), "--workers", "1"]) == 0
@@ -43,6 +44,7 @@ def test_outputs_and_same_seed_same_results(tmp_path: Path, capsys) -> None:
     assert len(lines) == 1 + 4 * 3
 
 
+@pytest.mark.slow
 def test_another_seed_other_numbers(tmp_path: Path) -> None:
     cfg = SISConfig(learners=["etg"], points=1, eval_runs=2, eval_steps=100, block=300)
     r0, r1 = run_job(cfg, "etg", 0), run_job(cfg, "etg", 1)
@@ -51,6 +53,7 @@ def test_another_seed_other_numbers(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("learner", ["etg", "qlearning"])
+@pytest.mark.slow
 def test_learning_improves_gaze_following(learner: str) -> None:
     cfg = SISConfig(learners=[learner], points=2, eval_runs=3, eval_steps=300, block=1000)
     result = run_job(cfg, learner, 0)
@@ -84,6 +87,7 @@ def test_bad_options_one_line_exit_2(args: list[str], message: str, tmp_path: Pa
     assert len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_held_out_places_are_reported_apart(tmp_path: Path, capsys) -> None:
     out = tmp_path / "held"
     assert main(["experiment", "sis", "--learners", "qlearning", *SMALL, "--train-places",
@@ -111,6 +115,7 @@ def test_bad_place_options_one_line_exit_2(args, message, tmp_path: Path, capsys
     assert message in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_preset_paper_2012_is_recorded_in_results(tmp_path: Path, capsys) -> None:
     out = tmp_path / "p"
     assert main(["experiment", "sis", "--preset", "paper-2012", "--learners", "contingency,etg",

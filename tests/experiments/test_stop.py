@@ -19,6 +19,8 @@ import pytest
 
 from relrl.cli import main
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 ROOT = Path(__file__).resolve().parents[2]
 SIS = ROOT / "examples" / "domains" / "sis.pl"
 LONG = ["--seeds", "0", "--learners", "qlearning,etg", "--points", "100000", "--eval-runs", "2",

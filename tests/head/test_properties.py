@@ -12,6 +12,7 @@ import math
 import tempfile
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -22,6 +23,8 @@ from head.protocols import get_protocol
 from head.scripts import MotorScript, Step
 from head.serial_head import SerialHead
 from head.sim import SimHead
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 PROFILE = settings(max_examples=150, deadline=None,
                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])

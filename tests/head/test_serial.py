@@ -67,6 +67,7 @@ def test_positions_are_read_back_from_the_controller(fast_cal):
         assert "position 0" in fake.queries
 
 
+@pytest.mark.slow
 def test_ssc32_reports_moving_then_done(fast_cal):
     fake = FakeController("ssc32", limits=_limits(fast_cal))
     # generous timeouts: the fake answers from a thread, and CI machines are busy

@@ -2,7 +2,11 @@
 
 from __future__ import annotations
 
+import pytest
+
 from relrl.monitor.bench import bench_monitor
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def test_bench_monitor_reports_both_rates() -> None:

@@ -141,6 +141,7 @@ def live_server():
 
 @pytest.mark.parametrize("path, status", [c[1:] for c in LIVE_CASES],
                          ids=[c[0] for c in LIVE_CASES])
+@pytest.mark.slow
 def test_a_live_session_answers_without_a_500(live_server, capfd, path, status) -> None:
     got, headers, body = _get(live_server.port, path)
     assert got == status, (got, body[:300])
@@ -278,6 +279,7 @@ def test_a_websocket_to_the_monitor_is_refused(live_server) -> None:
         assert not sock.recv(200).startswith(b"HTTP/1.1 101")
 
 
+@pytest.mark.slow
 def test_the_xss_label_does_not_run_in_a_browser(page, tmp_path) -> None:
     """The issue's exploit: a branch label of HTML-like form became a javascript: link in
     /tree.svg, and clicking it in Chromium ran script. Now the label is text, and the SVG's
@@ -301,6 +303,7 @@ def test_the_xss_label_does_not_run_in_a_browser(page, tmp_path) -> None:
 
 
 
+@pytest.mark.slow
 def test_the_pictures_policy_alone_stops_a_link_script(page, tmp_path, monkeypatch) -> None:
     """The second line of defence: with the labels' escaping taken away, the link is in the
     SVG -- and the SVG's content-security policy (a sandbox, no script) stops it."""
@@ -318,6 +321,7 @@ def test_the_pictures_policy_alone_stops_a_link_script(page, tmp_path, monkeypat
 
 
 
+@pytest.mark.slow
 def test_the_pages_copy_of_the_tree_holds_no_link(page, tmp_path, monkeypatch) -> None:
     """The page draws the tree inside itself: with the labels' escaping taken away, the
     link reaches /api/tree's SVG -- and the page copies only drawing elements and their

@@ -7,7 +7,11 @@ from __future__ import annotations
 import signal
 from pathlib import Path
 
+import pytest
+
 from tests.monitor.conftest import episode, screen, wait_until
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def _attr(page, selector: str, name: str) -> int:

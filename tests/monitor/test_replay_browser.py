@@ -43,6 +43,7 @@ def _scrub(page, t: int) -> None:
         s.dispatchEvent(new Event('input')); }}""")
 
 
+@pytest.mark.slow
 def test_scrubbing_shows_each_time_unit(page, recorded: Path, tmp_path: Path) -> None:
     rec = open_recording(recorded)  # its session.mcap
     with start_replay(recorded) as server:
@@ -93,6 +94,7 @@ def _view_box(page) -> list[float]:
     return [float(x) for x in page.get_attribute("#tree svg", "viewBox").split()]
 
 
+@pytest.mark.slow
 def test_replay_opens_paused_and_says_so(page, recorded: Path, tmp_path: Path) -> None:
     with start_replay(recorded) as server:
         page.goto(server.url)
@@ -119,6 +121,7 @@ def test_replay_opens_paused_and_says_so(page, recorded: Path, tmp_path: Path) -
     assert not page.errors, page.errors
 
 
+@pytest.mark.slow
 def test_replay_marks_the_leaf_and_its_path(page, recorded: Path) -> None:
     rec = open_recording(recorded)
     with start_replay(recorded) as server:
@@ -147,6 +150,7 @@ def test_replay_marks_the_leaf_and_its_path(page, recorded: Path) -> None:
     assert not page.errors, page.errors
 
 
+@pytest.mark.slow
 def test_the_tree_pans_zooms_and_fits(page, recorded: Path) -> None:
     with start_replay(recorded) as server:
         page.goto(server.url)
@@ -181,6 +185,7 @@ def test_the_tree_pans_zooms_and_fits(page, recorded: Path) -> None:
     assert not page.errors, page.errors
 
 
+@pytest.mark.slow
 def test_the_evaluations_are_a_curve(page, recorded: Path, tmp_path: Path) -> None:
     rec = open_recording(recorded)
     evaluations = [e for e in rec.events if e["kind"] == "evaluation"]

@@ -47,6 +47,7 @@ def _hub() -> Hub:
     return hub
 
 
+@pytest.mark.slow
 def test_every_endpoint_answers_get_and_refuses_writes() -> None:
     with start_live(_hub()) as server:
         for path in PATHS:
@@ -81,6 +82,7 @@ def test_off_localhost_every_request_needs_the_token() -> None:
                         {"Cookie": f"relrl_token={server.token}"})[0] == 200
 
 
+@pytest.mark.slow
 def test_on_localhost_a_foreign_host_header_is_refused() -> None:
     with start_live(_hub()) as server:
         assert server.token is None
@@ -183,6 +185,7 @@ def test_the_hub_hands_over_what_the_session_does() -> None:
         hub.status("dreaming")
 
 
+@pytest.mark.slow
 def test_a_session_tells_the_monitor_each_thing_it_does(tmp_path) -> None:
     """Every status a session sets, in order: from its own state, not guessed."""
     from relrl.episodes import RunOptions, load_episode, run_episode
@@ -207,6 +210,7 @@ def test_a_session_tells_the_monitor_each_thing_it_does(tmp_path) -> None:
                     ("finished", None, None)]
 
 
+@pytest.mark.slow
 def test_a_session_on_a_camera_says_it_waits_for_it(tmp_path) -> None:
     from relrl.episodes import RunOptions, load_episode, run_episode
     from tests.monitor.conftest import episode

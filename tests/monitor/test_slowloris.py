@@ -16,11 +16,15 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from relrl.monitor import start_replay
 from relrl.monitor.replay import Recording, ReplaySource
 from relrl.monitor.server import MonitorServer
 from tests.conftest import default_signals
 from tests.monitor.conftest import ROOT, Slowloris, episode, write_recording
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 #: the session's descriptors: fewer than the attack's connections.
 FD_LIMIT = 256

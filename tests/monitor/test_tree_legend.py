@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import re
 
+import pytest
+
 from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from relrl.loop import Agent, run
@@ -35,6 +37,7 @@ def test_the_etg_legend_says_what_its_leaves_hold() -> None:
     assert any(n["kind"] == "test" for n in graph["nodes"])
 
 
+@pytest.mark.slow
 def test_the_tg_legend_says_what_its_leaves_hold() -> None:
     from tests.relrl.test_tg import trained
 

@@ -124,6 +124,7 @@ def test_the_hand_covers_part_of_the_fruit() -> None:
     assert red[1] < 0.92 * red[0]
 
 
+@pytest.mark.slow
 def test_faces_survive_the_camera() -> None:
     from perception.pipeline import Perceiver
     from perception.vocabulary import POSES
@@ -141,6 +142,7 @@ def test_faces_survive_the_camera() -> None:
     assert right >= 22
 
 
+@pytest.mark.slow
 def test_art2_errs_with_variation_and_not_without() -> None:
     from perception.fruits import table1
 

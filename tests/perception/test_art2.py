@@ -59,6 +59,7 @@ def test_incorrect_guess():
     assert namer.teach(_colour(2), "tomato") == "incorrect_guess"
 
 
+@pytest.mark.slow
 def test_synthetic_fruit_session_mostly_succeeds():
     from perception.fruits import fruit_session
 

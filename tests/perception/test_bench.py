@@ -3,8 +3,12 @@
 import threading
 import time
 
+import pytest
+
 import perception
 from perception.bench import FreeCoresPool
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def test_photo_figures_wall_cpu_and_stages():

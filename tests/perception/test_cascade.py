@@ -49,6 +49,7 @@ def _opencv(classifier, img, scale, neighbours, lo, hi):
 
 
 @pytest.mark.parametrize("name", _FILES)
+@pytest.mark.slow
 def test_same_raw_hits_and_faces_as_opencv(name, images):
     """Raw hits (``minNeighbors=0``) as sets and grouped faces, over random scale steps, size
     ranges (including the single-scale and between-steps cases) and crops."""
@@ -73,6 +74,7 @@ def test_same_raw_hits_and_faces_as_opencv(name, images):
     assert raw_hits > 100 and faces > 5  # the comparison saw real detections
 
 
+@pytest.mark.slow
 def test_bands_of_a_search_add_up_to_the_search(images):
     cascade = Cascade(_DIR / _FILES[1])
     for img in images[:8]:
@@ -83,6 +85,7 @@ def test_bands_of_a_search_add_up_to_the_search(images):
         assert parts == whole
 
 
+@pytest.mark.slow
 def test_threads_search_at_once_with_the_same_results(images):
     cascade = Cascade(_DIR / _FILES[0])
     expected = [cascade.raw(img, 1.15, 20, min(img.shape)) for img in images]
@@ -105,6 +108,7 @@ def test_too_small_an_image_has_no_hits():
     assert cascade.detect(np.full((60, 60), 128, np.uint8), 1.15, 3, 20, 60) == []
 
 
+@pytest.mark.slow
 def test_parse_reads_the_cascade_and_rejects_what_it_cannot_run(tmp_path):
     model = parse_cascade(_DIR / _FILES[1])
     assert (model.width, model.height) == (20, 20)

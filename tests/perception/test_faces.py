@@ -28,6 +28,7 @@ def test_no_face_in_a_blank_or_noisy_frame():
     assert detect_face(rng.integers(0, 256, (240, 320, 3), dtype=np.uint8)) is None
 
 
+@pytest.mark.slow
 def test_lfw_recall_and_no_false_detection():
     # the figures of the full search today (98 / 100 faces, 0 on 100 non-faces): a faster
     # search must not find fewer faces or any non-face
@@ -61,6 +62,7 @@ def test_pan_sign_follows_the_nose():
     assert detect_face(render(SceneView("centre", "left_2", seed=1))).pan < left.pan
 
 
+@pytest.mark.slow
 def test_tracker_searches_near_the_last_face():
     tracker = FaceTracker()
     frames = [render(SceneView("centre", p, seed=k))
@@ -85,6 +87,7 @@ def _lfw_frames(step: int) -> list[np.ndarray]:
             for c in crops]
 
 
+@pytest.mark.slow
 def test_pooled_full_search_finds_the_same_faces(astronaut_bgr):
     from concurrent.futures import ThreadPoolExecutor
 

@@ -81,6 +81,7 @@ def test_annotate_draws_without_changing_the_frame():
     assert np.array_equal(frame, before) and not np.array_equal(out, frame)
 
 
+@pytest.mark.slow
 def test_bench_is_callable_from_the_package():
     import perception
 
@@ -91,6 +92,7 @@ def test_bench_is_callable_from_the_package():
     assert callable(module) and module.bench is not None
 
 
+@pytest.mark.slow
 def test_two_threads_give_the_same_facts():
     from perception.bench import _photos
 

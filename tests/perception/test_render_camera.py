@@ -9,6 +9,7 @@ from perception.errors import CameraError, ImageError, PerceptionError
 from perception.render import SceneView, render
 
 
+@pytest.mark.slow
 def test_render_is_deterministic_and_sized():
     v = SceneView("left", None, {"left": "apple"}, 0.8, seed=4)
     a, b = render(v, (640, 480)), render(v, (640, 480))
@@ -94,6 +95,7 @@ def test_registry_has_every_kind():
     assert isinstance(open_camera("synthetic://"), SyntheticCamera)
 
 
+@pytest.mark.slow
 def test_render_is_the_function_after_importing_sceneview() -> None:
     """Regression: importing SceneView first bound perception.render to the submodule."""
     import subprocess

@@ -46,6 +46,7 @@ def test_every_package_uses_the_one_definition() -> None:
 
 @pytest.mark.parametrize("module", ["head", "perception", "perception.vocabulary",
                                     "head.errors", "perception.errors"])
+@pytest.mark.slow
 def test_lower_layers_stand_alone(module: str) -> None:
     code = (f"import sys, {module}; print(sorted({{m.split('.')[0] for m in sys.modules}} & "
             "{'relrl', 'gymnasium', 'cv2', 'pyswip', 'numpy'}))")
@@ -92,6 +93,7 @@ def test_growing_worlds_build_their_vocabulary() -> None:
     assert not vocab.allows(("at", "toy", "centre"))
 
 
+@pytest.mark.slow
 def test_the_simulator_stays_in_the_sis_vocabulary_and_meets_every_pattern() -> None:
     from relrl.sim import SharedAttentionEnv
 
@@ -109,6 +111,7 @@ def test_the_simulator_stays_in_the_sis_vocabulary_and_meets_every_pattern() -> 
 
 
 @pytest.mark.parametrize("perception", ["symbolic", "render"])
+@pytest.mark.slow
 def test_the_episode_world_stays_in_the_episodes_vocabulary(perception: str) -> None:
     from relrl.episodes import EpisodeWorld, parse_episode
 

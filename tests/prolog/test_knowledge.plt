@@ -123,10 +123,7 @@ test(example_domains_valid, [P1-P2 == []-[]]) :-
 %   way the call ended. (Its time limit is armed and disarmed by the host: see
 %   tests/relrl/test_deadline.py.)
 caller_state(Active) :-
-    (   nb_current(relrl_active, Active0)
-    ->  Active = Active0
-    ;   Active = false                  % before the first call
-    ).
+    relrl_guard:call_context(active, Active).
 
 :- begin_tests(gateway_call).
 
@@ -177,3 +174,24 @@ test(text_rendering_lets_limits_through, [Passed == [time_limit_exceeded,
     \+ relrl_guard:text_failed(error(type_error(text, x), _)).
 
 :- end_tests(gateway_call).
+
+:- begin_tests(call_context).
+
+%   The per-call context is one record: a key set is read back, the others keep their
+%   values, and a key that is not the record's is refused.
+test(one_record, [Got-After == (here:3)-Before]) :-
+    findall(K-V, ( relrl_guard:call_context(K, V), K \== timeout_where ), Before),
+    relrl_guard:call_context(timeout_where, Was),
+    relrl_guard:set_call_context(timeout_where, here:3),
+    relrl_guard:call_context(timeout_where, Got),
+    findall(K-V, ( relrl_guard:call_context(K, V), K \== timeout_where ), After),
+    relrl_guard:set_call_context(timeout_where, Was).
+
+test(unknown_key, [error(domain_error(call_context_key, no_such_key))]) :-
+    relrl_guard:set_call_context(no_such_key, 1).
+
+test(the_eight_keys, [Keys == [active, halt, abort, timeout_where, answer_mode,
+                               answer_again, random_owner, state_touch]]) :-
+    findall(K, relrl_guard:call_context(K, _), Keys).
+
+:- end_tests(call_context).

@@ -86,3 +86,15 @@ test(only_learners_of_worlds_run_episodes,
     relrl_world:world_episodes(KB, episodes(stack, [3], 1, learn, []), _).
 
 :- end_tests(learner_declarations).
+
+:- begin_tests(learner_hooks).
+
+%   learner_hooks/2 compiles a hook that passes its arguments on, as written by hand.
+test(a_hook_passes_its_arguments_on) :-
+    clause(relrl_engine:learner_choose(tg, A, B, C, D, E, F), Body),
+    assertion(Body == relrl_tg:tg_choose(A, B, C, D, E, F)).
+
+test(an_unknown_hook_is_refused, [error(domain_error(learner_hook, nope))]) :-
+    relrl_learner_hooks:hook_clause(x, m, nope-p, _).
+
+:- end_tests(learner_hooks).

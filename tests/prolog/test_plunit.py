@@ -13,6 +13,7 @@ PLT = sorted((ROOT / "tests" / "prolog").glob("*.plt"))
 
 
 @pytest.mark.parametrize("plt", PLT, ids=[p.stem for p in PLT])
+@pytest.mark.slow
 def test_plunit(plt: Path) -> None:
     assert shutil.which("swipl"), "swipl must be installed (make test installs it)"
     proc = subprocess.run(
@@ -23,6 +24,7 @@ def test_plunit(plt: Path) -> None:
     assert "All " in proc.stderr and "tests passed" in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow
 def test_prolog_layer_loads_without_warnings() -> None:
     """The knowledge layer and both example domains load in plain swipl, warning-free."""
     proc = subprocess.run(

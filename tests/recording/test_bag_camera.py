@@ -17,6 +17,8 @@ from perception.errors import CameraError
 from perception.render import SceneView, render
 from relrl.recording.channels import ROS2_MSGDEFS
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

@@ -198,6 +198,7 @@ def test_a_bad_allowed_origin_is_one_line(origin: str) -> None:
         FoxgloveServer("127.0.0.1:0", origins=(origin,))
 
 
+@pytest.mark.slow
 def test_a_stalled_client_never_holds_the_writer() -> None:
     """A client that subscribes to everything and never reads: the session's writes stay
     fast (an append) and the server drops what the client cannot take."""
@@ -252,6 +253,7 @@ def test_bad_address_is_one_line() -> None:
         FoxgloveServer("127.0.0.1:99999")
 
 
+@pytest.mark.slow
 def test_a_live_session_in_foxglove(tmp_path) -> None:
     """relrl run --foxglove: a client subscribes to the camera, its annotations, the
     percepts and the joint states, and decodes each with the advertised schema."""

@@ -27,6 +27,8 @@ from relrl.recording.reader import McapRecording
 from tests.monitor.conftest import episode
 from tests.recording.foxglove_proto import protobuf_decoder
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

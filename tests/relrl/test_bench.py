@@ -5,7 +5,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from relrl.cli import main
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def test_bench_json(tmp_path: Path, capsys) -> None:

@@ -82,6 +82,7 @@ def test_missing_file_exit_2(capsys) -> None:
     assert "nowhere/none.pl: error: no such file" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cli_process_has_no_traceback(write_domain) -> None:
     path = write_domain("stimulus(face).\nresponse(look(left).\n")
     proc = subprocess.run([sys.executable, "-m", "relrl.cli", "check", str(path)],
@@ -105,6 +106,7 @@ def _without_swipl(argv: list[str], tmp_path) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_without_swi_prolog_a_command_that_needs_it_says_so(tmp_path) -> None:
     """No swipl on the PATH (and no LIBSWIPL_PATH): one line saying so, exit 2."""
     proc = _without_swipl(["check", "examples/domains/sis.pl"], tmp_path)
@@ -116,6 +118,7 @@ def test_without_swi_prolog_a_command_that_needs_it_says_so(tmp_path) -> None:
 
 @pytest.mark.parametrize("argv", [["--help"], ["--version"], ["experiment", "worlds", "--help"],
                                   ["head", "--help"], ["report", "--help"]])
+@pytest.mark.slow
 def test_without_swi_prolog_help_and_the_other_commands_work(argv: list[str],
                                                              tmp_path) -> None:
     """The options need no Prolog (the learner registry is asked when a command runs): help

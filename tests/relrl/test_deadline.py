@@ -37,6 +37,7 @@ def _later_calls_run(kb: KnowledgeBase) -> None:
         assert kb.query("between(1, 3, X)")[0][2][0][1] == 3
 
 
+@pytest.mark.slow
 def test_shell_query_that_ends_with_false_leaves_no_limit_behind() -> None:
     """Regression: in relrl shell, `(X = 1 ; fail).`, `;` (false.), then a wait past the
     limit: the next query failed with time_limit_exceeded (the alarm of the exhausted
@@ -55,6 +56,7 @@ def test_shell_query_that_ends_with_false_leaves_no_limit_behind() -> None:
 
 
 @pytest.mark.parametrize("ending", ["answer", "false", "error", "time limit"])
+@pytest.mark.slow
 def test_a_call_leaves_no_limit_behind(kb: KnowledgeBase, ending: str) -> None:
     if ending == "answer":
         assert kb.holds("true")
@@ -71,6 +73,7 @@ def test_a_call_leaves_no_limit_behind(kb: KnowledgeBase, ending: str) -> None:
 
 @pytest.mark.parametrize("ending", ["closed after one answer", "exhausted", "error",
                                     "time limit"])
+@pytest.mark.slow
 def test_an_open_query_leaves_no_limit_behind(kb: KnowledgeBase, ending: str) -> None:
     text = {"closed after one answer": "between(1, inf, X)", "exhausted": "(X = 1 ; fail)",
             "error": "(X = 1 ; atom_length(_, _))", "time limit": "(X = 1 ; repeat, fail)"}
@@ -88,6 +91,7 @@ def test_an_open_query_leaves_no_limit_behind(kb: KnowledgeBase, ending: str) ->
     _later_calls_run(kb)
 
 
+@pytest.mark.slow
 def test_a_step_leaves_no_limit_behind() -> None:
     with KnowledgeBase(SIS, timeout=LIMIT) as kb:
         agent = Agent(kb, make_learner("etg"), seed=0)
@@ -97,6 +101,7 @@ def test_a_step_leaves_no_limit_behind() -> None:
         _later_calls_run(kb)
 
 
+@pytest.mark.slow
 def test_a_limit_stops_a_blocking_system_call(kb: KnowledgeBase) -> None:
     """sleep/1 waits in the OS: the limit stops it there (SWI-Prolog's alert signal)."""
     t = time.monotonic()
@@ -123,6 +128,7 @@ def _quiet_sigint(test: Callable[[list], None]) -> None:
         signal.signal(signal.SIGINT, old)
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_the_running_goal_at_once() -> None:
     with KnowledgeBase(FRUITS, timeout=120) as kb:
         def test(seen: list) -> None:

@@ -16,6 +16,8 @@ from relrl.learners import make_learner
 from relrl.loop import Agent
 from tests.conftest import ROOT
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 GOLDEN = json.loads((ROOT / "tests" / "data" / "golden_decisions.json").read_text())
 
 

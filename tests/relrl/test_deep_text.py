@@ -18,6 +18,8 @@ from relrl.learners import make_learner
 from relrl.loop import Agent
 from tests.conftest import FRUITS, ROOT
 
+pytestmark = pytest.mark.slow  # every test here takes a second or more
+
 DEPTH = 20_000
 DEEP = "f(" * DEPTH + "a" + ")" * DEPTH
 

@@ -37,6 +37,7 @@ def cycles() -> dict[str, dict[str, Any]]:
 
 
 @pytest.mark.parametrize("learner", LEARNERS)
+@pytest.mark.slow
 def test_dropped_knowledge_bases_leave_nothing(cycles: dict[str, dict[str, Any]],
                                                learner: str) -> None:
     figures = cycles[learner]

@@ -147,6 +147,7 @@ def test_close_twice(fruits: KnowledgeBase) -> None:
     fruits.close()
 
 
+@pytest.mark.slow
 def test_a_million_calls_do_not_exhaust_the_string_stack() -> None:
     """Regression: every call pushed a text buffer on Prolog's string stack, which only a
     returning foreign predicate pops; an experiment of ~600k steps died with 'Too many
@@ -169,6 +170,7 @@ def test_partial_list_keeps_its_tail(fruits: KnowledgeBase) -> None:
     assert value[2][0] == "[|]" and value[2][1] == 2 and isinstance(value[2][2], Var)
 
 
+@pytest.mark.slow
 def test_time_limit_holds_across_many_short_calls() -> None:
     """Calls that end in time never see the watchdog fire, however long they run
     together, and a runaway call after them is still stopped at its own limit."""
@@ -223,6 +225,7 @@ def test_long_and_cyclic_lists_are_refused(
             kb.call("cyclist", Var())
 
 
+@pytest.mark.slow
 def test_compiled_calls_load_with_the_first_step_only() -> None:
     """A process that only loads and queries (relrl check, a shell) never imports numba;
     the first control step loads the compiled step and reader."""
@@ -252,6 +255,7 @@ def test_compiled_calls_load_with_the_first_step_only() -> None:
     ("relrl.query", set()),
     ("relrl.engine", set()),
 ])
+@pytest.mark.slow
 def test_the_transport_imports_no_layer_above_it(module: str, above: set[str]) -> None:
     """Layers import only the ones below them: bindings < terms < calls < the facade (kb)
     and its typed front (engine) and user queries (query); none imports pyswip."""

@@ -81,6 +81,7 @@ def _with_learner(tmp_path: Path, source: str, *command: str) -> subprocess.Comp
                           cwd=ROOT, timeout=120)
 
 
+@pytest.mark.slow
 def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> None:
     proc = _with_learner(tmp_path, TOY)
     assert proc.returncode == 0, proc.stderr
@@ -107,6 +108,7 @@ def test_a_learner_declared_only_in_prolog_is_chosen_by_name(tmp_path: Path) -> 
     (("relrl_engine:learner(toy).\n", ""),
      "learner toy: declares parameters or tasks but is not registered"),
 ])
+@pytest.mark.slow
 def test_a_learner_with_bad_declarations_is_an_error(tmp_path: Path, change: tuple[str, str],
                                                      message: str) -> None:
     proc = _with_learner(tmp_path, TOY.replace(*change))
@@ -114,6 +116,7 @@ def test_a_learner_with_bad_declarations_is_an_error(tmp_path: Path, change: tup
     assert message in proc.stderr
 
 
+@pytest.mark.slow
 def test_bad_declarations_are_one_line_and_exit_2_at_the_command_line(tmp_path: Path
                                                                        ) -> None:
     proc = _with_learner(tmp_path, TOY.replace("bias, 0.25, unit", "bias, 1.5, unit"),

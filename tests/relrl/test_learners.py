@@ -12,7 +12,6 @@ from relrl.errors import ConfigError
 from relrl.kb import KnowledgeBase
 from relrl.learners import DOMAINS, WORLDS, learners, make_learner, make_world_learner
 from relrl.loop import Agent, run
-from relrl.terms import Var
 from tests.conftest import ROOT
 from tests.relrl.tasks import BEST, LightDark
 
@@ -33,27 +32,30 @@ def greedy_accuracy(agent: Agent, steps: int = 400) -> float:
 
 
 @pytest.mark.parametrize("name", ["etg", "qlearning"])
+@pytest.mark.slow
 def test_value_learners_reach_the_optimum(name: str) -> None:
     agent = trained(name, epsilon=0.2)
     assert greedy_accuracy(agent) == 1.0
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_contingency_prefers_the_rewarded_responses() -> None:
     agent = trained("contingency")
     # Roulette-wheel choice stays stochastic, but the rewarded rules dominate.
     assert greedy_accuracy(agent) > 0.9
     rules = agent.learner.rules()
     fitness = {(ante[1], resp): f for ante, resp, _, f in rules}
-    light = agent.kb.call("relrl_state:state_encode", agent.kb.module,
-                          [("stimulus", "light")], Var())[0]
-    fed_dark = agent.kb.call("relrl_state:state_encode", agent.kb.module,
-                             [("stimulus", "dark"), ("stimulus", "food")], Var())[0]
+    features = agent.kb.features()
+    light = 1 << features.index(("stimulus", "light"))
+    fed_dark = (1 << features.index(("stimulus", "dark"))) | \
+        (1 << features.index(("stimulus", "food")))
     assert fitness[(light, "a")] > 5 > max(fitness.get((light, r), 1.0) for r in "bc")
     assert fitness[(fed_dark, "c")] > 5 > max(fitness.get((fed_dark, r), 1.0) for r in "ab")
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_contingency_as_execution_probabilities_reaches_its_cap() -> None:
     """With fitness read as an execution probability (max_fitness 1, the paper-2012 preset)
     no rule rises above 1, wrong responses fall to the lower bound, and the right response
@@ -188,6 +190,7 @@ def test_memory_positions() -> None:
     q.kb.close()
 
 
+@pytest.mark.slow
 def test_explanations() -> None:
     agent = trained("etg", steps=600, epsilon=0.2)
     agent.step([("see", "dark")], learning=False)

@@ -52,6 +52,7 @@ def _spoken(tmp_path: Path, words: list[str], gap: float = 1.0) -> Path:
     return _wav(tmp_path / "caregiver.wav", np.concatenate(parts))
 
 
+@pytest.mark.slow
 def test_audio_file_is_heard_at_its_time_units(tmp_path: Path) -> None:
     wav = _spoken(tmp_path, ["apple", "lemon"])
     source = AudioFileWords(wav, ["apple", "lemon", "orange", "attention"], 0.5)
@@ -64,6 +65,7 @@ def test_audio_file_is_heard_at_its_time_units(tmp_path: Path) -> None:
     assert heard["apple"] < heard["lemon"]
 
 
+@pytest.mark.slow
 def test_run_with_audio_reaches_hear_word(tmp_path: Path) -> None:
     wav = _spoken(tmp_path, ["orange", "apple"])
     script = episode(tmp_path, steps=20, perception="symbolic")

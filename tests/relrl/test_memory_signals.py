@@ -15,10 +15,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from relrl.engine import Engine
 from relrl.kb import KnowledgeBase
 from relrl.learners import make_learner
 from tests.conftest import ROOT
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 SIS = ROOT / "examples" / "domains" / "sis.pl"
 

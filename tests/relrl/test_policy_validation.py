@@ -117,6 +117,7 @@ def test_the_largest_values_learn_without_overflow(tmp_path: Path, q: str) -> No
             agent.learner.load(tmp_path / "edge.pl")
 
 
+@pytest.mark.slow
 def test_loading_and_saving_take_time_in_proportion_to_the_policy(tmp_path: Path) -> None:
     """A 5 MB policy loads and saves under a knowledge base whose time limit (0.5 s) is far
     shorter than reading it takes: no rule of the policy runs, its size bounds the work

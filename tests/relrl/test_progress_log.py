@@ -7,6 +7,8 @@ import logging
 import time
 from pathlib import Path
 
+import pytest
+
 from relrl import log
 from relrl.cli import main
 from relrl.progress import progress
@@ -43,6 +45,7 @@ def test_progress_on_a_terminal_is_a_tqdm_bar(monkeypatch) -> None:
     assert "2/5" in tty.getvalue() and "point" in tty.getvalue()
 
 
+@pytest.mark.slow
 def test_a_terminal_that_reports_no_size_still_shows_the_bar() -> None:
     """A bare pseudo-terminal (0 x 0, as test harnesses and supervisors open) once made
     tqdm draw nothing at all."""
@@ -82,6 +85,7 @@ def test_quiet_means_no_progress(monkeypatch) -> None:
         log.setup(0)
 
 
+@pytest.mark.slow
 def test_a_session_writes_its_log_file(tmp_path: Path, capsys) -> None:
     script = episode(tmp_path, steps=20, perception="symbolic",
                      extra="[evaluation]\nevery = 10\nruns = 1\nsteps = 5\n")

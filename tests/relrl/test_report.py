@@ -25,6 +25,7 @@ def sis_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_a_run_renders_its_numbers_and_where_they_come_from(sis_run: Path) -> None:
     run = load_run(sis_run)
     text = render(run, "summary", "exp1")
@@ -96,6 +97,7 @@ def test_an_unknown_view_names_the_known_ones(sis_run: Path) -> None:
         render(load_run(sis_run), "nope")
 
 
+@pytest.mark.slow
 def test_shipped_docs_match_the_runs_they_cite() -> None:
     docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
     stale = [line for md in docs for line in stale_blocks(md)]

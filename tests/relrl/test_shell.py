@@ -59,6 +59,7 @@ def test_percepts_memory_state(shell) -> None:
     assert text.endswith("true.\n")
 
 
+@pytest.mark.slow
 def test_errors_do_not_stop_the_shell(shell) -> None:
     sh, out = shell
     sh.run_lines(["repeat, fail.\n", "foo(.\n", ":nope\n", "stimulus(face).\n"])
@@ -76,6 +77,7 @@ def test_quit_stops(shell) -> None:
     assert out.getvalue() == ""
 
 
+@pytest.mark.slow
 def test_piped_shell_process() -> None:
     proc = subprocess.run([sys.executable, "-m", "relrl.cli", "shell", str(FRUITS)],
                           input="response(R).\n", capture_output=True, text=True, cwd=ROOT)
@@ -93,6 +95,7 @@ def _shell_proc(stdin: str, *args: str, domain: Path = FRUITS,
                           timeout=timeout)
 
 
+@pytest.mark.slow
 def test_piped_output_comes_in_order_with_the_answers() -> None:
     proc = _shell_proc("write(a), X = 1 ; write(b), X = 2.\n"
                        "member(X, [1, 2]), format(\"hello ~w~n\", [X]).\n")
@@ -100,11 +103,13 @@ def test_piped_output_comes_in_order_with_the_answers() -> None:
     assert proc.stdout == "aX = 1 ;\nbX = 2.\nhello 1\nX = 1 ;\nhello 2\nX = 2.\n"
 
 
+@pytest.mark.slow
 def test_a_choice_point_left_after_the_last_answer_reads_false() -> None:
     proc = _shell_proc("(X = 1 ; fail).\n")
     assert proc.stdout == "X = 1 ;\nfalse.\n"
 
 
+@pytest.mark.slow
 def test_cyclic_and_deep_answers_are_written_as_swipl_writes_them() -> None:
     proc = _shell_proc("X = f(X).\n"
                        "X = [a|X], Y = g(X, Y).\n"
@@ -129,6 +134,7 @@ def test_answers_write_whole_terms_on_request(shell) -> None:
 
 
 @pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "-inf", "soon", ""])
+@pytest.mark.slow
 def test_the_time_limit_cannot_be_switched_off(shell, value: str) -> None:
     sh, out = shell
     sh.run_lines([f":set timeout {value}\n", "repeat, fail.\n"])
@@ -139,6 +145,7 @@ def test_the_time_limit_cannot_be_switched_off(shell, value: str) -> None:
 
 
 @pytest.mark.parametrize("value", ["-5", "0", "nan", "inf"])
+@pytest.mark.slow
 def test_timeout_flag_is_checked(value: str) -> None:
     proc = _shell_proc("true.\n", "--timeout", value)
     assert proc.returncode == 2 and proc.stdout == ""
@@ -146,6 +153,7 @@ def test_timeout_flag_is_checked(value: str) -> None:
     assert "cannot be switched off" in proc.stderr
 
 
+@pytest.mark.slow
 def test_endless_answers_stop_at_max_when_piped() -> None:
     proc = _shell_proc("between(1, inf, X).\n", "--max", "3")
     assert proc.stdout.splitlines() == ["X = 1 ;", "X = 2 ;", "X = 3 ;",
@@ -187,6 +195,7 @@ def test_make_reloads_changed_files_and_keeps_a_broken_one(shell, write_domain) 
     assert lines[1:] == ["X = 2 ;", "X = 3."]   # the last good version stays
 
 
+@pytest.mark.slow
 def test_trace_prints_the_ports_of_the_domain_rules() -> None:
     proc = _shell_proc("trace.\nlooking_frontal(face).\nnotrace.\nlooking_frontal(face).\n")
     assert proc.returncode == 0, proc.stderr
@@ -261,6 +270,7 @@ def terminal(tmp_path: Path):
         term.close()
 
 
+@pytest.mark.slow
 def test_terminal_one_answer_at_a_time(terminal) -> None:
     terminal.send("stimulus(S).\n")
     assert terminal.expect(r"S = face ").endswith("\nS = face ")
@@ -279,6 +289,7 @@ def test_terminal_one_answer_at_a_time(terminal) -> None:
     assert terminal.close() == 0
 
 
+@pytest.mark.slow
 def test_terminal_output_in_order_and_last_answer_without_prompt(terminal) -> None:
     terminal.send("member(X, [1, 2]), write(hello(X)), nl.\n")
     assert terminal.expect(r"X = 1 ").endswith("\nhello(1)\nX = 1 ")
@@ -290,6 +301,7 @@ def test_terminal_output_in_order_and_last_answer_without_prompt(terminal) -> No
     assert terminal.expect(r"\?- ").endswith("\nfalse.\n\n?- ")
 
 
+@pytest.mark.slow
 def test_terminal_write_help_and_unknown_keys(terminal) -> None:
     terminal.send("numlist(1, 12, L), member(X, [a, b]).\n")
     assert terminal.expect(r"X = a ").endswith("L = [1, 2, 3, 4, 5, 6, 7, 8, 9|...],\nX = a ")
@@ -307,6 +319,7 @@ def test_terminal_write_help_and_unknown_keys(terminal) -> None:
     assert terminal.close() == 0
 
 
+@pytest.mark.slow
 def test_terminal_time_limit_per_answer(terminal) -> None:
     terminal.send("(X = 1 ; repeat, fail).\n")
     terminal.expect(r"X = 1 ")
@@ -316,6 +329,7 @@ def test_terminal_time_limit_per_answer(terminal) -> None:
     assert "error: query ran longer than 2 s" in text
 
 
+@pytest.mark.slow
 def test_terminal_ctrl_c_stops_the_query_at_once(tmp_path: Path) -> None:
     # The limit (300 s) is far beyond the test's patience (60 s): only a Ctrl-C that stops
     # Prolog at once, as swipl's does, passes. The signal comes once the query runs.

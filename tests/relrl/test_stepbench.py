@@ -18,6 +18,7 @@ def etg_recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return record(tmp_path_factory.mktemp("stepbench") / "etg.pl", "etg", steps=300, warmup=100)
 
 
+@pytest.mark.slow
 def test_recording_replays_with_the_same_decisions(etg_recording: Path) -> None:
     lines = etg_recording.read_text().splitlines()
     assert lines[0].startswith("stepbench(") and ",etg," in lines[0]
@@ -43,6 +44,7 @@ def test_a_different_decision_is_an_error_naming_the_step(etg_recording: Path,
         replay(bad, passes=1)
 
 
+@pytest.mark.slow
 def test_a_recording_is_data(tmp_path: Path, etg_recording: Path) -> None:
     first = etg_recording.read_text().splitlines()[0]
     bad = tmp_path / "bad.pl"
@@ -51,12 +53,14 @@ def test_a_recording_is_data(tmp_path: Path, etg_recording: Path) -> None:
         replay(bad, passes=1)
 
 
+@pytest.mark.slow
 def test_external_learner_replays(tmp_path: Path) -> None:
     path = record(tmp_path / "q.pl", "qlearning", steps=100, warmup=20)
     assert ",external," in path.read_text().splitlines()[0]
     assert replay(path, passes=1)["learner"] == "external"
 
 
+@pytest.mark.slow
 def test_cli_prolog_step_with_profile(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["bench", "--prolog-step", "--steps", "1000", "--profile", "--top", "5"]) == 0
     out = capsys.readouterr().out

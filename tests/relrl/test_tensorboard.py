@@ -59,6 +59,7 @@ def test_a_growing_log_is_read_while_it_grows(tmp_path: Path, monkeypatch) -> No
     assert _read(tmp_path)["reward"][-2:] == [(4, 4.0), (5, 5.0)]
 
 
+@pytest.mark.slow
 def test_a_session_writes_its_time_units_evaluations_and_naming(tmp_path: Path) -> None:
     from relrl.episodes import RunOptions, load_episode, run_episode
     from tests.monitor.conftest import episode

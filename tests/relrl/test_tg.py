@@ -69,6 +69,7 @@ def test_save_load_same_choices(tmp_path: Path) -> None:
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_same_seed_same_trajectory() -> None:
     def trajectory(seed: int) -> list:
         with KnowledgeBase(GAZE) as kb:
@@ -115,6 +116,7 @@ def test_explanation_shows_the_tests_and_bindings() -> None:
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_policy_reads_as_rules_and_consults_in_plain_swipl(tmp_path: Path) -> None:
     agent = trained()
     path = agent.learner.save(tmp_path / "tg.pl")
@@ -212,6 +214,7 @@ def test_graph_draws_the_tree() -> None:
     agent.kb.close()
 
 
+@pytest.mark.slow
 def test_example_learns_gaze_following_on_the_sis(tmp_path: Path) -> None:
     proc = subprocess.run([sys.executable, str(ROOT / "examples" / "tg_gaze_following.py"),
                            "--steps", "2000", "--policy", str(tmp_path / "tg.pl")],
@@ -246,6 +249,7 @@ def test_bad_parameter_on_the_command_line(capsys) -> None:
     assert "half_life must be >= 0" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_negations_leave_out_what_the_body_proves_and_old_policies_load(tmp_path: Path) -> None:
     """A no-branch below a test that introduced a variable is written as the negation of
     the test alone when it shares no variable with the path (the body proves the path);

@@ -32,6 +32,7 @@ def _policy(tmp_path: Path, learner: str) -> Path:
     return out / "policy.pl"
 
 
+@pytest.mark.slow
 def test_relrl_tree_draws_an_etg_policy(tmp_path: Path, capsys) -> None:
     policy = _policy(tmp_path, "etg")
     capsys.readouterr()
@@ -51,6 +52,7 @@ def test_relrl_tree_draws_an_etg_policy(tmp_path: Path, capsys) -> None:
 
 
 @pytest.mark.parametrize("case", ["contingency", "no-domain", "bad-format", "missing"])
+@pytest.mark.slow
 def test_relrl_tree_errors_are_one_line(tmp_path: Path, capsys, case: str) -> None:
     args = {"contingency": lambda: [str(_policy(tmp_path, "contingency")), "--domain",
                                     str(FRUITS)],

@@ -11,11 +11,14 @@ import statistics
 from pathlib import Path
 
 import gymnasium as gym
+import pytest
 from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
 
 import relrl.sim  # noqa: F401 - registers the environments
 from relrl.sim.wrappers import EpisodeScalars
 from tests.conftest import ROOT
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def _example(name: str):

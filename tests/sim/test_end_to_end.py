@@ -37,6 +37,7 @@ def test_gaze_follower_meets_the_evaluation_sequence() -> None:
     assert followed[:6] == ["left", "down"] * 3 and set(targets) == {"left", "down"}
 
 
+@pytest.mark.slow
 def test_unreliable_caregiver_lowers_the_followers_reward_not_its_cgi() -> None:
     follow = rollout(SharedAttentionEnv(max_steps=None), GazeFollower(), 3000, seed=3)
     shaky = rollout(SharedAttentionEnv("unreliable", max_steps=None), GazeFollower(), 3000,
@@ -46,6 +47,7 @@ def test_unreliable_caregiver_lowers_the_followers_reward_not_its_cgi() -> None:
     assert rate[1] < 0.8 * rate[0]
 
 
+@pytest.mark.slow
 def test_random_robot_cgi_is_near_one_fifth() -> None:
     env = SharedAttentionEnv(max_steps=None, record_trace=True)
     trace = rollout(env, RandomPolicy(seed=4), 150_000, seed=4)

@@ -74,6 +74,7 @@ def test_v1_observation_encodes_the_scene() -> None:
 
 @pytest.mark.parametrize("world", [World(places=9, kinds=2),
                                    World(places=9, colours=3, kinds=2, scene=True)])
+@pytest.mark.slow
 def test_the_wrapper_gives_what_the_domains_relations_give(world: World, tmp_path: Path) -> None:
     """The wrapper's view is the generated domain's relation/1, asked of a knowledge base of
     its own, time unit by time unit, and every fact it gives is ground text of a template."""
@@ -124,6 +125,7 @@ def test_the_relational_view_by_hand() -> None:
             "colour(toy(left),red)", "head_at(left)", "sees(toy)", "toy_at(toy(left),left)")
 
 
+@pytest.mark.slow
 def test_the_tabular_example_learns_and_reports_the_protocols_cgi() -> None:
     spec = importlib.util.spec_from_file_location("gym_tabular_q",
                                                   ROOT / "examples" / "gym_tabular_q.py")

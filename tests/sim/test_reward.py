@@ -38,6 +38,7 @@ def mean_reward(env: SharedAttentionEnv, policy, steps: int = 3000, seed: int = 
 @pytest.mark.parametrize("during_gaze", [False, True])
 @pytest.mark.parametrize("pattern", [("centre", "down"), ("centre", "centre", "down"),
                                      ("centre", "left", "down")])
+@pytest.mark.slow
 def test_a_farming_policy_earns_less_than_gaze_following(during_gaze: bool,
                                                          pattern: tuple[str, ...]) -> None:
     params = {"attention_during_gaze": during_gaze}
@@ -51,6 +52,7 @@ def test_a_farming_policy_earns_less_than_gaze_following(during_gaze: bool,
     assert farm <= PAPER_REWARD.other + gain * (3000 // 10 + 1) / 3000 + 1e-9
 
 
+@pytest.mark.slow
 def test_farming_loses_in_large_worlds_and_with_an_unreliable_caregiver() -> None:
     for world, params in [(World(places=17), {}), (World(), {"reliability": 0.5})]:
         def env(world: World = world, params: dict = params) -> SharedAttentionEnv:
@@ -73,6 +75,7 @@ def test_the_env_and_the_experiments_share_one_task_and_reward() -> None:
 
 
 @pytest.mark.parametrize("learner", ["qlearning", "etg"])
+@pytest.mark.slow
 def test_the_learners_reward_is_the_envs_time_unit_by_time_unit(learner: str) -> None:
     kb = KnowledgeBase(DEFAULT_DOMAIN)
     try:

@@ -5,11 +5,14 @@ from __future__ import annotations
 import itertools
 from collections import Counter
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from relrl.sim import CaregiverParams, GazeMetrics, SharedAttentionEnv
 from relrl.sim.places import TOY_PLACES
+
+pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 params = st.builds(
     CaregiverParams,

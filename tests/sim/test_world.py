@@ -44,6 +44,7 @@ def test_a_larger_world_subdivides_the_smaller_one(small: int, large: int) -> No
 
 
 @pytest.mark.parametrize("n", SIZES)
+@pytest.mark.slow
 def test_geometry_is_symmetric_and_spans_the_table(n: int) -> None:
     lay = layout(n)
     ang = np.array(lay.angle_between)
@@ -157,6 +158,7 @@ def test_examples_sis_pl_is_the_paper_worlds_generated_domain() -> None:
 
 @pytest.mark.parametrize("world", [World(places=9, colours=3, kinds=2),
                                    World(places=9, colours=2, kinds=2, scene=True)])
+@pytest.mark.slow
 def test_the_domain_reads_the_simulators_percepts(world: World, tmp_path: Path) -> None:
     """Facts of the generated domain hold exactly when the percepts of this time unit or
     the one before (the domain's memory span) say so."""

@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[2]
 BLOCKS = ROOT / "examples" / "worlds" / "blocks.pl"
 
 
+@pytest.mark.slow
 def test_tg_learns_3_block_stack_to_optimal() -> None:
     """The issue's short test: tg learns stack on 3 blocks (reward 1 at the goal) to the
     optimal number of moves in every greedy episode."""
@@ -41,6 +42,7 @@ def test_tg_learns_stack_with_the_shared_bias_and_acts_optimally_on_8() -> None:
     assert on8["exactly_optimal"] == 1.0
 
 
+@pytest.mark.slow
 def test_ptg_learns_3_block_unstack_to_optimal_and_acts_on_6() -> None:
     """P-learning: learned on 3 blocks only, the P-tree's greedy choices are optimal on 3
     blocks and, with no further learning, on 6."""
@@ -57,6 +59,7 @@ def test_ptg_learns_3_block_unstack_to_optimal_and_acts_on_6() -> None:
     assert text.startswith("P-tree (acts when greedy):") and "Q-tree" in text
 
 
+@pytest.mark.slow
 def test_learn_feeds_the_live_monitor() -> None:
     """learn_task gives the monitor's hub each evaluation (a plot point, the tree, a greedy
     episode's last state) and learns exactly as without it."""
@@ -77,6 +80,7 @@ def test_learn_feeds_the_live_monitor() -> None:
     assert hub.state["activity"] == "evaluating"
 
 
+@pytest.mark.slow
 def test_same_seed_same_episodes() -> None:
     def run() -> list:
         with World(BLOCKS) as world:
@@ -94,6 +98,7 @@ def test_task_names_and_instances() -> None:
             world.task("fly")
 
 
+@pytest.mark.slow
 def test_learn_evaluates_a_saved_policy_on_larger_worlds(tmp_path: Path, capsys) -> None:
     out = tmp_path / "run"
     assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "150",
@@ -106,6 +111,7 @@ def test_learn_evaluates_a_saved_policy_on_larger_worlds(tmp_path: Path, capsys)
     assert "size   7: of optimal" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_policy_saved_and_loaded_acts_the_same(tmp_path: Path) -> None:
     with World(BLOCKS) as world:
         world.attach(world.learner("tg"), seed=1)
@@ -121,6 +127,7 @@ def test_policy_saved_and_loaded_acts_the_same(tmp_path: Path) -> None:
     assert a == b
 
 
+@pytest.mark.slow
 def test_check_world_file_line_and_exit_2(tmp_path: Path, capsys) -> None:
     bad = tmp_path / "bad.pl"
     bad.write_text("initial_state(_, [p(a)]).\ntask(t).\naction(go(_)).\n"
@@ -140,6 +147,7 @@ def test_check_world_syntax_error(tmp_path: Path, capsys) -> None:
     assert f"{bad}:2:" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_learn_command_writes_its_folder(tmp_path: Path) -> None:
     out = tmp_path / "run"
     assert main(["learn", str(BLOCKS), "--task", "stack", "--sizes", "3", "--episodes", "40",
@@ -163,6 +171,7 @@ def test_learn_bad_flags_exit_2(argv: list[str], message: str, capsys) -> None:
     assert message in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_experiment_worlds_and_report(tmp_path: Path) -> None:
     from relrl.report import load_run, render
 
@@ -189,6 +198,7 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
     assert "slope k (cost ∝ size^k)" in render(load_run(out), "cost")
 
 
+@pytest.mark.slow
 def test_learn_never_writes_through_a_link(tmp_path: Path, capsys) -> None:
     """The output folder's policy.pl is a link to a file elsewhere: refused before learning
     (exit 2, one line), and the file it points to is left as it was."""
