@@ -8,7 +8,7 @@
   installed package without it this figure is skipped), CPU microseconds and inferences per
   step, called directly and through the gateway's guarded call;
 * the simulator's own step rate;
-* ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
+* ETG's steps/s with the live web monitor attached, against without (bench/monitor_cost.py);
 * a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
   (relrl.recording.bench; skipped without the ``mcap`` extra);
 * the perception pipeline's frames per second (perception.bench), optional.
@@ -171,7 +171,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
             "gateway_cpu_us_per_step": replayed["gateway"]["cpu_us_per_step"],
             "in_gateway_calls": replayed["direct"]["cpu_us_per_step"] / out["gateway_call_us"]}
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
-    from relrl.monitor.bench import bench_monitor
+    from bench.monitor_cost import bench_monitor
 
     out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
     try:  # a session's time units/s recording MCAP / with the trace alone

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from relrl.monitor.bench import bench_monitor
+from bench.monitor_cost import bench_monitor
 
 
 def test_bench_monitor_reports_both_rates() -> None:
