@@ -10,7 +10,7 @@
 * the simulator's own step rate;
 * ETG's steps/s with the live web monitor attached, against without (bench/monitor_cost.py);
 * a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
-  (relrl.recording.bench; skipped without the ``mcap`` extra);
+  (bench/recording_cost.py; skipped without the ``mcap`` extra);
 * the perception pipeline's frames per second (perception.bench), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
@@ -175,7 +175,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
 
     out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
     try:  # a session's time units/s recording MCAP / with the trace alone
-        from relrl.recording.bench import bench_recording
+        from bench.recording_cost import bench_recording
 
         out["recording"] = bench_recording(min(steps, 3000), pairs=6 if steps >= 1000 else 2)
     except ImportError as exc:  # pragma: no cover - the mcap extra missing

@@ -375,8 +375,6 @@ _ELSEWHERE = {
     "relrl/speech.py": "the recogniser's grammar, in a private temporary folder",
     "relrl/monitor/live.py": "the monitor process's OOM score (/proc/self/oom_score_adj)",
     "relrl/shell.py": "clauses typed after [user]., in a private temporary folder",
-    "relrl/recording/bench.py": "the benchmark's own episode script, in a private temporary "
-                                "folder",
     "relrl/recording/mcapfile.py": "the recording's process fills the empty session.mcap the "
                                    "writer made (or a new file; never a link, never a file "
                                    "with something in it)",
