@@ -11,7 +11,7 @@
 * ETG's steps/s with the live web monitor attached, against without (bench/monitor_cost.py);
 * a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
   (bench/recording_cost.py; skipped without the ``mcap`` extra);
-* the perception pipeline's frames per second (perception.bench), optional.
+* the perception pipeline's frames per second (bench/perception_speed.py), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
 (the agent's step, Python and Prolog together: percepts in, response out) costing at most 3
@@ -182,9 +182,9 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
         out["recording"] = {"skipped": str(exc)}
     if perception:
         try:
-            import perception as perception_pkg
+            from bench import perception_speed
 
-            out["perception"] = perception_pkg.bench(faces=faces)
+            out["perception"] = perception_speed.bench(faces=faces)
         except ImportError as exc:  # pragma: no cover - OpenCV missing
             out["perception"] = {"skipped": str(exc)}
     etg = out["learners"]["etg"]

@@ -53,7 +53,7 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
 
 
 def test_perception_photo_target_line(monkeypatch) -> None:
-    import perception.bench as perception_bench
+    from bench import perception_speed as perception_bench
     from relrl.bench import bench_all
 
     for fps, met in ((59.9, False), (60.0, True)):
@@ -66,7 +66,7 @@ def test_perception_photo_target_line(monkeypatch) -> None:
 
 
 def test_perception_two_thread_target_lines(monkeypatch) -> None:
-    import perception.bench as perception_bench
+    from bench import perception_speed as perception_bench
     from relrl.bench import bench_all
 
     figures = {"fps_photos_320x240_cold": 30.0, "fps_photos_320x240_cold_2threads": 59.0,
