@@ -24,7 +24,7 @@ The interaction step (the agent's step and the simulator's) is reported beside i
 the load; the ratio much less). tg: at most 1.5 gateway calls per step, at least 3,000
 steps/s, a step costing at most twice ETG's (the process's CPU time per interaction step),
 and a learning step in a world of 129 toy places costing at most 1.5 times one in a
-world of 5 (relrl.experiments.scaling_speed: one process, blocks alternating).
+world of 5 (bench/world_size.py: one process, blocks alternating).
 Perception: at least 60 fps on real photographs at 320x240 (full
 search), with one thread and with two (wall clock, and on two free cores).
 """
@@ -155,7 +155,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     # what a step costs this process (its CPU time), tg's against ETG's: the wall-clock
     # figures move with whatever else the machine runs while one learner or the other is timed
     out["tg_step_in_etg_steps"] = tg["cpu_us_per_step"] / etg_["cpu_us_per_step"]
-    from relrl.experiments.scaling_speed import step_cost_by_size
+    from bench.world_size import step_cost_by_size
 
     out["tg_step_by_size"] = step_cost_by_size("tg", (5, 129), warmup=min(3000, 10 * steps),
                                                block=max(50, steps // 10), blocks=6)
