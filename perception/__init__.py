@@ -9,7 +9,6 @@ The public surface::
     open_camera(src) -> Camera     # 0, cam://0, video file, folder, synthetic://
     ART2, FruitNamer               # colour categories named by a caregiver (Table 1)
     PLACES, POSES, COLOURS, HUES   # the shared vocabulary
-    bench(...) -> dict             # speed and face-detection figures
 
 Heavy imports (OpenCV) happen on first use, so importing this package is cheap.
 """
@@ -31,8 +30,6 @@ __all__ = [
     "Perceiver",
     # the synthetic camera and camera sources
     "SceneView",
-    # benchmark
-    "bench",
     "format_fact",
     "open_camera",
     # one call per frame
@@ -51,8 +48,6 @@ _WHERE = {
 
 
 def __getattr__(name: str) -> Any:
-    if name == "bench":  # the submodule, which is callable as the bench() function
-        return import_module("perception.bench")
     if name in _WHERE:
         module = _WHERE[name]
         loaded = import_module(module)

@@ -34,7 +34,7 @@
 :- use_module(library(pairs)).
 :- use_module(memory).
 :- use_module(declarations).
-:- use_module(perception).
+:- use_module(senses).
 :- use_module(state).
 :- use_module(motivation).
 :- use_module(rules).

@@ -129,8 +129,8 @@ python_api(necessity_inputs, relrl_declarations:necessity_inputs/3).
 python_api(check_domain, relrl_check:check_domain/2).
 python_api(rule_listing, relrl_check:rule_listing/2).
 python_api(bias_listing, relrl_check:bias_listing/2).
-python_api(world_problems, relrl_percepts:world_problems/3).
-python_api(unread_percepts, relrl_percepts:unread_percepts/3).
+python_api(world_problems, relrl_percept_check:world_problems/3).
+python_api(unread_percepts, relrl_percept_check:unread_percepts/3).
 python_api(world_episodes, relrl_world:world_episodes/3).
 python_api(world_info, relrl_world:world_info/2).
 python_api(world_task, relrl_world:world_task/3).

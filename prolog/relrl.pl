@@ -22,11 +22,11 @@
 :- use_module(library(arithmetic)).   % the same arithmetic checks for every load
 :- use_module(memory).
 :- use_module(declarations).
-:- use_module(perception).
+:- use_module(senses).
 :- use_module(state).
 :- use_module(responses).
 :- use_module(check).
-:- use_module(percepts).
+:- use_module(percept_check).
 :- use_module(engine).
 :- use_module(learners).
 :- use_module(policy).
@@ -64,7 +64,7 @@ kb(KB) :-
 %!  smell(?What) is nondet.
 %!  at(?What) is nondet.
 %
-%   Perception predicates over working memory; see relrl_perception:perceived/3.
+%   Perception predicates over working memory; see relrl_senses:perceived/3.
 
 see(What)   :- context_module(KB), sensed(see, KB, What).
 hear(What)  :- context_module(KB), sensed(hear, KB, What).

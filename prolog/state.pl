@@ -22,7 +22,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(declarations).
-:- use_module(perception).
+:- use_module(senses).
 :- use_module(rules).
 :- use_module(memory).
 :- use_module(kbstate, [kb_record/2]).
@@ -36,7 +36,7 @@ the state of the environment is the sum of 2^x over the stimuli and facts that h
 x follows declaration order, stimuli first and then facts, so a domain file always gives
 the same codes. A code decodes back to its terms without loss.
 
-A stimulus holds when it is perceived through any sense (perception.pl); a fact holds when
+A stimulus holds when it is perceived through any sense (senses.pl); a fact holds when
 its goal succeeds in the knowledge base.
 */
 

@@ -8,10 +8,10 @@
   installed package without it this figure is skipped), CPU microseconds and inferences per
   step, called directly and through the gateway's guarded call;
 * the simulator's own step rate;
-* ETG's steps/s with the live web monitor attached, against without (relrl.monitor.bench);
+* ETG's steps/s with the live web monitor attached, against without (bench/monitor_cost.py);
 * a session's time units/s with ``--record`` (the MCAP file) against ``--out`` alone, paired
-  (relrl.recording.bench; skipped without the ``mcap`` extra);
-* the perception pipeline's frames per second (perception.bench), optional.
+  (bench/recording_cost.py; skipped without the ``mcap`` extra);
+* the perception pipeline's frames per second (bench/perception_speed.py), optional.
 
 Targets (from the project's issues): ETG at most 1.5 gateway calls per step, and an ETG step
 (the agent's step, Python and Prolog together: percepts in, response out) costing at most 3
@@ -24,7 +24,7 @@ The interaction step (the agent's step and the simulator's) is reported beside i
 the load; the ratio much less). tg: at most 1.5 gateway calls per step, at least 3,000
 steps/s, a step costing at most twice ETG's (the process's CPU time per interaction step),
 and a learning step in a world of 129 toy places costing at most 1.5 times one in a
-world of 5 (relrl.experiments.scaling_speed: one process, blocks alternating).
+world of 5 (bench/world_size.py: one process, blocks alternating).
 Perception: at least 60 fps on real photographs at 320x240 (full
 search), with one thread and with two (wall clock, and on two free cores).
 """
@@ -154,7 +154,7 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
     # what a step costs this process (its CPU time), tg's against ETG's: the wall-clock
     # figures move with whatever else the machine runs while one learner or the other is timed
     out["tg_step_in_etg_steps"] = tg["cpu_us_per_step"] / etg_["cpu_us_per_step"]
-    from relrl.experiments.scaling_speed import step_cost_by_size
+    from bench.world_size import step_cost_by_size
 
     out["tg_step_by_size"] = step_cost_by_size("tg", (5, 129), warmup=min(3000, 10 * steps),
                                                block=max(50, steps // 10), blocks=6)
@@ -170,20 +170,20 @@ def bench_all(*, steps: int = 5000, perception: bool = True, faces: bool = True
             "gateway_cpu_us_per_step": replayed["gateway"]["cpu_us_per_step"],
             "in_gateway_calls": replayed["direct"]["cpu_us_per_step"] / out["gateway_call_us"]}
     out["sis_env_steps_per_second"] = bench_step_rate(200_000, record_trace=False)
-    from relrl.monitor.bench import bench_monitor
+    from bench.monitor_cost import bench_monitor
 
     out["monitor"] = bench_monitor(steps)   # ETG steps/s with the live monitor / without
     try:  # a session's time units/s recording MCAP / with the trace alone
-        from relrl.recording.bench import bench_recording
+        from bench.recording_cost import bench_recording
 
         out["recording"] = bench_recording(min(steps, 3000), pairs=6 if steps >= 1000 else 2)
     except ImportError as exc:  # pragma: no cover - the mcap extra missing
         out["recording"] = {"skipped": str(exc)}
     if perception:
         try:
-            import perception as perception_pkg
+            from bench import perception_speed
 
-            out["perception"] = perception_pkg.bench(faces=faces)
+            out["perception"] = perception_speed.bench(faces=faces)
         except ImportError as exc:  # pragma: no cover - OpenCV missing
             out["perception"] = {"skipped": str(exc)}
     etg = out["learners"]["etg"]

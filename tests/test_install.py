@@ -148,3 +148,16 @@ print(env.step(0)[4]["percepts"])
 """], installed)
     assert proc.returncode == 0, proc.stderr
     assert "('at', 'centre')" in proc.stdout
+
+
+def test_bench_harnesses_stay_in_the_checkout(installed) -> None:
+    """The measuring harnesses (bench/ beside relrl/) are not in the wheel; relrl bench from
+    the installed package says what it needs in one line, exit 2."""
+    site = installed["site"]
+    assert not (site / "bench").exists()
+    for gone in ("relrl/monitor/bench.py", "relrl/recording/bench.py", "perception/bench.py",
+                 "perception/bagbench.py", "relrl/experiments/scaling_speed.py"):
+        assert not (site / gone).exists(), gone
+    proc = _run([installed["relrl"], "bench", "--steps", "100"], installed)
+    assert proc.returncode == 2, proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and "bench/ beside relrl/" in proc.stderr

@@ -3,11 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
+import sys
+from pathlib import Path
 
 HELP = "measure gateway call cost, learner steps/s, simulator and perception rates"
 EXAMPLE = ("relrl bench --json bench.json\n"
            "  relrl bench --prolog-step --profile   # the Prolog side of an ETG step alone")
+
+
+#: The checkout relrl runs from: its top-level ``bench/`` package (beside ``relrl/`` and
+#: ``tests/``) holds the measuring harnesses, which are not part of the installed package.
+SOURCE_TREE = Path(__file__).resolve().parents[2]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -55,6 +63,7 @@ def run(args: argparse.Namespace) -> int:
     if args.top < 1:
         raise ConfigError(f"--top must be at least 1, not {args.top}")
     path = check_out_file(args.json, "--json") if args.json else None  # before an hour's work
+    load_harnesses()
     if args.prolog_step:
         figures = _prolog_step(args)
     else:
@@ -67,6 +76,38 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     json.dumps(figures)  # must be JSON-ready
     return 0
+
+
+def load_harnesses() -> None:
+    """Make the source tree's measuring harnesses importable as the ``bench`` package.
+
+    The harnesses live in ``bench/`` beside ``relrl/`` in a checkout (an editable install
+    maps only relrl, perception and head, so the package is loaded from its folder here).
+
+    Raises:
+        ConfigError: relrl runs from an installed package without its source tree, or
+            another module named ``bench`` is already loaded.
+    """
+    from relrl.errors import ConfigError
+
+    folder = SOURCE_TREE / "bench"
+    init = folder / "__init__.py"
+    if not init.is_file():
+        raise ConfigError("relrl bench measures with the harnesses of relrl's source tree "
+                          "(bench/ beside relrl/), which the installed package does not hold: "
+                          "run it from a checkout (git clone, then pip install -e .)")
+    loaded = sys.modules.get("bench")
+    if loaded is not None:
+        if Path(getattr(loaded, "__file__", "") or "").resolve() != init.resolve():
+            raise ConfigError(f"relrl bench needs the source tree's {folder}, but another "
+                              f"module named bench is loaded ({loaded!r})")
+        return
+    spec = importlib.util.spec_from_file_location("bench", init,
+                                                  submodule_search_locations=[str(folder)])
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules["bench"] = module
+    spec.loader.exec_module(module)
 
 
 def _prolog_step(args: argparse.Namespace) -> dict:

@@ -411,7 +411,7 @@ def run(args: argparse.Namespace) -> int:
             faulthandler.register(signal.SIGUSR1, file=sys.__stderr__, all_threads=True)
         except (ValueError, OSError, io.UnsupportedOperation):
             pass  # no real stderr (embedded): no stack dumps, nothing else changes
-    from relrl.experiments import main as sis_main
+    from relrl.experiments import sis as sis_experiment
     from relrl.experiments.report import OUTPUTS, summary_table
 
     if args.name == "scaling":
@@ -422,7 +422,7 @@ def run(args: argparse.Namespace) -> int:
 
     config = build_config(args)
     print(f"setting: {config.setting()}")
-    results, files, out, signum = _claimed_run(args, "runs/exp1", OUTPUTS, sis_main.run_sis,
+    results, files, out, signum = _claimed_run(args, "runs/exp1", OUTPUTS, sis_experiment.run_sis,
                                                config)
     print(summary_table(results["summary"]))
     if any(c["held"] is not None for c in results.get("claims", {}).values()):

@@ -215,7 +215,7 @@ def _quick_sis(config, out, workers=1, **engine):
 
 def test_experiment_writes_a_fresh_timestamped_folder_by_default(capsys, tmp_path,
                                                                  monkeypatch, umask_022):
-    monkeypatch.setattr("relrl.experiments.main.run_sis", _quick_sis)
+    monkeypatch.setattr("relrl.experiments.sis.run_sis", _quick_sis)
     monkeypatch.chdir(tmp_path)
     assert main(EXP) == 0
     assert main(EXP) == 0
@@ -351,7 +351,7 @@ def test_a_folder_link_planted_during_the_run_is_not_followed(capsys, tmp_path, 
         write_json_atomic(Path(out) / "sub" / "results.json", {"seeds": config.seeds})
         return {"summary": {}}, []
 
-    monkeypatch.setattr("relrl.experiments.main.run_sis", planting_sis)
+    monkeypatch.setattr("relrl.experiments.sis.run_sis", planting_sis)
     out = tmp_path / "out"
     one_line_exit_2(capsys, EXP + ["--out", str(out)], "sub is a symbolic link")
     assert list(elsewhere.iterdir()) == []
@@ -378,8 +378,6 @@ _ELSEWHERE = {
     "relrl/speech.py": "the recogniser's grammar, in a private temporary folder",
     "relrl/monitor/live.py": "the monitor process's OOM score (/proc/self/oom_score_adj)",
     "relrl/shell.py": "clauses typed after [user]., in a private temporary folder",
-    "relrl/recording/bench.py": "the benchmark's own episode script, in a private temporary "
-                                "folder",
     "relrl/recording/mcapfile.py": "the recording's process fills the empty session.mcap the "
                                    "writer made (or a new file; never a link, never a file "
                                    "with something in it)",

@@ -171,7 +171,7 @@ def test_claims_judged_on_a_summary() -> None:
 @pytest.mark.parametrize("preset", [None, "paper-2012"])
 def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_path: Path,
                                                      capsys, monkeypatch) -> None:
-    import relrl.experiments.main as experiments_main
+    import relrl.experiments.sis as experiments_sis
     from relrl.learners import DOMAINS, learners
 
     ran = []
@@ -180,7 +180,7 @@ def test_demo_says_which_setting_and_learners_it_ran(preset: str | None, tmp_pat
         ran.append(config)
         return {"summary": {}}, []
 
-    monkeypatch.setattr(experiments_main, "run_sis", fake_run_sis)
+    monkeypatch.setattr(experiments_sis, "run_sis", fake_run_sis)
     args = ["demo", "--out", str(tmp_path / "d")] + (["--preset", preset] if preset else [])
     assert main(args) == 0
     out = capsys.readouterr().out

@@ -162,12 +162,12 @@ def relrl_process() -> Iterator[type[RelrlProcess]]:
 
 
 class Slowloris:
-    """A slowloris client on loopback in a process of its own (``relrl.monitor.bench``'s),
+    """A slowloris client on loopback in a process of its own (``bench.monitor_cost``'s),
     bounded in ``count`` and ``seconds``: ``with Slowloris(port, 300, 4) as attack: ...``
     (``attack.opened`` once the connections are made; :meth:`result` waits for the end)."""
 
     def __init__(self, port: int, count: int, seconds: float) -> None:
-        from relrl.monitor.bench import SLOWLORIS
+        from bench.monitor_cost import SLOWLORIS
 
         self.proc = subprocess.Popen([sys.executable, "-c", SLOWLORIS, str(port), str(count),
                                       str(seconds)], stdout=subprocess.PIPE, text=True)

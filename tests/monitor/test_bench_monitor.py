@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from relrl.monitor.bench import bench_monitor
+from bench.monitor_cost import bench_monitor
 
 pytestmark = pytest.mark.slow  # every test here takes a second or more
 

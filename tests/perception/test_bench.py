@@ -1,18 +1,17 @@
-"""perception.bench: the photo case, its stage breakdown and the two-thread figures."""
+"""bench/perception_speed.py: the photo case, its stage breakdown and the two-thread figures."""
 
 import threading
 import time
 
 import pytest
 
-import perception
-from perception.bench import FreeCoresPool
+from bench.perception_speed import FreeCoresPool, bench
 
 pytestmark = pytest.mark.slow  # every test here takes a second or more
 
 
 def test_photo_figures_wall_cpu_and_stages():
-    out = perception.bench(frames=8)
+    out = bench(frames=8)
     for size in ("320x240", "640x480"):
         for key in ("fps_photos_{}_cold", "cpu_fps_photos_{}_cold", "fps_photos_{}_cold_2threads",
                     "cpu_fps_photos_{}_cold_2threads", "free_cores_fps_photos_{}_cold_2threads"):

@@ -4,7 +4,7 @@ import cv2
 import numpy as np
 import pytest
 
-from perception.bench import lfw_figures
+from bench.perception_speed import lfw_figures
 from perception.faces import FaceTracker, detect_face
 from perception.render import SceneView, render
 from perception.vocabulary import POSES
@@ -91,7 +91,7 @@ def _lfw_frames(step: int) -> list[np.ndarray]:
 def test_pooled_full_search_finds_the_same_faces(astronaut_bgr):
     from concurrent.futures import ThreadPoolExecutor
 
-    from perception.bench import _photos
+    from bench.perception_speed import _photos
 
     frames = [render(SceneView("centre", pose, lighting=light, seed=5), size)
               for pose in POSES for light in (0.6, 1.25) for size in ((320, 240), (640, 480))]

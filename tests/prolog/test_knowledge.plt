@@ -88,8 +88,8 @@ test(decode_rejects_unknown_bits, [error(domain_error(state_code, _))]) :-
 test(fact_applied_to_stimulus) :-
     fresh_kb(KB, 'fruits.pl'),
     relrl_memory:wm_insert(KB, [see(face), pose(face, frontal)]),
-    relrl_perception:perceived(KB, see, frontal(face)),
-    \+ relrl_perception:perceived(KB, see, left_profile_1(face)).
+    relrl_senses:perceived(KB, see, frontal(face)),
+    \+ relrl_senses:perceived(KB, see, left_profile_1(face)).
 
 :- end_tests(state).
 

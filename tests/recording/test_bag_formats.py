@@ -459,7 +459,7 @@ def test_a_bag_that_contradicts_itself_is_one_line(tmp_path: Path, case: str, sa
 
 
 def test_the_bag_reading_figures_run() -> None:
-    from perception.bagbench import bench
+    from bench.bag_reading import bench
 
     figures = bench(frames=3, rounds=1)
     assert figures["frames"] == 3

@@ -55,7 +55,7 @@ def test_bench_json(tmp_path: Path, capsys) -> None:
 
 
 def test_perception_photo_target_line(monkeypatch) -> None:
-    import perception.bench as perception_bench
+    from bench import perception_speed as perception_bench
     from relrl.bench import bench_all
 
     for fps, met in ((59.9, False), (60.0, True)):
@@ -68,7 +68,7 @@ def test_perception_photo_target_line(monkeypatch) -> None:
 
 
 def test_perception_two_thread_target_lines(monkeypatch) -> None:
-    import perception.bench as perception_bench
+    from bench import perception_speed as perception_bench
     from relrl.bench import bench_all
 
     figures = {"fps_photos_320x240_cold": 30.0, "fps_photos_320x240_cold_2threads": 59.0,
@@ -78,3 +78,38 @@ def test_perception_two_thread_target_lines(monkeypatch) -> None:
     assert targets["perception_photos_320x240_fps>=60"] is False
     assert targets["perception_photos_320x240_2threads_fps>=60"] is False
     assert targets["perception_photos_320x240_2threads_free_cores_fps>=60"] is True
+
+
+def test_bench_without_the_source_tree_is_one_line(tmp_path: Path, monkeypatch,
+                                                   capsys) -> None:
+    """The harnesses (bench/) are not installed: without them, relrl bench says so in one
+    line and exits 2 before any measuring."""
+    import relrl.cli.bench as cli_bench
+
+    monkeypatch.setattr(cli_bench, "SOURCE_TREE", tmp_path)
+    assert main(["bench", "--no-perception", "--steps", "100"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "bench/ beside relrl/" in err
+    assert "Traceback" not in err
+
+
+def test_bench_loads_the_harnesses_of_its_own_checkout(tmp_path: Path, monkeypatch) -> None:
+    import sys
+    import types
+
+    import relrl.cli.bench as cli_bench
+    from relrl.errors import ConfigError
+
+    for name in [m for m in sys.modules if m == "bench" or m.startswith("bench.")]:
+        monkeypatch.delitem(sys.modules, name)
+    cli_bench.load_harnesses()
+    loaded = sys.modules["bench"]
+    assert Path(loaded.__file__) == cli_bench.SOURCE_TREE / "bench" / "__init__.py"
+    from bench.monitor_cost import bench_monitor  # a harness, found in that folder
+
+    assert callable(bench_monitor)
+    other = types.ModuleType("bench")
+    other.__file__ = str(tmp_path / "bench.py")
+    monkeypatch.setitem(sys.modules, "bench", other)
+    with pytest.raises(ConfigError, match="another module named bench"):
+        cli_bench.load_harnesses()

@@ -31,15 +31,14 @@
   caregiver's pose read right on 192 frames (:func:`pose_figures`): 98 / 0 and 191 / 192, as
   with OpenCV's own search.
 
-Run ``python -m perception.bench``. scikit-image is needed for the face figures only.
+Run ``python -m bench.perception_speed`` from the checkout. scikit-image is needed for the
+face figures only.
 """
 
 from __future__ import annotations
 
 import json
-import sys
 import time
-import types
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -316,16 +315,6 @@ def bench(frames: int = 240, seed: int = 0, faces: bool = True) -> dict[str, flo
     finally:
         cv2.setNumThreads(old)
 
-
-class _CallableModule(types.ModuleType):
-    """``perception.bench`` is both this module (``python -m perception.bench``) and, called,
-    the :func:`bench` function: ``perception.bench(frames=100)``."""
-
-    def __call__(self, *args: object, **kwargs: object) -> dict[str, float | int]:
-        return bench(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule
 
 if __name__ == "__main__":
     print(json.dumps(bench(), indent=2))

@@ -11,7 +11,8 @@ Timed, best of ``rounds``, in seconds for all frames:
 * ``bag_camera_mcap``, ``bag_camera_db3``: every frame as BGR through
   :class:`~perception.bag.BagCamera` (``paced=False``), for both containers.
 
-Run ``python -m perception.bagbench [FRAMES]`` (needs the ``mcap`` extra); prints JSON.
+Run ``python -m bench.bag_reading [FRAMES]`` from the checkout (needs the ``mcap`` extra);
+prints JSON.
 """
 
 from __future__ import annotations

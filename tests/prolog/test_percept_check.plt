@@ -1,6 +1,6 @@
-/*  plunit tests of relrl_percepts (prolog/percepts.pl) and of relrl's declarations for
+/*  plunit tests of relrl_percept_check (prolog/percept_check.pl) and of relrl's declarations for
     domain files (prolog/declarations.pl). Run from pytest (tests/prolog/test_plunit.py) or:
-        swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_percepts.plt
+        swipl -g run_tests -t halt prolog/relrl.pl tests/prolog/test_percept_check.plt
 */
 :- use_module(library(plunit)).
 :- use_module('../../prolog/relrl').
@@ -51,31 +51,31 @@ facts(Problems, Facts) :-
 
 test(sis_world, [Facts == ['profile(face)']]) :-
     domain(Text), kb_with(Text, KB), sis(V),
-    relrl_percepts:world_problems(KB, V, Problems),
+    relrl_percept_check:world_problems(KB, V, Problems),
     facts(Problems, Facts).
 
 test(episodes_world, [Facts == ['gaze_left(face)', 'helped(face)', 'seen_left(face)']]) :-
     domain(Text), kb_with(Text, KB), episodes(V),
-    relrl_percepts:world_problems(KB, V, Problems),
+    relrl_percept_check:world_problems(KB, V, Problems),
     facts(Problems, Facts).
 
 test(located_and_explained, [Where-Msg == 2-"fact gaze_left(face) can never hold in this \c
      world: it needs pose(face, left), which the world never perceives"]) :-
     domain(Text), kb_with(Text, KB), episodes(V),
-    relrl_percepts:world_problems(KB, V, [problem(_, Where, Msg)|_]).
+    relrl_percept_check:world_problems(KB, V, [problem(_, Where, Msg)|_]).
 
 test(stimulus_never_perceived, [Msg == "stimulus toy is never perceived in this world"]) :-
     kb_with("stimulus(toy).\nresponse(r).\n", KB),
-    relrl_percepts:world_problems(KB, [see(face)], [problem(_, 1, Msg)]).
+    relrl_percept_check:world_problems(KB, [see(face)], [problem(_, 1, Msg)]).
 
 test(recursion_terminates, [Problems == []]) :-
     kb_with("stimulus(face).\nfact(loop(face)).\nloop(X) :- loop(X).\nresponse(r).\n", KB),
-    relrl_percepts:world_problems(KB, [see(face)], Problems).
+    relrl_percept_check:world_problems(KB, [see(face)], Problems).
 
 test(dynamic_may_hold, [Problems == []]) :-
     kb_with(":- dynamic remembered/1.\nstimulus(face).\nfact(remembered(face)).\n\c
              response(r).\n", KB),
-    relrl_percepts:world_problems(KB, [see(face)], Problems).
+    relrl_percept_check:world_problems(KB, [see(face)], Problems).
 
 :- end_tests(world_problems).
 
@@ -83,7 +83,7 @@ test(dynamic_may_hold, [Problems == []]) :-
 
 test(unread, [Unread == [se(face), colour(face, red), see(dog)]]) :-
     domain(Text), kb_with(Text, KB),
-    relrl_percepts:unread_percepts(KB, [se(face), see(face), pose(face, left),
+    relrl_percept_check:unread_percepts(KB, [se(face), see(face), pose(face, left),
                                        colour(face, red), pose(face, left_2), see(dog),
                                        at(face, left)],
                                    Unread).

@@ -1,4 +1,4 @@
-:- module(relrl_perception,
+:- module(relrl_senses,
           [ perceived/3,          % +KB, +Sense, ?What
             sensed/3,             % +Sense, +KB, ?What
             perceived_at/3,       % +KB, ?Stimulus, ?Place

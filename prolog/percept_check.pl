@@ -1,4 +1,4 @@
-:- module(relrl_percepts,
+:- module(relrl_percept_check,
           [ world_problems/3,     % +KB, +Vocabulary, -Problems
             unread_percepts/3     % +KB, +Percepts, -Unread
           ]).
@@ -11,7 +11,7 @@
 /** <module> What a domain perceives, against what a world perceives
 
 A domain reads working memory through percept/1, memory/2, the senses see/1, hear/1,
-smell/1, at/1 and at/2 (relrl_perception). A world (the simulator, the episode world, a
+smell/1, at/1 and at/2 (relrl_senses). A world (the simulator, the episode world, a
 camera) produces only some percepts: its *vocabulary*, a list of percept terms in which a
 variable stands for any value, e.g. [see(face), pose(face, frontal), pose(face, left),
 hear(_)] (the Python side declares them, see the `percepts` package).
@@ -63,7 +63,7 @@ world_problem(KB, Vocabulary, problem(File, Line, Message)) :-
     format(string(Message), "stimulus ~q is never perceived in this world", [Stimulus]).
 
 stimulus_percept(Stimulus, Percept) :-
-    relrl_perception:sense(Sense),
+    relrl_senses:sense(Sense),
     Percept =.. [Sense, Stimulus].
 stimulus_percept(Stimulus, at(Stimulus, _)).
 
@@ -131,7 +131,7 @@ blocked_all([Body|Bodies], KB, V, D, S, Needs) :-
     blocked(KB, V, Body, D, S, Needs),
     blocked_all(Bodies, KB, V, D, S, _).
 
-%   The working-memory element a perception predicate reads (relrl_perception:perceived/3
+%   The working-memory element a perception predicate reads (relrl_senses:perceived/3
 %   for the senses: see(face) reads see(face); see(frontal(face)) is sense_of_fact/3).
 percept_read(percept(E), E).
 percept_read(memory(E, _), E).
@@ -155,7 +155,7 @@ sense_of_fact(Goal, Percept, What) :-
 sense_goal(Goal, Sense, What) :-
     compound(Goal),
     compound_name_arity(Goal, Sense, 1),
-    relrl_perception:sense(Sense),
+    relrl_senses:sense(Sense),
     arg(1, Goal, What).
 
 %   A predicate the domain defines itself (not relrl's, not a library's).
