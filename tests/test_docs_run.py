@@ -132,7 +132,7 @@ SLOW = {
     "relrl run examples/episodes/experiment2.toml --out runs/exp2",
     ".venv/bin/relrl bench",
     ".venv/bin/relrl bench --json runs/bench/results.json",
-    "python -m perception.bench",
+    "python -m bench.perception_speed",
     "python -m perception.fruits",
     "relrl learn examples/worlds/blocks.pl --task stack --episodes 500",
     "relrl learn examples/worlds/blocks.pl --task on --learner ptg --monitor",
