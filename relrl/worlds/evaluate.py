@@ -186,6 +186,7 @@ def evaluate_policy(world_path: str | Path, policy: str | Path, task_text: str, 
             starts = read_states(world, states, task)
             batches = [("states", starts, None)]
         else:
+            world.check_instance(task_text, sizes)  # on(b1, b1), on(b1, b99): one line
             batches = [(str(size), None, size) for size in sizes]
         rows: list[dict[str, Any]] = []
         summary: dict[str, Any] = {}

@@ -160,3 +160,16 @@ def test_evaluate_refuses_a_state_reached_below_its_optimum(policies, tmp_path: 
     assert len(err.splitlines()) == 1
     assert f"{display_path(str(states))}:1: the goal" in err and "fewer than the optimum" in err
     assert not (out / "results.json").exists()
+
+
+@pytest.mark.parametrize("task", ["on(b1, b1)", "on(b1, b99)"])
+def test_evaluate_refuses_a_task_instance_that_cannot_be_reached(policies, tmp_path: Path,
+                                                                 capsys, task: str) -> None:
+    """A task instance whose goal no state of the evaluated sizes holds is one line, exit 2,
+    and nothing written (as relrl learn refuses it)."""
+    out = tmp_path / "bad"
+    assert _evaluate(policies["on"], task, "--sizes", "4", "--episodes", "2",
+                     "--out", str(out)) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot be reached" in err[0], err
+    assert not (out / "results.json").exists()
