@@ -164,6 +164,23 @@ class KnowledgeBase:
             raise EngineError(f"{module}:{name}/{len(arguments)} failed in {self.module}")
         return out
 
+    def api_watched(self, goal: str, *arguments: Term, seconds: float) -> list | None:
+        """Call the layer's ``goal`` with ``arguments`` and one more output argument under
+        the guard's progress watch (a world's calls, prolog/guard.pl progress_watch/2): a
+        rule is stopped once it has run ``seconds`` since the world's last step, however
+        long the whole call. The output's value in a one-element list, or None when the goal
+        fails.
+
+        Raises:
+            QueryTimeout: a rule ran ``seconds`` with no step.
+        """
+        module, predicate = self._prolog.goal(goal)
+        watched, watcher = self._prolog.goal("watched")
+        inner = (":", module, (predicate, *arguments, Var()))
+        values = self._prolog.run((":", watched, (watcher, seconds, inner)), seconds, [1],
+                                  watched=True)
+        return None if values is None else [values[0][2][-1]]
+
     def api_goal(self, goal: str) -> tuple[str, str]:
         """``(module, predicate)`` of the goal ``python_api/2`` names ``goal``.
 

@@ -187,7 +187,8 @@ _WORLDS = {
                "test_sizes": ListOf(int, least=1)},
     "summary": ListOf({"world": str, "task": str, "learner": str, "seeds": int,
                        "train_optimality": float, "train_optimality_min": float,
-                       "test": MapOf({"optimality": Maybe(float)}, int_keys=True),
+                       "test": MapOf({"optimality": Maybe(float), "optimality_min?": Maybe(float),
+                                      "success_min?": Maybe(float)}, int_keys=True),
                        "episodes_to_095": Maybe(float), "memory_positions": Maybe(float)}),
 }
 _LEARN = MapOf({"reached": int, "seeds": int, "steps_to_threshold": Maybe(float),

@@ -44,6 +44,11 @@ LINKED = ("examples", "docs", "prolog", "bench")
 
 #: command (as written, comment left out) -> why it does not run here.
 NOT_RUN: dict[str, str] = {
+    "relrl check --world maze.pl -q": "a reader's own world file (the text describes it); "
+                                      "tests/worlds/test_world_check.py checks these lines",
+    "relrl evaluate runs/unstack/policy.pl --world examples/worlds/blocks.pl --task unstack "
+    "--sizes 10,20,50 --episodes 20": "a policy learned for minutes first; "
+                                      "tests/worlds/test_evaluate.py runs relrl evaluate",
     # the set-up: tests/test_first_hour.py checks `make demo` is `relrl demo` and runs that
     "make demo": "installs Debian packages and a virtual environment; tests/test_first_hour.py "
                  "runs its recipe (relrl demo)",

@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Any
 
 from relrl.bridge.calls import display_path as _display_path
-from relrl.bridge.calls import prolog
 from relrl.engine import Engine, EngineError, call, call_semidet, one
 from relrl.errors import ConfigError, PrologError, QueryTimeout
 from relrl.kb import KnowledgeBase
@@ -335,14 +334,9 @@ class World:
             QueryTimeout: a rule of the world ran :attr:`rule_seconds` (named).
             EngineError: the goal failed.
         """
-        module, predicate = prolog().goal(goal)
-        watched, watcher = prolog().goal("watched")
-        out = Var()
-        inner = (":", module, (predicate, *arguments, out))
         try:
             with self.kb.interruptible():
-                values = prolog().run((":", watched, (watcher, self.rule_seconds, inner)),
-                                      self.rule_seconds, [1], watched=True)
+                values = self.kb.api_watched(goal, *arguments, seconds=self.rule_seconds)
         except QueryTimeout as exc:
             limit = (f"ran longer than {self.rule_seconds:g} s (a rule that never ends? "
                      "--rule-seconds sets the limit)")
@@ -352,9 +346,8 @@ class World:
             raise QueryTimeout(f"{_display_path(str(self.path))}: the world's goal {limit}") \
                 from None
         if values is None:
-            raise EngineError(f"{module}:{predicate}/{len(arguments) + 1} failed in "
-                              f"{self.kb.module}")
-        return values[0][2][-1]
+            raise EngineError(f"{goal}/{len(arguments) + 1} failed in {self.kb.module}")
+        return values[0]
 
     # -- life -------------------------------------------------------------------------------
 

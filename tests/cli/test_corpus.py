@@ -7,8 +7,8 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 273 cases: 198 bad inputs in ``CASES`` and 32 more tests here, 26 in
-``test_outputs.py``, 17 in ``test_nothing_lost.py`` (each parametrized case counted once;
+The corpus holds 275 cases: 199 bad inputs in ``CASES`` and 32 more tests here, 26 in
+``test_outputs.py``, 18 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
 
@@ -298,6 +298,9 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("report-out-unwritable", ["report", "{d}/adir", "--out", "/proc/relrl.md"], ["/proc"]),
     # ---- learn (worlds written in Prolog) ---------------------------------------------------
     ("learn-missing-world", ["learn", "{d}/nope.pl"], ["nope.pl", "no such world file"]),
+    ("evaluate-missing-policy", ["evaluate", "{d}/nope.pl", "--world",
+                                 BLOCKS, "--task", "stack"],
+     ["nope.pl", "no such"]),
     ("learn-world-a-folder", ["learn", "{d}/adir"], ["adir", "no such world file"]),
     ("learn-random-bytes", ["learn", "{d}/random.toml"], ["random.toml"]),
     ("learn-unknown-task", LEARN + ["--task", "fly"], ["fly", "no such task"]),

@@ -77,7 +77,7 @@ def test_without_matplotlib_a_note(tmp_path: Path, monkeypatch) -> None:
     (["--caregiver-param", "reliability=2"], "reliability"),
     (["--caregiver", "nobody"], "unknown caregiver model 'nobody'"),
     (["--param", "etg.alpha=3"], "alpha must be in [0, 1]"),
-    (["--points", "0"], "--points must be at least 1"),
+    (["--points", "0"], "--points must be 1 to 1,000,000,000, not 0"),
 ])
 def test_bad_options_one_line_exit_2(args: list[str], message: str, tmp_path: Path,
                                      capsys) -> None:
