@@ -761,7 +761,7 @@ test(states_syntax_error, [Line == 2]) :-
     states_file(["[on(b1, floor), clear(b1)].", "[on(b1 floor)]."], Path),
     world_read_states(KB, Path, stack, problem(Line, _)).
 
-test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_on/2,highest/1,on/2])"]) :-
+test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_clear/1,goal_on/2,highest/1,on/2])"]) :-
     blocks(KB),
     states_file(["[on(b1, floor), clear(b1)].", "", "[on(b1, floor), fly(b1)]."], Path),
     world_read_states(KB, Path, stack, problem(Line, Msg)).

@@ -237,7 +237,8 @@ def test_a_rule_error_mid_run_keeps_the_policy_learned_before_it(tmp_path: Path,
     written; the folder's record is not left running."""
     import json
 
-    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- aggregate_all(count, member(on(_, _), S), N), N > 5, "
+    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- "
+                                       "aggregate_all(count, member(on(_, _), S), N), N > 5, "
                                        f"{goal}.")
     out = tmp_path / "out"
     proc = relrl("learn", str(world), "--size", "3", "--eval-sizes", "4,8", "--episodes",
@@ -349,7 +350,8 @@ def test_a_failed_experiment_worlds_job_keeps_its_points_and_policy(tmp_path: Pa
     job's evaluation points and the policy it saved before that evaluation are kept."""
     import json
 
-    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- aggregate_all(count, member(on(_, _), S), N), N > 5, "
+    world, line = world_with(tmp_path, "precondition(move(_, _), S) :- "
+                                       "aggregate_all(count, member(on(_, _), S), N), N > 5, "
                                        "atom_length(S, _).")
     out = tmp_path / "out"
     message = one_line(relrl("experiment", "worlds", "--worlds", str(world), "--tasks",
