@@ -322,7 +322,8 @@ def test_a_huge_png_in_a_bag_is_refused_before_decoding(tmp_path: Path, kind: st
     script = ("import sys\nfrom relrl.cli import main\n"
               "try:\n    code = main(['perceive', sys.argv[1]])\n"
               "except SystemExit as e:\n    code = e.code\n"
-              "hwm = [ln.split()[1] for ln in open('/proc/self/status') if ln.startswith('VmHWM')]\n"
+              "hwm = [ln.split()[1] for ln in open('/proc/self/status')\n"
+              "       if ln.startswith('VmHWM')]\n"
               "print(hwm[0], code)\n")
     out = subprocess.run([sys.executable, "-c", script, str(bag)], capture_output=True,
                          text=True, timeout=300, cwd=ROOT)
