@@ -34,12 +34,12 @@ from typing import Any
 
 import numpy as np
 
-from relrl.experiments.fruits import OUTCOMES, PAPER, merge_confusions, rates
+from relrl.experiments.exp2.measures import OUTCOMES, PAPER, merge_confusions, rates
 from relrl.machine import machine_info
 
 __all__ = ["main", "run_job", "summarise"]
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFAULT_SCRIPT = ROOT / "examples" / "episodes" / "experiment2.toml"
 
 
@@ -359,6 +359,3 @@ def _stopped(name: str | None) -> int:
     return 128 + (signal.Signals[name].value if name in signal.Signals.__members__
                   else signal.SIGINT)
 
-
-if __name__ == "__main__":
-    sys.exit(main())
