@@ -107,7 +107,7 @@ def summarise(jobs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """CSV tables, plots, ``results.json`` and ``timing.json``."""
-    from relrl.experiments.report import write_csv, write_json_atomic
+    from relrl.experiments.results import write_csv, write_json_atomic
 
     jobs, summary = results["jobs"], results["summary"]
     files = [out / n for n in ("fig6.csv", "fig6_summary.csv", "table1.csv",
@@ -156,7 +156,7 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         import matplotlib.pyplot as plt
     except ImportError:
         return []
-    from relrl.experiments.report import save_figure
+    from relrl.experiments.results import save_figure
 
     units = sorted({s["time_unit"] for s in summary.values()})
     fig, axes = plt.subplots(1, len(units), figsize=(5.5 * len(units), 3.8), squeeze=False)
