@@ -1,8 +1,9 @@
 """``relrl bench``'s recording figure: a session's time units per second with ``--record``
 against the same session with ``--out`` alone, paired on the simulator.
 
-The session is the real one (:func:`relrl.episodes.run_episode`): the fruits domain, ETG, the
-protocol caregiver with fruits, ``perception`` ``symbolic`` (the simulator's facts; no frames:
+The session is the real one (:func:`relrl.episodes.run_episode`) of
+:func:`bench.episode_script.fruits_episode`: the fruits domain, ETG, the protocol caregiver
+with fruits, ``perception`` ``symbolic`` (the simulator's facts; no frames:
 every time unit's channels are recorded, nothing else) or ``render`` (frames rendered and
 perceived, recorded at the default ``--record-rate``). The loop's rate is timed from inside:
 the session polls its word source once per time unit, and the bench's source notes the time.
@@ -19,24 +20,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["bench_recording"]
+from bench.episode_script import fruits_episode
 
-_SCRIPT = """[episode]
-name = "bench-recording"
-domain = "{domain}"
-seed = 3
-learner = "etg"
-[world]
-perception = "{perception}"
-fruits = ["apple", "lime", "orange"]
-names = {{ lime = "lemon" }}
-[caregiver]
-contact_hold = 1
-[[phase]]
-name = "fruits"
-steps = {steps}
-objects = true
-"""
+__all__ = ["bench_recording"]
 
 
 class _Clock:
@@ -99,8 +85,8 @@ def bench_recording(steps: int = 3000, *, pairs: int = 6,
     with tempfile.TemporaryDirectory(prefix="relrl-bench-rec-") as tmp:
         root = Path(tmp)
         script = root / "bench.toml"
-        script.write_text(_SCRIPT.format(domain=example("domains/fruits.pl"),
-                                         perception=perception, steps=steps))
+        script.write_text(fruits_episode(example("domains/fruits.pl"), name="bench-recording",
+                                         seed=3, steps=steps, perception=perception))
         plain, recorded = [], []
         for i in range(pairs):
             for rec in ((False, True) if i % 2 == 0 else (True, False)):

@@ -138,14 +138,12 @@ undefined_goal(KB, Goal, PI) :-
     PI = Name/Arity,
     \+ defined_in(KB, Goal).
 
+%   Visible: defined in KB, inherited from its import modules (relrl, user, system) or
+%   autoloadable (a library predicate such as last/2 or list_to_assoc/2), which SWI-Prolog
+%   answers without loading the library.
+
 defined_in(KB, Goal) :-
-    (   predicate_property(KB:Goal, defined)
-    ->  true
-    ;   predicate_property(KB:Goal, autoload(_))
-    ->  true
-    ;   functor(Goal, Name, Arity),
-        '$in_library'(Name, Arity, _)
-    ).
+    predicate_property(KB:Goal, visible).
 
 %   Responses used in behaviour and constraint rules must be declared.
 

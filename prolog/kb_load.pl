@@ -7,6 +7,7 @@
 :- use_module(library(error)).
 :- use_module(library(lists)).
 :- use_module(library(apply)).
+:- use_module(library(modules), []).   % its destroy_module/1: see destroy_module/1 below
 :- use_module(guard).
 :- use_module(engine, [engine_forget/1]).
 
@@ -66,8 +67,7 @@ gw_drop_kb(Module) :-
     ->  forall(( source_file_property(File, load_context(Module, _, _)),
                  \+ source_file_property(File, module(_)) ),
                unload_file(File)),
-        retractall(system:'$load_context_module'(_, Module, _)),
-        '$destroy_module'(Module),
+        destroy_module(Module),
         garbage_collect_clauses,
         garbage_collect_atoms
     ;   true
@@ -77,6 +77,19 @@ gw_drop_kb(Module) :-
 %   clauses and compiled programs held is freed now, not once some 10,000 atoms more
 %   (the atom collector's margin) have been made, which a process stepping one knowledge
 %   base after another may take thousands of them to reach.
+
+%!  destroy_module(+Module) is det.
+%
+%   Destroy the temporary module Module, its clauses and its records of loaded files.
+%   SWI-Prolog 9.0.4 has no public predicate for this outside the goal of
+%   in_temporary_module/3, whose module lives only while that goal runs; a knowledge base
+%   lives across many calls from Python. library(modules) destroys its temporary modules with
+%   its own destroy_module/1, which it does not export: this is the one place relrl calls it,
+%   so that SWI-Prolog's internals stay SWI-Prolog's business. tests/prolog/test_kb_load.plt
+%   fails if it stops destroying the module.
+
+destroy_module(Module) :-
+    modules:destroy_module(Module).
 
 %!  gw_load(+File, +Module, -Problems:list) is det.
 %

@@ -59,6 +59,18 @@ documentation, which is what programs should call.
 kb(KB) :-
     context_module(KB).
 
+%   relrl_domains(Name) is the folder of the shipped domains, examples/domains beside this
+%   file's folder in a checkout and in an installed package alike. A domain takes their
+%   shared parts from it wherever the domain file lies: :- include(relrl_domains(socialize)).
+
+:- multifile user:file_search_path/2.
+:- dynamic user:file_search_path/2.
+
+user:file_search_path(relrl_domains, Dir) :-
+    module_property(relrl, file(File)),
+    file_directory_name(File, PrologDir),
+    directory_file_path(PrologDir, '../examples/domains', Dir).
+
 %!  see(?What) is nondet.
 %!  hear(?What) is nondet.
 %!  smell(?What) is nondet.

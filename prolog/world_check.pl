@@ -150,9 +150,7 @@ undefined(KB, Goal, Name/Arity) :-
     callable(Goal),
     Goal \= _:_,
     functor(Goal, Name, Arity),
-    \+ predicate_property(KB:Goal, defined),
-    \+ predicate_property(KB:Goal, autoload(_)),
-    \+ '$in_library'(Name, Arity, _).
+    \+ predicate_property(KB:Goal, visible).   % defined, inherited or autoloadable
 
 % ---- what running it shows -----------------------------------------------------------------
 

@@ -139,14 +139,11 @@ forbidden(name_object) :- \+ see(object).
 
 % ---- Necessities -------------------------------------------------------------------------
 
-% socialize, with the parameters of section 5.2. The paper's input weights are positive
-% magnitudes; declared as satisfiers they enter Eq. 1 negated, so contact lowers the need
-% (see docs/engine.md for the sign convention).
-necessity(socialize).
-unit(socialize, bias, 1.00).
-unit(socialize, recurrent_weight, 1.00).
-unit(socialize, delta, 0.20).
-unit(socialize, threshold, 0.50).
+% socialize, with the parameters of section 5.2 (relrl_domains(socialize) is
+% examples/domains/socialize.pl). The paper's input weights are positive magnitudes;
+% declared as satisfiers they enter Eq. 1 negated, so contact lowers the need (see
+% docs/engine.md for the sign convention).
+:- include(relrl_domains(socialize)).
 
 satisfier(socialize, hear(attention), 1.50).
 satisfier(socialize, see(frontal(face)), 0.95).

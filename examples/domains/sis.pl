@@ -132,11 +132,8 @@ response(look(right)).
 
 % ---- Necessities -------------------------------------------------------------------------
 
-necessity(socialize).
-unit(socialize, bias, 1.00).
-unit(socialize, recurrent_weight, 1.00).
-unit(socialize, delta, 0.20).
-unit(socialize, threshold, 0.50).
+% The paper's socialize unit (section 5.2), shared by the shipped domains.
+:- include(relrl_domains(socialize)).
 
 satisfier(socialize, hear(attention), 1.50).
 satisfier(socialize, see(gaze_frontal(face)), 0.95).

@@ -24,7 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run the quick Experiment 1 and say where everything is."""
     from relrl.errors import ConfigError
-    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.results import OUTPUTS, summary_table
     from relrl.experiments.runner import command_signals
     from relrl.experiments.sis import SISConfig, run_sis
     from relrl.outdir import OutDir

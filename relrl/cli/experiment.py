@@ -412,7 +412,7 @@ def run(args: argparse.Namespace) -> int:
         except (ValueError, OSError, io.UnsupportedOperation):
             pass  # no real stderr (embedded): no stack dumps, nothing else changes
     from relrl.experiments import sis as sis_experiment
-    from relrl.experiments.report import OUTPUTS, summary_table
+    from relrl.experiments.results import OUTPUTS, summary_table
 
     if args.name == "scaling":
         return _run_scaling(args)

@@ -142,7 +142,7 @@ def _recording_ended(s: dict) -> str:
 
 
 def _report(s: dict) -> str:
-    from relrl.experiments.fruits import report_lines
+    from relrl.experiments.exp2.measures import report_lines
 
     cgi = "n/a" if s["cgi"] is None else f"{s['cgi']:.3f}"
     head = (f"{s['episode']}: {s['units']} time units ({s['time_unit']}s, {s['steps']} control "

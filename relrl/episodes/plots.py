@@ -21,7 +21,7 @@ def plot_episode(out: Path, summary: dict[str, Any], rewards: list[float]) -> li
         import matplotlib.pyplot as plt
     except ImportError:
         return []
-    from relrl.experiments.report import save_figure
+    from relrl.experiments.results import save_figure
 
     files = []
     # on devices, evaluations and naming ran on the scripted world: the titles say so

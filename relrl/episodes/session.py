@@ -157,7 +157,7 @@ class _Run:
     """The state of one episode run."""
 
     def __init__(self, episode: Episode, opts: RunOptions) -> None:
-        from relrl.experiments.fruits import Naming
+        from relrl.experiments.exp2.measures import Naming
         from relrl.kb import KnowledgeBase
         from relrl.learners import make_learner
         from relrl.loop import Agent
@@ -265,7 +265,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
     """
     from relrl.episodes.devices import RecordingEnded
     from relrl.errors import ConfigError
-    from relrl.experiments import fruits
+    from relrl.experiments.exp2 import measures
     from relrl.loop import Interaction
 
     opts = opts or RunOptions()
@@ -310,7 +310,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                        f"after {run.units} {unit_name} of learning (paused meanwhile)")
                       + f": {len(eval_seeds)} runs of {ev['steps']} {unit_name} without "
                         f"learning, on the {where['evaluation']}")
-            point = fruits.evaluate_cgi(
+            point = measures.evaluate_cgi(
                 run.agent, episode, eval_seeds, stop,
                 on_run=lambda k: _status(opts, activity, detail, done=k,
                                          total=len(eval_seeds)))
@@ -329,7 +329,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
             # learning resumes where it stopped: the world keeps its time line (and phase)
 
         cycles = episode.time_unit == "interaction"
-        bound = fruits.unit_bound(episode) if cycles else 1
+        bound = measures.unit_bound(episode) if cycles else 1
         shown = None  # the phase the monitor's status line names
         ended: dict[str, Any] | None = None  # where a bag as the camera ended
         for unit in range(1, episode.steps + 1):
@@ -381,7 +381,7 @@ def run_episode(episode: Episode, opts: RunOptions | None = None,
                         "and names it, and keeps learning; execution "
                         f"{k + 1} of {episode.naming['executions']}, on the "
                         f"{where['naming']}", done=k, total=episode.naming["executions"])
-                res = fruits.naming_execution(run.agent, episode, episode.seed * 1000 + k,
+                res = measures.naming_execution(run.agent, episode, episode.seed * 1000 + k,
                                               stop=stop)
                 res["on"] = where["naming"]
                 if stop():
@@ -508,7 +508,7 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None,
              ended: dict[str, Any] | None = None) -> dict[str, Any]:
     """The summary; ``ended`` is where a recording as the camera ended (``{"t", "seconds"}``):
     the session's normal end, so the summary is not partial for the time units it lacked."""
-    from relrl.experiments import fruits
+    from relrl.experiments.exp2 import measures
 
     m = run.metrics
     c = m.cgi()
@@ -534,7 +534,7 @@ def _summary(run: _Run, *, stopped: bool, why: str | None = None,
     if run.curve:
         summary["evaluation"] = run.curve
     if run.executions:
-        summary["table1"] = fruits.table1(run.executions)
+        summary["table1"] = measures.table1(run.executions)
     return summary
 
 

@@ -318,7 +318,7 @@ def _sizes_summary(jobs: list[dict[str, Any]], config: ScalingConfig,
 
 def growth(summary: dict[str, Any]) -> dict[str, Any]:
     """Per learner, the log-log slope of memory against world size (1: linear)."""
-    from relrl.experiments.report import loglog_slope
+    from relrl.experiments.results import loglog_slope
 
     out = {}
     for learner, rows in summary["learn"].items():

@@ -13,7 +13,7 @@ import platform
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import (
+from relrl.experiments.results import (
     pyplot_or_note,
     save_figure,
     skip_plots,

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from relrl.experiments.protocol import codes_met
-from relrl.experiments.report import aggregate, write_outputs
+from relrl.experiments.results import aggregate, write_outputs
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.learners import DOMAINS, learners
 from relrl.machine import machine_info

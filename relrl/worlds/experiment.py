@@ -25,7 +25,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from relrl.experiments.report import pyplot_or_note, save_figure, skip_plots, write_csv
+from relrl.experiments.results import pyplot_or_note, save_figure, skip_plots, write_csv
 from relrl.experiments.runner import raise_kept, run_jobs
 from relrl.learners import WORLDS, learners
 from relrl.machine import machine_info

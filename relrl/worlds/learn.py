@@ -286,7 +286,7 @@ def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int
     sizes (linear growth: the two equal); and ``slope``, the exponent k of cost ∝ size^k
     fitted on logarithms over all the sizes (linear growth: k = 1).
     """
-    from relrl.experiments.report import loglog_slope
+    from relrl.experiments.results import loglog_slope
 
     per: dict[int, list[float]] = {s: [] for s in sizes}
     for _ in range(rounds):

@@ -205,7 +205,7 @@ def test_a_folder_of_other_files_is_refused_and_never_emptied(capsys, tmp_path):
 
 def _quick_sis(config, out, workers=1, **engine):
     """Stands in for Experiment 1 (the folder policy is under test, not the experiment)."""
-    from relrl.experiments.report import write_json_atomic
+    from relrl.experiments.results import write_json_atomic
 
     out = Path(out)
     write_json_atomic(out / "results.json", {"seeds": config.seeds})
@@ -345,7 +345,7 @@ def test_a_folder_link_planted_during_the_run_is_not_followed(capsys, tmp_path, 
     elsewhere.mkdir()
 
     def planting_sis(config, out, workers=1, **engine):
-        from relrl.experiments.report import write_json_atomic
+        from relrl.experiments.results import write_json_atomic
 
         (Path(out) / "sub").symlink_to(elsewhere)  # after the claim checked the folder
         write_json_atomic(Path(out) / "sub" / "results.json", {"seeds": config.seeds})

@@ -12,7 +12,7 @@ import pytest
 
 from relrl.episodes import EpisodeError, EpisodeWorld, RunOptions, parse_episode, run_episode
 from relrl.episodes.script import TIME_UNITS
-from relrl.experiments.fruits import Naming, merge_confusions, rates, report_lines, table1
+from relrl.experiments.exp2.measures import Naming, merge_confusions, rates, report_lines, table1
 from relrl.learners import DOMAINS, learners
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -202,7 +202,7 @@ def test_symbolic_run_without_features_says_so(tmp_path) -> None:
 
 @pytest.mark.slow
 def test_sweep_writes_tables_and_plots(tmp_path) -> None:
-    from relrl.experiments.exp2 import main
+    from relrl.experiments.exp2.sweep import main
 
     path = tmp_path / "small.toml"
     path.write_text(script(PHASES + "[evaluation]\nevery = 10\nruns = 2\nsteps = 5\n"))

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from relrl.episodes import RunOptions, parse_episode, run_episode
-from relrl.experiments.fruits import OUTCOMES, PAPER, rates
+from relrl.experiments.exp2.measures import OUTCOMES, PAPER, rates
 from relrl.speech import Recognizer, Speaker, SpeechError, sentence_for, synthesise
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from relrl.cli import main
-from relrl.experiments.report import plot
+from relrl.experiments.results import plot
 from relrl.experiments.sis import SISConfig, run_job
 
 SMALL = ["--points", "2", "--eval-runs", "2", "--eval-steps", "100", "--block", "300"]

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from bench.episode_script import fruits_episode
 from tests.conftest import default_signals
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -27,26 +28,9 @@ def episode(tmp_path: Path, steps: int = 200, perception: str = "render",
             extra: str = "") -> Path:
     """A short Experiment-2-like script (protocol caregiver with fruits)."""
     path = tmp_path / "short.toml"
-    path.write_text(f"""[episode]
-name = "short"
-domain = "{FRUITS}"
-seed = 5
-learner = "etg"
-policy_save = "policy.pl"
-[world]
-perception = "{perception}"
-fruits = ["apple", "lime", "orange"]
-names = {{ lime = "lemon" }}
-[caregiver]
-contact_hold = 1
-[[phase]]
-name = "no objects"
-steps = 10
-objects = false
-[[phase]]
-name = "fruits"
-steps = {steps - 10}
-{extra}""")
+    path.write_text(fruits_episode(FRUITS, name="short", seed=5, steps=steps,
+                                   perception=perception, warm_up=10, policy_save="policy.pl",
+                                   extra=extra))
     return path
 
 

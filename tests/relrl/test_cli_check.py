@@ -77,6 +77,18 @@ def test_bad_domain_one_line_exit_2(case: str, write_domain, capsys) -> None:
     assert "Traceback" not in err
 
 
+def test_library_predicates_count_as_defined_others_do_not(write_domain, capsys) -> None:
+    """A rule may call an autoloadable library predicate (library(ugraphs), library(heaps),
+    library(lists)); a predicate defined nowhere is reported."""
+    path = write_domain("stimulus(face).\nresponse(r).\nfact(f(face)).\n"
+                        "f(face) :- vertices_edges_to_ugraph([a], [], _), empty_heap(_), "
+                        "last([1], _).\n"
+                        "fact(g(face)).\ng(face) :- nothere(face).\n")
+    assert main(["check", "--quiet", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"{path}:6: g/1 calls undefined predicate nothere/1", "1 problem"], err
+
+
 def test_missing_file_exit_2(capsys) -> None:
     assert main(["check", "nowhere/none.pl"]) == 2
     assert "nowhere/none.pl: error: no such file" in capsys.readouterr().err

@@ -5,13 +5,16 @@ percept the domain does not know."""
 from __future__ import annotations
 
 import io
+import shutil
+import subprocess
 
 import pytest
 
 from relrl.cli import main
 from relrl.kb import KnowledgeBase
 from relrl.shell import Shell
-from tests.conftest import FRUITS, SIS
+from relrl.terms import Var
+from tests.conftest import FRUITS, ROOT, SIS
 
 INTERLEAVED = """\
 stimulus(face).
@@ -47,6 +50,30 @@ def test_a_domain_spreads_over_files(write_domain) -> None:
         assert kb.declarations("response") == [("look", "centre"), ("look", "left"),
                                                ("look", "right")]
         assert kb.declarations("stimulus") == ["face", "object", "attention"]
+
+
+SOCIALIZE = {("socialize", "bias"): 1.0, ("socialize", "recurrent_weight"): 1.0,
+             ("socialize", "delta"): 0.2, ("socialize", "threshold"): 0.5}
+
+
+@pytest.mark.parametrize("domain", [SIS, FRUITS], ids=["sis", "fruits"])
+def test_a_copied_domain_still_includes_the_shared_socialize_unit(domain, tmp_path) -> None:
+    """The shipped domains include the socialize unit through relrl_domains(socialize), not
+    by a path beside them: a copy in a folder of its own loads, through relrl and in plain
+    swipl, with the unit's parameters."""
+    copy = tmp_path / domain.name
+    shutil.copy(domain, copy)
+    with KnowledgeBase(copy) as kb:
+        assert kb.declarations("necessity") == ["socialize"]
+        units = {(n, p): v for _, n, p, v in kb.find("unit", Var(), Var(), Var())}
+    assert units == SOCIALIZE
+    goal = ("forall(unit(N, P, V), format('~w ~w ~w~n', [N, P, V])), halt")
+    proc = subprocess.run(["swipl", "-q", "-g", goal, "-t", "halt(1)",
+                           str(ROOT / "prolog" / "relrl.pl"), str(copy)],
+                          capture_output=True, text=True, cwd=tmp_path, timeout=60)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    assert {tuple(line.split()[:2]): float(line.split()[2])
+            for line in proc.stdout.splitlines()} == SOCIALIZE
 
 
 WRONG_WORLD = """\

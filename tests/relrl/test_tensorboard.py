@@ -87,7 +87,7 @@ def _curve(point: int, cgi: float) -> dict:
 
 
 def test_an_experiment_writes_a_run_per_learner_and_per_job(tmp_path: Path) -> None:
-    from relrl.experiments.report import tensorboard_runs
+    from relrl.experiments.results import tensorboard_runs
 
     results = {"summary": {"etg": {"curve": [_curve(0, 0.2), _curve(1, 0.6)],
                                    "eye_contacts": {"cumulative_mean": [0.5, 1.0, 1.5]}}},

@@ -43,6 +43,18 @@ def test_base_world_is_valid(tmp_path: Path, capsys) -> None:
     assert _check(_world(tmp_path, BASE), capsys) == (0, [])
 
 
+def test_check_world_library_predicates_count_as_defined(tmp_path: Path, capsys) -> None:
+    """A world may call autoloadable library predicates; a predicate defined nowhere is
+    still an error."""
+    text = BASE + ("ok(S) :- vertices_edges_to_ugraph([a], [], _), empty_heap(_), "
+                   "last([S], S).\n")
+    good = text.replace("memberchk(at(3), S).", "memberchk(at(3), S), ok(S).")
+    assert _check(_world(tmp_path, good), capsys) == (0, [])
+    bad = text.replace("memberchk(at(3), S).", "memberchk(at(3), S), nowhere(S).")
+    code, err = _check(_world(tmp_path, bad, "bad.pl"), capsys)
+    assert code == 2 and any("goal/2 calls undefined predicate nowhere/1" in e for e in err), err
+
+
 def test_check_world_unreachable_goal_is_an_error(tmp_path: Path, capsys) -> None:
     path = _world(tmp_path, BASE.replace("memberchk(at(3), S).", "memberchk(at(5), S)."))
     code, lines = _check(path, capsys)

@@ -34,12 +34,12 @@ from typing import Any
 
 import numpy as np
 
-from relrl.experiments.fruits import OUTCOMES, PAPER, merge_confusions, rates
+from relrl.experiments.exp2.measures import OUTCOMES, PAPER, merge_confusions, rates
 from relrl.machine import machine_info
 
 __all__ = ["main", "run_job", "summarise"]
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFAULT_SCRIPT = ROOT / "examples" / "episodes" / "experiment2.toml"
 
 
@@ -107,7 +107,7 @@ def summarise(jobs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) -> list[Path]:
     """CSV tables, plots, ``results.json`` and ``timing.json``."""
-    from relrl.experiments.report import write_csv, write_json_atomic
+    from relrl.experiments.results import write_csv, write_json_atomic
 
     jobs, summary = results["jobs"], results["summary"]
     files = [out / n for n in ("fig6.csv", "fig6_summary.csv", "table1.csv",
@@ -156,7 +156,7 @@ def _plots(out: Path, summary: dict[str, Any]) -> list[Path]:
         import matplotlib.pyplot as plt
     except ImportError:
         return []
-    from relrl.experiments.report import save_figure
+    from relrl.experiments.results import save_figure
 
     units = sorted({s["time_unit"] for s in summary.values()})
     fig, axes = plt.subplots(1, len(units), figsize=(5.5 * len(units), 3.8), squeeze=False)
@@ -359,6 +359,3 @@ def _stopped(name: str | None) -> int:
     return 128 + (signal.Signals[name].value if name in signal.Signals.__members__
                   else signal.SIGINT)
 
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from relrl.experiments.report import cgi_figure, plot
+from relrl.experiments.results import cgi_figure, plot
 
 
 def _summary(points: int = 5) -> dict:
@@ -53,7 +53,7 @@ def test_the_figures_are_written(tmp_path: Path) -> None:
 def test_loglog_slope_is_the_growth_exponent() -> None:
     """cost ∝ size^k: k from all the points, whatever the constant; None without two sizes
     or with a value that cannot be logged."""
-    from relrl.experiments.report import loglog_slope
+    from relrl.experiments.results import loglog_slope
 
     assert loglog_slope([3, 6, 12], [5.0, 20.0, 80.0]) == pytest.approx(2.0)
     assert loglog_slope([3, 5, 10], [7.0, 7.0, 7.0]) == pytest.approx(0.0)

@@ -1,8 +1,7 @@
-"""Experiment 2 of da Silva & Romero (2012, section 5.2): gaze following with fruits, then
-declarative pointing (naming the fruit), on the episode world.
+"""Experiment 2's two measurements (da Silva & Romero 2012, section 5.2).
 
 The protocol is an episode script (``examples/episodes/experiment2.toml``, run by
-``relrl run``); this module holds its two measurements:
+``relrl run``); this module holds what it measures:
 
 * :func:`evaluate_cgi` -- learning is interrupted and the robot is evaluated by ``runs`` runs
   of ``steps`` time units, greedy and without learning, the fruit placed by a pre-established
