@@ -139,6 +139,7 @@ SLOW = {
     ".venv/bin/relrl bench --json runs/bench/results.json",
     "python -m bench.perception_speed",
     "python -m perception.fruits",
+    "python -m perception.fruits --plain",
     "relrl learn examples/worlds/blocks.pl --task stack --episodes 500",
     "relrl learn examples/worlds/blocks.pl --task on --learner ptg --monitor",
     "relrl learn examples/worlds/blocks_moves.pl --task on --out runs/on",
