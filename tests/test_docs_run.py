@@ -83,6 +83,10 @@ NOT_RUN: dict[str, str] = {
         "hours on two cores; docs/results/exp2 is its run",
     "relrl experiment worlds --out runs/worlds": "the worlds benchmark, about an hour; "
                                                  "docs/results/worlds is its run",
+    "relrl experiment worlds --worlds examples/worlds/blocks.pl,examples/worlds/delivery.pl "
+    "--learners tg --seeds 0-9 --workers 2 --no-speed --out runs/worlds":
+        "the ten-seed benchmark of worlds.md's results, tens of minutes on two cores; "
+        "docs/results/worlds is its run",
     "relrl report runs/worlds": "renders the run of the line before it (an hour); "
                                 "docs/outputs.md runs relrl report on a shipped run",
     ".venv/bin/relrl experiment scaling --world colours=3,kinds=2,scene=true --sizes 5,9,17 "
