@@ -26,7 +26,7 @@ TEST_EXTRAS := dev,speech,monitor,ray,mcap,foxglove
 #   make sb3 TORCH="torch==2.13.0+cpu --extra-index-url https://download.pytorch.org/whl/cpu"
 TORCH ?= torch==2.13.0+cpu
 
-.PHONY: demo test check sb3 setup setup-demo setup-test debs-demo debs-test lint clean
+.PHONY: demo test check sb3 test-sb3 setup setup-demo setup-test debs-demo debs-test lint clean
 
 setup: setup-test
 setup-demo: debs-demo $(VENV)/.installed-demo
@@ -85,6 +85,14 @@ sb3: setup-demo
 	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),sb3]'
 	$(BIN)/python examples/sb3_shared_attention.py --algo ppo --steps 20000 --check --logdir runs/sb3
 	$(BIN)/python examples/sb3_shared_attention.py --algo dqn --steps 20000 --check --logdir runs/sb3
+
+# The tests marked `sb3` (docs/rl-tools.md's Stable-Baselines3 snippet, run as written), which
+# need torch and Stable-Baselines3: the tests' set-up, torch's CPU build, then SB3. `make test`
+# and `make check` deselect them (tests/conftest.py).
+test-sb3: setup-test
+	$(BIN)/pip install -q $(TORCH)
+	$(BIN)/pip install -q -e '.[$(DEMO_EXTRAS),$(TEST_EXTRAS),sb3]'
+	$(BIN)/python -m pytest -m sb3
 
 lint: setup-test
 	$(BIN)/ruff check relrl perception head tests bench

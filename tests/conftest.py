@@ -1,4 +1,5 @@
-"""Shared fixtures: paths of the example domains and a factory for small domain files."""
+"""Shared fixtures: paths of the example domains and a factory for small domain files; the
+``sb3`` selection."""
 
 from __future__ import annotations
 
@@ -32,3 +33,14 @@ def default_signals() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
 
 
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Tests marked ``sb3`` need Stable-Baselines3 and torch, which only ``make test-sb3``
+    installs (and then runs them, ``pytest -m sb3``). They run when the ``-m`` expression
+    names ``sb3``; otherwise they are deselected (counted as deselected; neither run nor
+    skipped), so ``make test`` and ``make check`` do not need PyTorch."""
+    if "sb3" in (config.getoption("markexpr") or ""):
+        return
+    kept = [item for item in items if item.get_closest_marker("sb3") is None]
+    if len(kept) < len(items):
+        config.hook.pytest_deselected(items=[i for i in items if i not in kept])
+        items[:] = kept

@@ -15,7 +15,9 @@ real devices, placeholders a reader replaces, runs of hours, the set-up commands
 (``tests/test_first_hour.py`` checks ``make demo`` and runs README.md's first hour). An
 entry that no block holds any more fails, so the list stays the docs' own. A command that
 reads what another page's command writes has that command in :data:`BEFORE`. Commands
-that take minutes are in :data:`SLOW` (``-m "not slow"`` leaves them out). In a Python
+that take minutes are in :data:`SLOW` (``-m "not slow"`` leaves them out). A Python block
+that needs a package the tests' set-up does not install is in :data:`PYTHON_NEEDS` with the
+marker of the selection that installs it (``sb3``: ``make test-sb3``). In a Python
 block, ``print(...)  # VALUE`` shows what it prints when VALUE is a Python literal
 (``...`` in it: a sketch, not checked). A failure names the block's ``file:line``, the
 command and why.
@@ -129,10 +131,13 @@ BEFORE: dict[str, str] = {
 }
 
 #: a line of a Python block -> why that block does not run here.
-PYTHON_NOT_RUN: dict[str, str] = {
-    "from stable_baselines3 import PPO": "Stable-Baselines3 and torch, which `make sb3` "
-    "installs and runs (examples/sb3_shared_attention.py makes the same calls); the tests' "
-    "set-up has neither",
+PYTHON_NOT_RUN: dict[str, str] = {}
+
+#: a line of a Python block -> the marker of the selection that installs what the block needs:
+#: ``sb3``, Stable-Baselines3 and torch (``make test-sb3``; tests/conftest.py deselects these
+#: unless ``-m`` names the marker).
+PYTHON_NEEDS: dict[str, str] = {
+    "from stable_baselines3 import PPO": "sb3",
 }
 
 #: commands (as written) that take minutes: run with ``-m slow``.
@@ -143,6 +148,7 @@ SLOW = {
     ".venv/bin/relrl bench --json runs/bench/results.json",
     "python -m bench.perception_speed",
     "python -m perception.fruits",
+    "python -m perception.fruits --plain",
     "relrl learn examples/worlds/blocks.pl --task stack --episodes 500",
     "relrl learn examples/worlds/blocks.pl --task on --learner ptg --monitor",
     "relrl learn examples/worlds/blocks_moves.pl --task on --out runs/on",
@@ -249,6 +255,8 @@ def _params() -> list:
             continue
         slow = block.lang != "python" and any(c in SLOW for c, _ in commands(block))
         marks = [pytest.mark.slow] if slow or _slow_python(block) else []
+        marks += [getattr(pytest.mark, PYTHON_NEEDS[x.strip()]) for x in block.lines
+                  if block.lang == "python" and x.strip() in PYTHON_NEEDS]
         params.append(pytest.param(block, id=block.where, marks=marks))
     return params
 
@@ -380,7 +388,8 @@ def test_every_block_says_what_it_is() -> None:
 def test_every_listed_command_is_still_in_the_docs() -> None:
     written = {c for b in all_blocks() if b.lang in RUN - {"python"} for c, _ in commands(b)}
     python = {x.strip() for b in all_blocks() if b.lang == "python" for x in b.lines}
-    stale = sorted((set(NOT_RUN) | SLOW) - written) + sorted(set(PYTHON_NOT_RUN) - python)
+    stale = sorted((set(NOT_RUN) | SLOW) - written) + \
+        sorted((set(PYTHON_NOT_RUN) | set(PYTHON_NEEDS)) - python)
     assert not stale, "listed in tests/test_docs_run.py but in no block: " + "; ".join(stale)
 
 

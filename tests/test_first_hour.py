@@ -129,3 +129,15 @@ def test_every_first_hour_command_runs_as_written(tmp_path: Path) -> None:
     assert re.search(r"leaf \[\d+\] state \d+", text)                  # the tree, as text
     assert re.search(r"R = look\(\w+\)", text)                        # a query's answers
     assert "is valid" in text                                          # the copied domain
+
+    # the demo and `relrl report` on its run (runs/demo-YYYYMMDD-HHMMSS) count the same
+    # evaluation points
+    demo = re.search(r"(\d+) evaluation points", outputs[".venv/bin/relrl demo"])
+    runs = sorted((tmp_path / "runs").glob("demo-*"))
+    assert len(runs) == 1, runs
+    report = subprocess.run([".venv/bin/relrl", "report", str(runs[0].relative_to(tmp_path))],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=120)
+    assert report.returncode == 0, report.stderr
+    counted = re.search(r"(\d+) evaluation points", report.stdout)
+    assert demo and counted, (outputs[".venv/bin/relrl demo"], report.stdout)
+    assert demo[1] == counted[1], (demo[0], counted[0])
