@@ -30,6 +30,7 @@
 :- use_module(rules).
 :- use_module(engine).
 :- use_module(kbstate).
+:- use_module(guard, [progress_mark/0]).
 :- use_module(world_bias).
 
 /** <module> Worlds written in Prolog
@@ -260,13 +261,9 @@ world_next(KB, Goal, S0, A, S, outcome(R, Reached)) :-
     ->  R = 1
     ;   R = 0
     ),
-    progress.
-
-%   A step of the world is done: the gateway's time limit of a batch of episodes counts
-%   from here (relrl_guard:progress_watch/2 reads this flag), so a rule that loops is
-%   stopped after the limit however long the batch runs.
-progress :-
-    flag(relrl_progress, N, N + 1).
+    progress_mark.      % the gateway's time limit of a batch of episodes counts from
+                        % here (relrl_guard:progress_watch/2), so a rule that loops is
+                        % stopped after the limit however long the batch runs
 
 %!  world_view(+KB, +Goal, +State, -View:list) is det.
 %
@@ -464,7 +461,7 @@ run_episode(Run, Size, S0, Goal, ep(Size, Goal, Steps, Return, Reached, Optimal,
     world_actions(KB, S0, A0),
     steps(Run, Goal, S0, V0, A0, 0, Bound, 0, Steps, Return, Reached, [], Examples, Trace),
     (   Run = run(_, Learner, learn, episode, _, _)
-    ->  forall(member(T, Examples), ( learner_update(Learner, KB, T), progress ))
+    ->  forall(member(T, Examples), ( learner_update(Learner, KB, T), progress_mark ))
     ;   true
     ).
 
