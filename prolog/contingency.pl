@@ -53,13 +53,16 @@ satiation (all numbers; the readings of the paper behind each are in docs/engine
 %
 %     rules(Authored, Learned, Matched)
 %       Authored  a list of a(Id, Antecedent, Response, Necessity, Fitness), in Id order
-%       Learned   an assoc from k(Code, Necessity, Response) to f(Fitnesses): the fitness
-%                 of each learned rule of that key, oldest first (a key has one rule unless
-%                 a response other than the chosen one was emitted and learned from twice)
+%       Learned   an assoc from k(Code, Necessity) to rs(Pairs), Pairs Response-f(Fitnesses)
+%                 in the order learned: the fitness of each learned rule of that state,
+%                 necessity and response, oldest first (one rule unless a response other
+%                 than the chosen one was emitted and learned from twice). A choice looks
+%                 its state and necessity up once, then each response in a short list.
 %       Matched   the rules the last choice used: learned(Code, N, R) and authored(Id)
 %                 keys, or [] (none, or already learned from)
 %
-%   A fitness changes in place in its a/5 or f/1 term; a new learned rule puts a new assoc
+%   A fitness changes in place in its a/5 or f/1 term; a new learned rule extends its rs/1
+%   list (a short copy), or, in a state and necessity new to the learner, puts a new assoc
 %   (a copy: nb_setarg/3); the last choice's matches replace the old ones (a short list).
 
 param(Params, Name, Value) :-
@@ -96,11 +99,11 @@ contingency_init(KB) :-
 
 contingency_choose(KB, Code, N, Allowed, Params, Action) :-
     Allowed \== [],
-    slices(KB, Code, N, Allowed, Params, Slices, Total),
+    rules(KB, Rules),
+    slices(KB, Rules, Code, N, Allowed, Params, Slices, Total),
     random(X0),
     X is X0 * Total,
     pick(Slices, X, slice(Action, _, Matches)),
-    rules(KB, Rules),
     nb_setarg(3, Rules, Matches).
 
 %!  contingency_probabilities(+KB, +Code, +N, +Allowed, +Params, -Pairs) is det.
@@ -111,20 +114,21 @@ contingency_choose(KB, Code, N, Allowed, Params, Action) :-
 
 contingency_probabilities(KB, Code, N, Allowed, Params, Pairs) :-
     must_be(list, Allowed),
-    slices(KB, Code, N, Allowed, Params, Slices, Total),
+    rules(KB, Rules),
+    slices(KB, Rules, Code, N, Allowed, Params, Slices, Total),
     findall(R-P, ( member(slice(R, F, _), Slices), P is F / Total ), Pairs).
 
-slices(KB, Code, N, Allowed, Params, Slices, Total) :-
+slices(KB, rules(Authored, Learned, _), Code, N, Allowed, Params, Slices, Total) :-
     param(Params, default_fitness, Default),
     param(Params, default_always, Always),
-    rules(KB, Rules),
-    maplist(slice(KB, Rules, Code, N, Default, Always), Allowed, Slices),
+    here(Learned, Code, N, Here),
+    maplist(slice(KB, Authored, Here, Code, N, Default, Always), Allowed, Slices),
     sum_list_of(Slices, Total).
 
 %   A response's slice: its matching rules' fitness, or the default without one; with
 %   default_always the default stays in every slice and the rules' fitness is added to it.
-slice(KB, Rules, Code, N, Default, Always, R, slice(R, F, Matches)) :-
-    findall(M-Fm, matching_rule(KB, Rules, Code, N, R, M, Fm), Pairs),
+slice(KB, Authored, Here, Code, N, Default, Always, R, slice(R, F, Matches)) :-
+    findall(M-Fm, matching_rule(KB, Authored, Here, Code, N, R, M, Fm), Pairs),
     pairs_keys_values(Pairs, Matches, Fs),
     sum_list(Fs, F0),
     (   Always =:= 0
@@ -135,10 +139,17 @@ slice(KB, Rules, Code, N, Default, Always, R, slice(R, F, Matches)) :-
     ;   F is Default + F0
     ).
 
-matching_rule(_, rules(_, Learned, _), Code, N, R, learned(Code, N, R), F) :-
-    get_assoc(k(Code, N, R), Learned, f(Fs)),
+%   Here: the learned rules of the state Code and the necessity N (rs/1's pairs).
+here(Learned, Code, N, Here) :-
+    (   get_assoc(k(Code, N), Learned, rs(Here0))
+    ->  Here = Here0
+    ;   Here = []
+    ).
+
+matching_rule(_, _, Here, Code, N, R, learned(Code, N, R), F) :-
+    memberchk(R-f(Fs), Here),
     member(F, Fs).
-matching_rule(KB, rules(Authored, _, _), _, N, R, authored(Id), F) :-
+matching_rule(KB, Authored, _, _, N, R, authored(Id), F) :-
     member(a(Id, Antecedent0, R0, N1, F), Authored),
     N1 == N,
     R0 = R,
@@ -183,13 +194,24 @@ contingency_update(KB, Code0, A0, N0, Reinforced, Params) :-
         ;   Base = 0
         ),
         clamp(Params, Base + Delta, F),
-        Key = k(Code0, N0, A0),
-        (   get_assoc(Key, Learned0, f(Fs0))
-        ->  append(Fs0, [F], Fs)
-        ;   Fs = [F]
-        ),
-        put_assoc(Key, Learned0, f(Fs), Learned),
-        nb_setarg(2, Rules, Learned)
+        (   add_learned(Learned0, Code0, N0, A0, F)
+        ->  true
+        ;   put_assoc(k(Code0, N0), Learned0, rs([A0-f([F])]), Learned),
+            nb_setarg(2, Rules, Learned)
+        )
+    ).
+
+%   Add a rule of fitness F to Learned in place; fails when Learned has no rule of the
+%   state Code and the necessity N yet.
+add_learned(Learned, Code, N, R, F) :-
+    get_assoc(k(Code, N), Learned, Cell),
+    Cell = rs(Pairs0),
+    (   memberchk(R-FCell, Pairs0)
+    ->  FCell = f(Fs0),
+        append(Fs0, [F], Fs),
+        nb_setarg(1, FCell, Fs)
+    ;   append(Pairs0, [R-f([F])], Pairs),
+        nb_setarg(1, Cell, Pairs)
     ).
 
 %!  consequence_delta(+Params, +N0, +Reinforced, -Delta) is det.
@@ -216,7 +238,8 @@ consequence_delta(Params, N0, Reinforced, Delta) :-
 %   A learned key's first rule moves (and goes last among the key's rules); an authored
 %   rule moves in place.
 adjust(rules(_, Learned, _), learned(Code, N, R), Delta, Params) :-
-    (   get_assoc(k(Code, N, R), Learned, Cell),
+    (   get_assoc(k(Code, N), Learned, rs(Pairs)),
+        memberchk(R-Cell, Pairs),
         Cell = f([F0|Fs])
     ->  clamp(Params, F0 + Delta, F),
         append(Fs, [F], Fs1),
@@ -240,14 +263,16 @@ clamp(Params, Expr, F) :-
 %!  contingency_rules(+KB, -Rules:list) is det.
 %
 %   Rules are behaviour(Antecedent, Response, Necessity, Fitness) terms, authored first (in
-%   the domain's order), then the learned ones by state code, necessity and response.
+%   the domain's order), then the learned ones by state code and necessity (and, within
+%   those, in the order learned).
 
 contingency_rules(KB, Rules) :-
     rules(KB, rules(Authored0, Learned0, _)),
     findall(behaviour(A, R, N, F), member(a(_, A, R, N, F), Authored0), Authored),
     assoc_to_list(Learned0, Pairs),
     findall(behaviour(state(C), R, N, F),
-            ( member(k(C, N, R)-f(Fs), Pairs), member(F, Fs) ), Learned),
+            ( member(k(C, N)-rs(RFs), Pairs), member(R-f(Fs), RFs), member(F, Fs) ),
+            Learned),
     append(Authored, Learned, Rules).
 
 %!  contingency_restore(+KB, +Rules:list) is det.
@@ -259,10 +284,10 @@ contingency_restore(KB, Rules) :-
     must_be(list, Rules),
     findall(a(Id, A, R, N, F),
             ( nth1(Id, Rules, behaviour(A, R, N, F)), \+ learned_rule(A) ), Authored),
-    findall(k(Code, N, R)-F, member(behaviour(state(Code), R, N, F), Rules), Keyed0),
+    findall(l(Code, N, R, F), member(behaviour(state(Code), R, N, F), Rules), Keyed0),
     include(learned_key, Keyed0, Keyed),
     empty_assoc(Empty),
-    foldl(add_learned, Keyed, Empty, Learned),
+    foldl(restore_learned, Keyed, Empty, Learned),
     set_rules(KB, Authored, Learned).
 
 learned_rule(A) :-
@@ -270,15 +295,14 @@ learned_rule(A) :-
     A = state(Code),
     integer(Code).
 
-learned_key(k(Code, _, _)-_) :-
+learned_key(l(Code, _, _, _)) :-
     integer(Code).
 
-add_learned(Key-F, Learned0, Learned) :-
-    (   get_assoc(Key, Learned0, f(Fs0))
-    ->  append(Fs0, [F], Fs)
-    ;   Fs = [F]
-    ),
-    put_assoc(Key, Learned0, f(Fs), Learned).
+restore_learned(l(Code, N, R, F), Learned0, Learned) :-
+    (   add_learned(Learned0, Code, N, R, F)
+    ->  Learned = Learned0
+    ;   put_assoc(k(Code, N), Learned0, rs([R-f([F])]), Learned)
+    ).
 
 %!  contingency_explain(+KB, +Code, +N, -Explanation) is det.
 %
@@ -286,9 +310,11 @@ add_learned(Key-F, Learned0, Learned) :-
 %   Response-Fitness, highest first.
 
 contingency_explain(KB, Code, N, Ranked) :-
-    rules(KB, Rules),
+    rules(KB, rules(Authored, Learned, _)),
+    here(Learned, Code, N, Here),
     findall(F-R, ( kb_response(KB, R),
-                   findall(Fm, matching_rule(KB, Rules, Code, N, R, _, Fm), Fs), Fs \== [],
+                   findall(Fm, matching_rule(KB, Authored, Here, Code, N, R, _, Fm), Fs),
+                   Fs \== [],
                    sum_list(Fs, F) ), Pairs),
     sort(1, @>=, Pairs, Sorted),
     findall(R-F, member(F-R, Sorted), Ranked).
@@ -300,12 +326,9 @@ contingency_explain(KB, Code, N, Ranked) :-
 contingency_size(KB, size(Rules, Rules)) :-
     rules(KB, rules(Authored, Learned, _)),
     length(Authored, A),
-    assoc_to_values(Learned, Cells),
-    foldl(count_cell, Cells, A, Rules).
-
-count_cell(f(Fs), N0, N) :-
-    length(Fs, L),
-    N is N0 + L.
+    aggregate_all(count, ( gen_assoc(_, Learned, rs(Pairs)), member(_-f(Fs), Pairs),
+                           member(_, Fs) ), L),
+    Rules is A + L.
 
 %   ---- The engine's hooks (see engine.pl) ------------------------------------------------
 
