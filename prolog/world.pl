@@ -31,6 +31,7 @@
 :- use_module(engine).
 :- use_module(kbstate).
 :- use_module(guard, [progress_mark/0]).
+:- use_module(learner_contract, [learner_hook/1]).
 :- use_module(world_bias).
 
 /** <module> Worlds written in Prolog
@@ -474,7 +475,7 @@ steps(Run, Goal, S, V, Legal, T, Bound, Ret0, Steps, Return, Reached, Ex0, Ex, T
     ->  Steps = T, Return = Ret0, Reached = false, Ex = Ex0,
         end_trace(Run, S, Trace)
     ;   Run = run(KB, Learner, Mode, Updates, _, KeepTrace),
-        relrl_engine:hook(learner_choose(Learner, KB, V, none, Legal, Mode, A)),
+        learner_hook(learner_choose(Learner, KB, V, none, Legal, Mode, A)),
         world_next(KB, Goal, S, A, S1, outcome(R, Done)),
         Ret1 is Ret0 + R,
         T1 is T + 1,
@@ -519,7 +520,7 @@ end_trace(run(_, _, _, _, _, KeepTrace), S, Trace) :-
 
 %   A hook that fails is an error naming it, as in a control step (engine.pl).
 learner_update(Learner, KB, Transition) :-
-    relrl_engine:hook(learner_update(Learner, KB, Transition)).
+    learner_hook(learner_update(Learner, KB, Transition)).
 
 % ---- optimal steps -------------------------------------------------------------------------
 
