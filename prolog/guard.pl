@@ -289,7 +289,7 @@ error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
     ->  Kind = rule_error(GoalText, Where, resource_error(Resource)),
         format(string(Message), "~w: rule ~w ran out of ~w (a recursion without end?)",
                [Where, GoalText, Resource])
-    ;   E = error(domain_error(world_vocabulary, Text), _)    % world.pl's contract/4
+    ;   E = error(domain_error(world_vocabulary, Text), _)    % world_step.pl
     ->  Kind = rule_error(GoalText, Where, domain_error(world_vocabulary, Text)),
         format(string(Message), "~w: ~w", [Where, Text])
     ;   strip_context(E, E1),
