@@ -128,7 +128,7 @@ slices(KB, rules(Authored, Learned, _), Code, N, Allowed, Params, Slices, Total)
 %   A response's slice: its matching rules' fitness, or the default without one; with
 %   default_always the default stays in every slice and the rules' fitness is added to it.
 slice(KB, Authored, Here, Code, N, Default, Always, R, slice(R, F, Matches)) :-
-    findall(M-Fm, matching_rule(KB, Authored, Here, Code, N, R, M, Fm), Pairs),
+    matching_rules(KB, Authored, Here, Code, N, R, Pairs),
     pairs_keys_values(Pairs, Matches, Fs),
     sum_list(Fs, F0),
     (   Always =:= 0
@@ -146,15 +146,30 @@ here(Learned, Code, N, Here) :-
     ;   Here = []
     ).
 
-matching_rule(_, _, Here, Code, N, R, learned(Code, N, R), F) :-
-    memberchk(R-f(Fs), Here),
-    member(F, Fs).
-matching_rule(KB, Authored, _, _, N, R, authored(Id), F) :-
-    member(a(Id, Antecedent0, R0, N1, F), Authored),
-    N1 == N,
-    R0 = R,
-    copy_term(Antecedent0, Antecedent),     % the stored rule keeps its variables
-    rule_holds(KB, Antecedent).
+%   Pairs are Rule-Fitness for the rules of response R that match the state Code and the
+%   necessity N: the learned ones (Here), then the authored ones whose antecedent holds, in
+%   their order.
+matching_rules(KB, Authored, Here, Code, N, R, Pairs) :-
+    (   memberchk(R-f(Fs), Here)
+    ->  learned_pairs(Fs, learned(Code, N, R), Pairs, Rest)
+    ;   Pairs = Rest
+    ),
+    authored_pairs(Authored, KB, N, R, Rest).
+
+learned_pairs([], _, Pairs, Pairs).
+learned_pairs([F|Fs], Key, [Key-F|Pairs], Rest) :-
+    learned_pairs(Fs, Key, Pairs, Rest).
+
+authored_pairs([], _, _, _, []).
+authored_pairs([a(Id, Antecedent0, R0, N1, F)|As], KB, N, R, Pairs) :-
+    (   N1 == N,
+        R0 = R,
+        copy_term(Antecedent0, Antecedent),   % the stored rule keeps its variables
+        rule_holds(KB, Antecedent)
+    ->  Pairs = [authored(Id)-F|Pairs1]
+    ;   Pairs = Pairs1
+    ),
+    authored_pairs(As, KB, N, R, Pairs1).
 
 sum_list_of(Slices, Total) :-
     foldl(add_slice, Slices, 0, Total).
@@ -313,8 +328,9 @@ contingency_explain(KB, Code, N, Ranked) :-
     rules(KB, rules(Authored, Learned, _)),
     here(Learned, Code, N, Here),
     findall(F-R, ( kb_response(KB, R),
-                   findall(Fm, matching_rule(KB, Authored, Here, Code, N, R, _, Fm), Fs),
-                   Fs \== [],
+                   matching_rules(KB, Authored, Here, Code, N, R, Pairs0),
+                   Pairs0 \== [],
+                   pairs_values(Pairs0, Fs),
                    sum_list(Fs, F) ), Pairs),
     sort(1, @>=, Pairs, Sorted),
     findall(R-F, member(F-R, Sorted), Ranked).
