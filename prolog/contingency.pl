@@ -13,9 +13,11 @@
 :- use_module(library(apply)).
 :- use_module(library(random)).
 :- use_module(library(pairs)).
+:- use_module(library(assoc)).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(rules).
+:- use_module(kbstate).
 :- use_module(policy, [policy_refuse/3, policy_number/3]).
 
 /** <module> Contingency learning
@@ -44,13 +46,41 @@ Params: default_fitness, influence, min_fitness, max_fitness, default_always, ex
 satiation (all numbers; the readings of the paper behind each are in docs/engine.md).
 */
 
-:- dynamic
-    learned_/5,      % KB, Code, Necessity, Response, Fitness
-    authored_/5,     % KB, Id, Antecedent, Response, Necessity-Fitness
-    matched_/2.      % KB, Matches: rule references used by the last choice
+%   ---- The learner's state ------------------------------------------------------------------
+%
+%   The rules are the `learner` part of the knowledge base's record (kbstate.pl), one term
+%   changed in place (nb_setarg/3), so that a step asserts and retracts nothing:
+%
+%     rules(Authored, Learned, Matched)
+%       Authored  a list of a(Id, Antecedent, Response, Necessity, Fitness), in Id order
+%       Learned   an assoc from k(Code, Necessity) to rs(Pairs), Pairs Response-f(Fitnesses)
+%                 in the order learned: the fitness of each learned rule of that state,
+%                 necessity and response, oldest first (one rule unless a response other
+%                 than the chosen one was emitted and learned from twice). A choice looks
+%                 its state and necessity up once, then each response in a short list.
+%       Matched   the rules the last choice used: learned(Code, N, R) and authored(Id)
+%                 keys, or [] (none, or already learned from)
+%
+%   A fitness changes in place in its a/5 or f/1 term; a new learned rule extends its rs/1
+%   list (a short copy), or, in a state and necessity new to the learner, puts a new assoc
+%   (a copy: nb_setarg/3); the last choice's matches replace the old ones (a short list).
 
 param(Params, Name, Value) :-
     memberchk(Name=Value, Params).
+
+%   KB's rules term (the stored term itself), made empty if the learner part holds none.
+rules(KB, Rules) :-
+    kb_record(KB, Record),
+    record_get(Record, learner, Rules0),
+    (   Rules0 = rules(_, _, _)
+    ->  Rules = Rules0
+    ;   empty_assoc(Empty),
+        record_set(Record, learner, rules([], Empty, [])),
+        record_get(Record, learner, Rules)
+    ).
+
+set_rules(KB, Authored, Learned) :-
+    kb_set(KB, learner, rules(Authored, Learned, [])).
 
 %!  contingency_init(+KB) is det.
 %
@@ -58,12 +88,10 @@ param(Params, Name, Value) :-
 
 contingency_init(KB) :-
     must_be(atom, KB),
-    retractall(learned_(KB, _, _, _, _)),
-    retractall(authored_(KB, _, _, _, _)),
-    retractall(matched_(KB, _)),
     findall(rule(A, R, N, F), behaviour_rule(KB, A, R, N, F), Rules),
-    forall(nth1(Id, Rules, rule(A, R, N, F)),
-           assertz(authored_(KB, Id, A, R, N-F))).
+    findall(a(Id, A, R, N, F), nth1(Id, Rules, rule(A, R, N, F)), Authored),
+    empty_assoc(Learned),
+    set_rules(KB, Authored, Learned).
 
 %!  contingency_choose(+KB, +Code, +N, +Allowed, +Params, -Action) is det.
 %
@@ -71,12 +99,12 @@ contingency_init(KB) :-
 
 contingency_choose(KB, Code, N, Allowed, Params, Action) :-
     Allowed \== [],
-    slices(KB, Code, N, Allowed, Params, Slices, Total),
+    rules(KB, Rules),
+    slices(KB, Rules, Code, N, Allowed, Params, Slices, Total),
     random(X0),
     X is X0 * Total,
     pick(Slices, X, slice(Action, _, Matches)),
-    retractall(matched_(KB, _)),
-    assertz(matched_(KB, Matches)).
+    nb_setarg(3, Rules, Matches).
 
 %!  contingency_probabilities(+KB, +Code, +N, +Allowed, +Params, -Pairs) is det.
 %
@@ -86,19 +114,21 @@ contingency_choose(KB, Code, N, Allowed, Params, Action) :-
 
 contingency_probabilities(KB, Code, N, Allowed, Params, Pairs) :-
     must_be(list, Allowed),
-    slices(KB, Code, N, Allowed, Params, Slices, Total),
+    rules(KB, Rules),
+    slices(KB, Rules, Code, N, Allowed, Params, Slices, Total),
     findall(R-P, ( member(slice(R, F, _), Slices), P is F / Total ), Pairs).
 
-slices(KB, Code, N, Allowed, Params, Slices, Total) :-
+slices(KB, rules(Authored, Learned, _), Code, N, Allowed, Params, Slices, Total) :-
     param(Params, default_fitness, Default),
     param(Params, default_always, Always),
-    maplist(slice(KB, Code, N, Default, Always), Allowed, Slices),
+    here(Learned, Code, N, Here),
+    maplist(slice(KB, Authored, Here, Code, N, Default, Always), Allowed, Slices),
     sum_list_of(Slices, Total).
 
 %   A response's slice: its matching rules' fitness, or the default without one; with
 %   default_always the default stays in every slice and the rules' fitness is added to it.
-slice(KB, Code, N, Default, Always, R, slice(R, F, Matches)) :-
-    findall(M-Fm, matching_rule(KB, Code, N, R, M, Fm), Pairs),
+slice(KB, Authored, Here, Code, N, Default, Always, R, slice(R, F, Matches)) :-
+    matching_rules(KB, Authored, Here, Code, N, R, Pairs),
     pairs_keys_values(Pairs, Matches, Fs),
     sum_list(Fs, F0),
     (   Always =:= 0
@@ -109,12 +139,37 @@ slice(KB, Code, N, Default, Always, R, slice(R, F, Matches)) :-
     ;   F is Default + F0
     ).
 
-matching_rule(KB, Code, N, R, learned(Code, N, R), F) :-
-    learned_(KB, Code, N, R, F).
-matching_rule(KB, _, N, R, authored(Id), F) :-
-    authored_(KB, Id, Antecedent, R, N1-F),
-    N1 == N,
-    rule_holds(KB, Antecedent).
+%   Here: the learned rules of the state Code and the necessity N (rs/1's pairs).
+here(Learned, Code, N, Here) :-
+    (   get_assoc(k(Code, N), Learned, rs(Here0))
+    ->  Here = Here0
+    ;   Here = []
+    ).
+
+%   Pairs are Rule-Fitness for the rules of response R that match the state Code and the
+%   necessity N: the learned ones (Here), then the authored ones whose antecedent holds, in
+%   their order.
+matching_rules(KB, Authored, Here, Code, N, R, Pairs) :-
+    (   memberchk(R-f(Fs), Here)
+    ->  learned_pairs(Fs, learned(Code, N, R), Pairs, Rest)
+    ;   Pairs = Rest
+    ),
+    authored_pairs(Authored, KB, N, R, Rest).
+
+learned_pairs([], _, Pairs, Pairs).
+learned_pairs([F|Fs], Key, [Key-F|Pairs], Rest) :-
+    learned_pairs(Fs, Key, Pairs, Rest).
+
+authored_pairs([], _, _, _, []).
+authored_pairs([a(Id, Antecedent0, R0, N1, F)|As], KB, N, R, Pairs) :-
+    (   N1 == N,
+        R0 = R,
+        copy_term(Antecedent0, Antecedent),   % the stored rule keeps its variables
+        rule_holds(KB, Antecedent)
+    ->  Pairs = [authored(Id)-F|Pairs1]
+    ;   Pairs = Pairs1
+    ),
+    authored_pairs(As, KB, N, R, Pairs1).
 
 sum_list_of(Slices, Total) :-
     foldl(add_slice, Slices, 0, Total).
@@ -142,8 +197,11 @@ pick([S|Ss], X, Pick) :-
 
 contingency_update(KB, Code0, A0, N0, Reinforced, Params) :-
     consequence_delta(Params, N0, Reinforced, Delta),
-    (   retract(matched_(KB, Matches)), Matches \== []
-    ->  forall(member(M, Matches), adjust(KB, M, Delta, Params))
+    rules(KB, Rules),
+    Rules = rules(_, Learned0, Matches),
+    (   Matches \== []
+    ->  nb_setarg(3, Rules, []),
+        forall(member(M, Matches), adjust(Rules, M, Delta, Params))
     ;   param(Params, default_fitness, Default),
         param(Params, default_always, Always),
         (   Always =:= 0
@@ -151,7 +209,24 @@ contingency_update(KB, Code0, A0, N0, Reinforced, Params) :-
         ;   Base = 0
         ),
         clamp(Params, Base + Delta, F),
-        assertz(learned_(KB, Code0, N0, A0, F))
+        (   add_learned(Learned0, Code0, N0, A0, F)
+        ->  true
+        ;   put_assoc(k(Code0, N0), Learned0, rs([A0-f([F])]), Learned),
+            nb_setarg(2, Rules, Learned)
+        )
+    ).
+
+%   Add a rule of fitness F to Learned in place; fails when Learned has no rule of the
+%   state Code and the necessity N yet.
+add_learned(Learned, Code, N, R, F) :-
+    get_assoc(k(Code, N), Learned, Cell),
+    Cell = rs(Pairs0),
+    (   memberchk(R-FCell, Pairs0)
+    ->  FCell = f(Fs0),
+        append(Fs0, [F], Fs),
+        nb_setarg(1, FCell, Fs)
+    ;   append(Pairs0, [R-f([F])], Pairs),
+        nb_setarg(1, Cell, Pairs)
     ).
 
 %!  consequence_delta(+Params, +N0, +Reinforced, -Delta) is det.
@@ -175,16 +250,23 @@ consequence_delta(Params, N0, Reinforced, Delta) :-
         Delta is -Rate * Extinction
     ).
 
-adjust(KB, learned(Code, N, R), Delta, Params) :-
-    (   retract(learned_(KB, Code, N, R, F0))
+%   A learned key's first rule moves (and goes last among the key's rules); an authored
+%   rule moves in place.
+adjust(rules(_, Learned, _), learned(Code, N, R), Delta, Params) :-
+    (   get_assoc(k(Code, N), Learned, rs(Pairs)),
+        memberchk(R-Cell, Pairs),
+        Cell = f([F0|Fs])
     ->  clamp(Params, F0 + Delta, F),
-        assertz(learned_(KB, Code, N, R, F))
+        append(Fs, [F], Fs1),
+        nb_setarg(1, Cell, Fs1)
     ;   true
     ).
-adjust(KB, authored(Id), Delta, Params) :-
-    (   retract(authored_(KB, Id, A, R, N-F0))
-    ->  clamp(Params, F0 + Delta, F),
-        assertz(authored_(KB, Id, A, R, N-F))
+adjust(rules(Authored, _, _), authored(Id), Delta, Params) :-
+    (   member(Rule, Authored),
+        arg(1, Rule, Id)
+    ->  arg(5, Rule, F0),
+        clamp(Params, F0 + Delta, F),
+        nb_setarg(5, Rule, F)
     ;   true
     ).
 
@@ -195,11 +277,17 @@ clamp(Params, Expr, F) :-
 
 %!  contingency_rules(+KB, -Rules:list) is det.
 %
-%   Rules are behaviour(Antecedent, Response, Necessity, Fitness) terms, authored first.
+%   Rules are behaviour(Antecedent, Response, Necessity, Fitness) terms, authored first (in
+%   the domain's order), then the learned ones by state code and necessity (and, within
+%   those, in the order learned).
 
 contingency_rules(KB, Rules) :-
-    findall(behaviour(A, R, N, F), authored_(KB, _, A, R, N-F), Authored),
-    findall(behaviour(state(C), R, N, F), learned_(KB, C, N, R, F), Learned),
+    rules(KB, rules(Authored0, Learned0, _)),
+    findall(behaviour(A, R, N, F), member(a(_, A, R, N, F), Authored0), Authored),
+    assoc_to_list(Learned0, Pairs),
+    findall(behaviour(state(C), R, N, F),
+            ( member(k(C, N)-rs(RFs), Pairs), member(R-f(Fs), RFs), member(F, Fs) ),
+            Learned),
     append(Authored, Learned, Rules).
 
 %!  contingency_restore(+KB, +Rules:list) is det.
@@ -209,14 +297,27 @@ contingency_rules(KB, Rules) :-
 
 contingency_restore(KB, Rules) :-
     must_be(list, Rules),
-    retractall(learned_(KB, _, _, _, _)),
-    retractall(authored_(KB, _, _, _, _)),
-    retractall(matched_(KB, _)),
-    forall(nth1(Id, Rules, behaviour(A, R, N, F)),
-           (   A = state(Code), integer(Code)
-           ->  assertz(learned_(KB, Code, N, R, F))
-           ;   assertz(authored_(KB, Id, A, R, N-F))
-           )).
+    findall(a(Id, A, R, N, F),
+            ( nth1(Id, Rules, behaviour(A, R, N, F)), \+ learned_rule(A) ), Authored),
+    findall(l(Code, N, R, F), member(behaviour(state(Code), R, N, F), Rules), Keyed0),
+    include(learned_key, Keyed0, Keyed),
+    empty_assoc(Empty),
+    foldl(restore_learned, Keyed, Empty, Learned),
+    set_rules(KB, Authored, Learned).
+
+learned_rule(A) :-
+    nonvar(A),
+    A = state(Code),
+    integer(Code).
+
+learned_key(l(Code, _, _, _)) :-
+    integer(Code).
+
+restore_learned(l(Code, N, R, F), Learned0, Learned) :-
+    (   add_learned(Learned0, Code, N, R, F)
+    ->  Learned = Learned0
+    ;   put_assoc(k(Code, N), Learned0, rs([R-f([F])]), Learned)
+    ).
 
 %!  contingency_explain(+KB, +Code, +N, -Explanation) is det.
 %
@@ -224,8 +325,12 @@ contingency_restore(KB, Rules) :-
 %   Response-Fitness, highest first.
 
 contingency_explain(KB, Code, N, Ranked) :-
+    rules(KB, rules(Authored, Learned, _)),
+    here(Learned, Code, N, Here),
     findall(F-R, ( kb_response(KB, R),
-                   findall(Fm, matching_rule(KB, Code, N, R, _, Fm), Fs), Fs \== [],
+                   matching_rules(KB, Authored, Here, Code, N, R, Pairs0),
+                   Pairs0 \== [],
+                   pairs_values(Pairs0, Fs),
                    sum_list(Fs, F) ), Pairs),
     sort(1, @>=, Pairs, Sorted),
     findall(R-F, member(F-R, Sorted), Ranked).
@@ -235,9 +340,11 @@ contingency_explain(KB, Code, N, Ranked) :-
 %   Size is size(Rules, Positions): the number of stored rules; each takes one position.
 
 contingency_size(KB, size(Rules, Rules)) :-
-    aggregate_all(count, learned_(KB, _, _, _, _), L),
-    aggregate_all(count, authored_(KB, _, _, _, _), A),
-    Rules is L + A.
+    rules(KB, rules(Authored, Learned, _)),
+    length(Authored, A),
+    aggregate_all(count, ( gen_assoc(_, Learned, rs(Pairs)), member(_-f(Fs), Pairs),
+                           member(_, Fs) ), L),
+    Rules is A + L.
 
 %   ---- The engine's hooks (see engine.pl) ------------------------------------------------
 
@@ -261,10 +368,7 @@ relrl_engine:learner_parameter(contingency, extinction, 1.0, unit).
 relrl_engine:learner_parameter(contingency, satiation, 0.0, flag).
 relrl_engine:learner_serves(contingency, domains, []).
 
-relrl_engine:learner_forget(contingency, KB) :-
-    retractall(learned_(KB, _, _, _, _)),
-    retractall(authored_(KB, _, _, _, _)),
-    retractall(matched_(KB, _)).
+relrl_engine:learner_forget(contingency, _KB).     % all in the record
 
 relrl_engine:learner_init(contingency, KB, _Params) :-
     contingency_init(KB).
@@ -358,11 +462,8 @@ check_rule(KB, NF, Responses, Necessities, T) :-
     ).
 
 relrl_engine:learner_snapshot(contingency, KB, matched(Matches)) :-
-    (   matched_(KB, Matches0)
-    ->  Matches = Matches0
-    ;   Matches = []
-    ).
+    rules(KB, rules(_, _, Matches)).
 
 relrl_engine:learner_resume(contingency, KB, matched(Matches)) :-
-    retractall(matched_(KB, _)),
-    assertz(matched_(KB, Matches)).
+    rules(KB, Rules),
+    nb_setarg(3, Rules, Matches).

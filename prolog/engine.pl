@@ -39,7 +39,8 @@
 :- use_module(motivation).
 :- use_module(rules).
 :- use_module(kbstate).
-:- use_module(guard, [call_context/2, set_call_context/2]).
+:- use_module(learner_contract).
+:- use_module(engine_random).
 :- set_prolog_flag(optimise, true).   % arithmetic compiled inline (this file only)
 
 /** <module> The control step, inside Prolog
@@ -81,11 +82,8 @@ touches its own file and one line of learners.pl.
 ## Random numbers
 
 Each knowledge base owns its random stream, so two agents in one process give the same
-trajectories as each alone. Learners just use library(random): SWI-Prolog has one random
-generator (per thread), and the engine keeps in it the stream of the knowledge base that
-stepped last, swapping only when another knowledge base steps (a robot stepping one agent
-never saves or restores the generator's 2.5 KB state). The engine's own predicates that
-touch the generator first put that stream away with its knowledge base (park/0).
+trajectories as each alone; engine_random.pl keeps it (the generator holds the stream of
+the knowledge base that stepped last).
 
 ## Between steps
 
@@ -160,29 +158,14 @@ run(KB, Run) :-
     engine(KB, engine(Run, _, _)).
 
 eng(KB, eng(Prev, Random)) :-
-    engine(KB, engine(_, Prev, Random0)),
-    (   random_owner(KB)
-    ->  random_property(state(Random))
-    ;   Random = Random0
-    ).
+    engine(KB, Engine),
+    arg(2, Engine, Prev),
+    random_now(KB, Engine, Random).
 
 set_eng(KB, eng(Prev, Random)) :-
     engine(KB, Engine),
     nb_setarg(2, Engine, Prev),
-    set_stream(KB, Engine, Random).
-
-%   KB's stream is now Random (the generator loads it when KB next needs it).
-set_stream(KB, Engine, Random) :-
-    (   random_owner(KB)                % first: an interrupt between the two writes
-    ->  set_call_context(random_owner, none)     % must not let a later park overwrite
-    ;   true                                    % Random with the generator's state
-    ),
-    nb_setarg(3, Engine, Random).
-
-%   The generator holds Owner's stream (the KB that stepped last), or that of none: the
-%   one process-wide global of the engine (there is one generator per thread).
-random_owner(Owner) :-
-    call_context(random_owner, Owner).
+    random_replace(KB, Engine, Random).
 
 %!  engine_pause is det.
 %
@@ -193,43 +176,18 @@ random_owner(Owner) :-
 %   working memory (relrl_state:state_touch/0: the rules may change meanwhile).
 
 engine_pause :-
-    park,
+    random_park,
     state_touch.
-
-%   Put the stream the generator holds away with its knowledge base.
-park :-
-    (   random_owner(Owner),
-        Owner \== none
-    ->  (   kb_record_exists(Owner),
-            kb_get(Owner, engine, Engine),
-            Engine \== none
-        ->  random_property(state(Random)),
-            nb_setarg(3, Engine, Random)
-        ;   true
-        ),
-        set_call_context(random_owner, none)
-    ;   true
-    ).
 
 %!  engine_claim_random(+KB) is det.
 %
 %   Load KB's random stream into the generator, where it stays until another knowledge
-%   base steps or engine_park/0 puts it away: for a driver that runs the learner's hooks
+%   base steps or engine_pause/0 puts it away: for a driver that runs the learner's hooks
 %   itself, many steps in one call (relrl_world:world_episodes/3).
 
 engine_claim_random(KB) :-
     engine(KB, Engine),
-    claim_random(KB, Engine).
-
-%   Load KB's stream into the generator (Engine is KB's engine term).
-claim_random(KB, Engine) :-
-    (   random_owner(KB)
-    ->  true
-    ;   park,
-        arg(3, Engine, Random),
-        set_random(state(Random)),
-        set_call_context(random_owner, KB)
-    ).
+    random_claim(KB, Engine).
 
 %!  engine_learner(+KB, -Learner) is det.
 %
@@ -344,13 +302,13 @@ engine_configure(KB, Learner, Params, Seed) :-
     ->  Constraints = true
     ;   Constraints = none                            % no constraint rules: all allowed
     ),
-    fresh_random(Seed, Random),
+    random_fresh(Seed, Random),
     kb_set(KB, engine, engine(run(Learner, Params, Features, Responses, Units, Reinforcers,
                                   Constraints, Necessities, Plan, Caps),
                               none, Random)),
     wm_clear(KB),
     motivation_reset(KB),
-    with_random(KB, hook(learner_init(Learner, KB, Params))),
+    with_random(KB, learner_hook(learner_init(Learner, KB, Params))),
     rules_forget(KB, RulesMark),
     state_forget(KB, StateMark).
 
@@ -366,20 +324,11 @@ has_constraints(KB) :-
         N > 0
     ).
 
-fresh_random(Seed, Random) :-
-    park,
-    (   integer(Seed)
-    ->  set_random(seed(Seed))
-    ;   Seed == none
-    ->  set_random(seed(random))
-    ;   type_error(integer, Seed)
-    ),
-    random_property(state(Random)).
-
-%   Run Goal with KB's random stream in the generator (it stays there, see claim_random/2).
+%   Run Goal with KB's random stream in the generator (it stays there: engine_random.pl's
+%   random_claim/2).
 with_random(KB, Goal) :-
     engine(KB, Engine),
-    claim_random(KB, Engine),
+    random_claim(KB, Engine),
     call(Goal).
 
 %!  engine_reseed(+KB, +Seed:integer) is det.
@@ -389,8 +338,8 @@ with_random(KB, Goal) :-
 engine_reseed(KB, Seed) :-
     must_be(integer, Seed),
     engine(KB, Engine),
-    fresh_random(Seed, Random),
-    set_stream(KB, Engine, Random).
+    random_fresh(Seed, Random),
+    random_replace(KB, Engine, Random).
 
 %!  engine_end_episode(+KB) is det.
 %
@@ -404,7 +353,7 @@ engine_end_episode(KB) :-
     wm_clear(KB),
     motivation_reset(KB),
     (   memberchk(end_episode, Caps)
-    ->  hook(learner_end_episode(Learner, KB))
+    ->  learner_hook(learner_end_episode(Learner, KB))
     ;   true
     ).
 
@@ -417,10 +366,7 @@ engine_end_episode(KB) :-
 engine_forget(KB) :-
     must_be(atom, KB),
     forget_learner(KB),
-    (   random_owner(KB)
-    ->  set_call_context(random_owner, none)
-    ;   true
-    ),
+    random_disown(KB),
     kb_forget(KB),
     state_forget(KB),
     rules_forget(KB).
@@ -429,116 +375,17 @@ engine_forget(KB) :-
 forget_learner(KB) :-
     (   kb_record_exists(KB),
         kb_get(KB, engine, engine(run(Learner, _, _, _, _, _, _, _, _, _), _, _))
-    ->  hook(learner_forget(Learner, KB)),
+    ->  learner_hook(learner_forget(Learner, KB)),
         kb_set(KB, learner, none),
         kb_set(KB, tree, none),
         kb_set(KB, inner, none)
     ;   true
     ).
 
-%   ---- Learners' capabilities --------------------------------------------------------------
-
-%!  learner_capabilities(+Learner, -Caps:list) is det.
-%
-%   Caps are Learner's declared properties (learner_property/2), once its hooks are
-%   checked: every learner has learner_init/3, learner_forget/2, learner_update/3 and
-%   learner_explain/5, and learner_choose/7 unless it is `external`; it has the hooks of
-%   each capability it declares (capability_hooks/2), and no clause of an optional hook it
-%   does not declare (a hook the engine would never call is a mistake, not a default).
-%
-%   @error learner_hooks(Learner, Problems) listing missing(Hook) and
-%   undeclared(Capability, Hook) problems.
-
-learner_capabilities(Learner, Caps) :-
-    findall(P, learner_property(Learner, P), Caps0),
-    sort(Caps0, Caps),
-    (   memberchk(external, Caps)
-    ->  Required = [learner_init/3, learner_forget/2, learner_update/3, learner_explain/5]
-    ;   Required = [learner_init/3, learner_forget/2, learner_update/3, learner_explain/5,
-                    learner_choose/7]
-    ),
-    findall(missing(H), ( member(H, Required), \+ has_hook(Learner, H) ), Missing),
-    findall(Problem,
-            ( capability_hooks(Cap, Hooks),
-              member(H, Hooks),
-              (   memberchk(Cap, Caps)
-              ->  \+ has_hook(Learner, H),
-                  Problem = missing(H)
-              ;   has_hook(Learner, H),
-                  Problem = undeclared(Cap, H)
-              ) ),
-            Declared),
-    append(Missing, Declared, Problems),
-    (   Problems == []
-    ->  true
-    ;   throw(error(learner_hooks(Learner, Problems), _))
-    ).
-
-%!  capability_hooks(?Capability, ?Hooks:list) is nondet.
-%
-%   The optional hooks a learner has when it declares learner_property(Name, Capability).
-
-capability_hooks(state, [learner_state/4]).
-capability_hooks(size, [learner_size/3]).
-capability_hooks(policy, [learner_save/3, learner_restore/3, learner_policy_term/2]).
-capability_hooks(policy_info, [learner_policy_info/3]).
-capability_hooks(text, [learner_text/3]).
-capability_hooks(graph, [learner_graph/3]).
-capability_hooks(knowledge, [learner_knowledge/3]).
-capability_hooks(end_episode, [learner_end_episode/2]).
-capability_hooks(snapshot, [learner_snapshot/3, learner_resume/3]).
-
-%   Learner has a clause of hook Name/Arity (its first argument is the learner's name).
-has_hook(Learner, Name/Arity) :-
-    functor(Head, Name, Arity),
-    arg(1, Head, Learner),
-    \+ \+ clause(Head, _).
-
-%   Call a learner's hook, which must succeed: a hook that fails is an error naming it
-%   (an exception it raises goes on as it is).
-hook(Goal) :-
-    (   call(Goal)
-    ->  true
-    ;   functor(Goal, Name, Arity),
-        arg(1, Goal, Learner),
-        hook_failed(Learner, Name/Arity)
-    ).
-
-hook_failed(Learner, Hook) :-
-    throw(error(learner_hook_failed(Learner, Hook), _)).
-
 %   Learner has capability Cap (KB's configured run).
 capable(KB, Cap) :-
     run(KB, run(_, _, _, _, _, _, _, _, _, Caps)),
     memberchk(Cap, Caps).
-
-:- multifile prolog:error_message//1.
-
-prolog:error_message(learner_hooks(Learner, Problems)) -->
-    [ 'learner ~q: '-[Learner] ],
-    hook_problems(Problems).
-prolog:error_message(learner_capability(Learner, Cap)) -->
-    [ 'learner ~q has no capability ~q (learner_property/2)'-[Learner, Cap] ].
-prolog:error_message(learner_hook_failed(Learner, learner_update/3)) --> !,
-    [ 'learner ~q: its hook learner_update/3 failed (a hook must succeed; it is given '-
-      [Learner],
-      'transition(S0, A0, N0, Allowed0, R, Reinforced, S1, N1, Allowed1))' ].
-prolog:error_message(learner_hook_failed(Learner, Hook)) -->
-    [ 'learner ~q: its hook ~q failed (a hook must succeed)'-[Learner, Hook] ].
-
-hook_problems([]) --> [].
-hook_problems([P|Ps]) -->
-    hook_problem(P),
-    (   { Ps == [] }
-    ->  []
-    ;   [ '; ' ],
-        hook_problems(Ps)
-    ).
-
-hook_problem(missing(H)) -->
-    [ 'no ~q hook'-[H] ].
-hook_problem(undeclared(Cap, H)) -->
-    [ 'has ~q but does not declare learner_property(_, ~q)'-[H, Cap] ].
 
 %!  engine_step(+KB, +Percepts, +Emitted, +Mode, +Want, -Out) is det.
 %
@@ -566,7 +413,7 @@ engine_step(KB, Percepts, EmittedIx, Mode, Want, Out) :-
     kb_record(KB, Record),
     record_engine(KB, Record, Engine),
     Engine = engine(Run, Prev, _),
-    claim_random(KB, Engine),
+    random_claim(KB, Engine),
     step(KB, Record, Run, Prev, Percepts, EmittedIx, Mode, Want, Out, Next),
     nb_setarg(2, Engine, Next).
 
@@ -593,7 +440,7 @@ step(KB, Record, run(Learner, Params, _, Responses, Units, _, Constraints, _, Pl
     ->  (   learner_update(Learner, KB, transition(S0, Emitted, N0, Allowed0, Reward,
                                                    Reinforced, State, Active, Allowed))
         ->  true
-        ;   hook_failed(Learner, learner_update/3)
+        ;   learner_hook_failed(Learner, learner_update/3)
         )
     ;   true
     ),
@@ -604,7 +451,7 @@ step(KB, Record, run(Learner, Params, _, Responses, Units, _, Constraints, _, Pl
         ->  true
         ;   domain_error(response, Action)
         )
-    ;   hook_failed(Learner, learner_choose/7)
+    ;   learner_hook_failed(Learner, learner_choose/7)
     ),
     extras(Want, KB, Learner, State, Active, Extras).
 
@@ -623,7 +470,7 @@ learner_view(Learner, Caps, KB, Code, State) :-
     (   memberchk(state, Caps)
     ->  (   learner_state(Learner, KB, Code, State0)
         ->  State = State0
-        ;   hook_failed(Learner, learner_state/4)
+        ;   learner_hook_failed(Learner, learner_state/4)
         )
     ;   State = Code
     ).
@@ -705,7 +552,7 @@ engine_explain(KB, When, Explanation) :-
     explanation(KB, Learner, State, N, Explanation).
 
 explanation(KB, Learner, State, N, explanation(Learner, State, N, Detail)) :-
-    hook(learner_explain(Learner, KB, State, N, Detail)).
+    learner_hook(learner_explain(Learner, KB, State, N, Detail)).
 
 %!  engine_text(+KB, -Text:string) is det.
 %
@@ -714,7 +561,7 @@ explanation(KB, Learner, State, N, explanation(Learner, State, N, Detail)) :-
 engine_text(KB, Text) :-
     engine_learner(KB, Learner),
     (   capable(KB, text)
-    ->  hook(learner_text(Learner, KB, Text))
+    ->  learner_hook(learner_text(Learner, KB, Text))
     ;   Text = ""
     ).
 
@@ -726,7 +573,7 @@ engine_text(KB, Text) :-
 engine_graph(KB, Graph) :-
     engine_learner(KB, Learner),
     (   capable(KB, graph)
-    ->  hook(learner_graph(Learner, KB, Graph))
+    ->  learner_hook(learner_graph(Learner, KB, Graph))
     ;   Graph = graph([], [])
     ).
 
@@ -737,7 +584,7 @@ engine_graph(KB, Graph) :-
 engine_knowledge(KB, Terms) :-
     engine_learner(KB, Learner),
     (   capable(KB, knowledge)
-    ->  hook(learner_knowledge(Learner, KB, Terms))
+    ->  learner_hook(learner_knowledge(Learner, KB, Terms))
     ;   Terms = []
     ).
 
@@ -749,7 +596,7 @@ engine_knowledge(KB, Terms) :-
 engine_size(KB, size(Learner, Positions, Details)) :-
     engine_learner(KB, Learner),
     (   capable(KB, size)
-    ->  hook(learner_size(Learner, KB, size(Positions, Details)))
+    ->  learner_hook(learner_size(Learner, KB, size(Positions, Details)))
     ;   Positions = 0, Details = []
     ).
 
@@ -766,7 +613,7 @@ engine_snapshot(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
     motivation_outputs(KB, Units),
     eng(KB, Eng),
     (   capable(KB, snapshot)
-    ->  hook(learner_snapshot(Learner, KB, LearnerSnap))
+    ->  learner_hook(learner_snapshot(Learner, KB, LearnerSnap))
     ;   LearnerSnap = none
     ).
 
@@ -776,7 +623,7 @@ engine_restore(KB, snapshot(Memory, Units, Eng, LearnerSnap)) :-
     motivation_set_outputs(KB, Units),
     set_eng(KB, Eng),
     (   capable(KB, snapshot)
-    ->  hook(learner_resume(Learner, KB, LearnerSnap))
+    ->  learner_hook(learner_resume(Learner, KB, LearnerSnap))
     ;   true
     ).
 
@@ -813,7 +660,7 @@ engine_resume(KB, Slot) :-
 engine_policy_info(KB, Info) :-
     run(KB, run(Learner, _, Features, Responses, _, _, _, _, _, Caps)),
     (   memberchk(policy_info, Caps)
-    ->  hook(learner_policy_info(Learner, KB, Info))
+    ->  learner_hook(learner_policy_info(Learner, KB, Info))
     ;   Info = [features(Features), responses(Responses)]
     ).
 
@@ -846,4 +693,4 @@ write_policy(S, KB, Learner, Info, Header) :-
            []),
     portray_clause(S, relrl_policy(Learner, Info)),
     nl(S),
-    hook(learner_save(Learner, KB, S)).
+    learner_hook(learner_save(Learner, KB, S)).

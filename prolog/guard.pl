@@ -57,7 +57,10 @@ keys are declared once, by context_key/3.
 %       (toplevel.pl);
 %     - random_owner: the knowledge base whose random stream the generator holds
 %       (engine.pl), or `none`;
-%     - state_touch: how many times the rules may have changed (state.pl).
+%     - state_touch: how many times the rules may have changed (state.pl);
+%     - watch: watch(Limit, Seen, Since) while progress_watch/2 runs its goal (the
+%       progress count last seen and when it changed), `none` otherwise;
+%     - progress: how many units of work (a world's steps) progress_mark/0 has counted.
 %
 %   The context is per thread and survives backtracking, as nb_setval/2 does.
 
@@ -88,6 +91,8 @@ context_key(answer_mode,   5, print).
 context_key(answer_again,  6, none).
 context_key(random_owner,  7, none).
 context_key(state_touch,   8, 0).
+context_key(watch,         9, none).
+context_key(progress,     10, 0).
 
 %   This thread's record (a global variable's term: nb_setarg/3 changes it in place),
 %   made with the defaults on first use.
@@ -211,11 +216,11 @@ time_up(_Signal) :-
 %   (the moments before progress_watch/2 sets the watch and after it ends).
 tick(_Signal) :-
     (   call_context(active, true),
-        nb_current(relrl_watch, watch(Limit, Seen, Since)),
-        flag(relrl_progress, N, N),
+        call_context(watch, watch(Limit, Seen, Since)),
+        call_context(progress, N),
         get_time(Now),
         (   N =\= Seen
-        ->  nb_setval(relrl_watch, watch(Limit, N, Now)),
+        ->  set_call_context(watch, watch(Limit, N, Now)),
             fail
         ;   Now - Since >= Limit
         )
@@ -227,7 +232,8 @@ tick(_Signal) :-
 %
 %   Run Goal once, stopped with `time_limit_exceeded` once Limit seconds pass with no
 %   progress_mark/0 (the host raises the prof signal every tenth of a second while the
-%   call runs: relrl/bridge/deadline.py, SIG_TICK).
+%   call runs: relrl/bridge/deadline.py, SIG_TICK). The watch is the call context's
+%   `watch`, set while Goal runs and `none` again when it ends, whatever way it ends.
 
 progress_watch(Limit, Goal) :-
     must_be(number, Limit),
@@ -235,18 +241,21 @@ progress_watch(Limit, Goal) :-
     ->  true
     ;   domain_error(positive_number, Limit)
     ),
-    flag(relrl_progress, N, N),
+    call_context(progress, N),
     get_time(Now),
-    setup_call_cleanup(nb_setval(relrl_watch, watch(Limit, N, Now)),
+    setup_call_cleanup(set_call_context(watch, watch(Limit, N, Now)),
                        once(Goal),
-                       nb_setval(relrl_watch, none)).
+                       set_call_context(watch, none)).
 
 %!  progress_mark is det.
 %
-%   A unit of work (a world's step) has ended: progress_watch/2 counts its limit from now.
+%   A unit of work (a world's step) has ended: progress_watch/2 counts its limit from now
+%   (the call context's `progress` count goes up by one).
 
 progress_mark :-
-    flag(relrl_progress, N, N + 1).
+    call_context(progress, N0),
+    N is N0 + 1,
+    set_call_context(progress, N).
 
 interrupt(_Signal) :-
     (   call_context(active, true)
@@ -280,7 +289,7 @@ error_result(relrl_rule_error(Goal, Where0, E), error(Kind, Message)) :- !,
     ->  Kind = rule_error(GoalText, Where, resource_error(Resource)),
         format(string(Message), "~w: rule ~w ran out of ~w (a recursion without end?)",
                [Where, GoalText, Resource])
-    ;   E = error(domain_error(world_vocabulary, Text), _)    % world.pl's contract/4
+    ;   E = error(domain_error(world_vocabulary, Text), _)    % world_step.pl
     ->  Kind = rule_error(GoalText, Where, domain_error(world_vocabulary, Text)),
         format(string(Message), "~w: ~w", [Where, Text])
     ;   strip_context(E, E1),

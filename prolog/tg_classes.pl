@@ -31,7 +31,7 @@ the example of the other and leaves every test's answer as it was. They are one 
 they sort to the same leaf, succeed on the same candidate tests, have the same Q and the
 same exploration bonus.
 
-The learner chooses over classes (tg.pl): each class is scored by one representative, the
+The learner chooses over classes (tg_choice.pl): each class is scored by one representative, the
 choice among classes is Boltzmann (or greedy), and within the chosen class a member is drawn
 uniformly. With a world of P places and a state that mentions a few of them, there are a
 few classes whatever P is: "look at one of the places nothing is at" is one choice, not P

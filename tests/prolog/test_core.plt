@@ -198,6 +198,34 @@ test(roulette_draws_the_execution_probabilities, [true(Worst < 0.01)]) :-
                  D is abs(C / N - Pr) ), Ds),
     max_list(Ds, Worst).
 
+%   What a choice in state 1 would weigh: each response with a rule, highest first.
+test(explain_ranks_the_rules, [Ranked == [a-2.0, b-0.05]]) :-
+    contingency_params(P),
+    stream_kb(P, KB),
+    relrl_contingency:contingency_explain(KB, 1, hunger, Ranked).
+
+%   A response other than the one chosen, emitted and learned from twice, keeps both rules
+%   (their fitness counts twice, as stored).
+test(a_rule_learned_twice_counts_twice, [Rules-Size == [behaviour(state(2), b, hunger, 1.5),
+                                                        behaviour(state(2), b, hunger, 1.5)]
+                                                       -size(2, 2)]) :-
+    kb_with('tests/data/tiny.pl', KB),
+    contingency_params(P),
+    relrl_contingency:contingency_init(KB),
+    relrl_contingency:contingency_update(KB, 2, b, hunger, true, P),
+    relrl_contingency:contingency_update(KB, 2, b, hunger, true, P),
+    relrl_contingency:contingency_rules(KB, Rules),
+    relrl_contingency:contingency_size(KB, Size).
+
+%   A control step changes the rules in the knowledge base's record: the module keeps no
+%   clause of its own for a knowledge base.
+test(no_clauses_per_knowledge_base, [Dynamic == []]) :-
+    contingency_params(P),
+    stream_kb(P, _),
+    findall(PI, ( predicate_property(relrl_contingency:H, dynamic),
+                  \+ predicate_property(relrl_contingency:H, imported_from(_)),
+                  functor(H, Name, Arity), PI = Name/Arity ), Dynamic).
+
 :- end_tests(contingency).
 
 % ---------------------------------------------------------------------------------------

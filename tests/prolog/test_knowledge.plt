@@ -190,8 +190,8 @@ test(one_record, [Got-After == (here:3)-Before]) :-
 test(unknown_key, [error(domain_error(call_context_key, no_such_key))]) :-
     relrl_guard:set_call_context(no_such_key, 1).
 
-test(the_eight_keys, [Keys == [active, halt, abort, timeout_where, answer_mode,
-                               answer_again, random_owner, state_touch]]) :-
+test(the_ten_keys, [Keys == [active, halt, abort, timeout_where, answer_mode,
+                             answer_again, random_owner, state_touch, watch, progress]]) :-
     findall(K, relrl_guard:call_context(K, _), Keys).
 
 :- end_tests(call_context).
