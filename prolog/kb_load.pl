@@ -111,7 +111,11 @@ gw_load(File, Module, Problems) :-
             asserta(collecting(Key)),
             guarded(load_stream(Abs, Id, Module), Result),
             retract(collecting(Key))),
-        note_result(Result, Key, Abs),
+        (   Result = error(interrupted, _)      % Ctrl-C between directives: a stop,
+        ->  retractall(collected(Key, _)),      % not a problem of the file
+            throw(relrl_interrupted)
+        ;   note_result(Result, Key, Abs)
+        ),
         findall(P, retract(collected(Key, P)), Problems0),
         exclude(cancelled_halt_warning(Result), Problems0, Problems)
     ;   exists_directory(File)

@@ -345,6 +345,29 @@ def test_ctrl_c_stops_a_domain_directive_that_never_ends_at_once(tmp_path: Path)
     assert proc.returncode == 130 and "Traceback" not in err, err
 
 
+def test_ctrl_c_while_a_domain_loads_is_a_stop_not_a_problem_of_the_file(tmp_path: Path) -> None:
+    """Ctrl-C while `relrl run` reads a domain's clauses (not in a directive): exit 130 and
+    "interrupted", as anywhere else (it said "d.pl: interrupted", exit 2)."""
+    import signal
+    import time
+
+    domain = tmp_path / "d.pl"
+    with domain.open("w") as fh:
+        fh.write((ROOT / "examples" / "domains" / "fruits.pl").read_text())
+        fh.write(":- format(user_error, \"reading~n\", []).\n")
+        for i in range(300_000):
+            fh.write(f"bigfact(f{i}, g({i}, [a, b, c])).\n")
+    script = (ROOT / "examples" / "episodes" / "hello.toml").read_text()
+    (tmp_path / "h.toml").write_text(script.replace("../domains/fruits.pl", str(domain)))
+    proc = started("run", str(tmp_path / "h.toml"), "--out", str(tmp_path / "out"))
+    wait_for(proc.stderr, "reading", proc)
+    time.sleep(0.5)                         # in the clauses after the directive
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "Traceback" not in err, err
+    assert "d.pl" not in err, err
+
+
 def test_a_failed_experiment_worlds_job_keeps_its_points_and_policy(tmp_path: Path) -> None:
     """A job whose rule fails on the larger test size: the run stops (exit 2, one line), the
     job's evaluation points and the policy it saved before that evaluation are kept."""
