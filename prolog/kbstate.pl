@@ -40,7 +40,7 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 :- dynamic key_/2.                  % KB, the name of its record's global variable
 :- dynamic inner_/2.                % Key, Owner: Key's record is kept inside Owner's
 
-%   The record, kb(Engine, Memory, Units, Learner, Tree, Task, Kept, Inner):
+%   The record, kb(Engine, Memory, Units, Learner, Tree, Task, Kept, Inner, Returns):
 %     engine    engine(Run, Prev, Random) or none (engine.pl)
 %     memory    wm(Clock, Span, Pairs, Elements, Now) (memory.pl)
 %     units     Necessity-Y pairs (motivation.pl)
@@ -50,8 +50,10 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 %     kept      Slot-Snapshot pairs (engine_keep/2)
 %     inner     inner(Key, Options, Record): the record of Key kept inside this one, with
 %               the options of the learner that made it (kb_nest/3), or none
+%     returns   ret(Lambda, Last): tg's return_lambda and its last update's state and
+%               target (tg.pl, tg_update/2), or none
 
-empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [], none)).
+empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [], none, none)).
 
 new_record(KB, Record) :-
     must_be(atom, KB),
@@ -86,14 +88,15 @@ kb_record(KB, Record) :-
 %   value: `none`, an empty memory, [] for the units and the kept snapshots. Fails when
 %   Part is not a part (kb_get/3 tells the error).
 
-record_get(kb(V, _, _, _, _, _, _, _), engine, V).
-record_get(kb(_, V, _, _, _, _, _, _), memory, V).
-record_get(kb(_, _, V, _, _, _, _, _), units, V).
-record_get(kb(_, _, _, V, _, _, _, _), learner, V).
-record_get(kb(_, _, _, _, V, _, _, _), tree, V).
-record_get(kb(_, _, _, _, _, V, _, _), task, V).
-record_get(kb(_, _, _, _, _, _, V, _), kept, V).
-record_get(kb(_, _, _, _, _, _, _, V), inner, V).
+record_get(kb(V, _, _, _, _, _, _, _, _), engine, V).
+record_get(kb(_, V, _, _, _, _, _, _, _), memory, V).
+record_get(kb(_, _, V, _, _, _, _, _, _), units, V).
+record_get(kb(_, _, _, V, _, _, _, _, _), learner, V).
+record_get(kb(_, _, _, _, V, _, _, _, _), tree, V).
+record_get(kb(_, _, _, _, _, V, _, _, _), task, V).
+record_get(kb(_, _, _, _, _, _, V, _, _), kept, V).
+record_get(kb(_, _, _, _, _, _, _, V, _), inner, V).
+record_get(kb(_, _, _, _, _, _, _, _, V), returns, V).
 
 %!  record_set(+Record, +Part, +Value) is semidet.
 %
@@ -102,7 +105,7 @@ record_get(kb(_, _, _, _, _, _, _, V), inner, V).
 %   table of the layout; a part is read by one head unification.
 
 record_set(Record, Part, Value) :-
-    record_get(kb(1, 2, 3, 4, 5, 6, 7, 8), Part, I),
+    record_get(kb(1, 2, 3, 4, 5, 6, 7, 8, 9), Part, I),
     nb_setarg(I, Record, Value).
 
 %!  kb_get(+KB, +Part, -Value) is det.

@@ -20,6 +20,7 @@
 :- use_module(tg_tree).
 :- use_module(tg_classes).
 :- use_module(tg_choice, [tg_look_up/9, tg_leaf_q/3]).
+:- use_module(kbstate, [kb_get/3, kb_set/3]).
 :- reexport(tg_knowledge).
 :- reexport(tg_choice, [ tg_q/5,         % +KB, +Facts, +Action, +Necessity, -Q
                          tg_choose/6,    % +KB, +Facts, +Necessity, +Allowed, +Mode, -Action
@@ -76,7 +77,8 @@ Params (Name=Value): alpha (0: Q is the mean of the leaf's Q-targets; otherwise 
 is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greedy),
 epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus,
 half_life, novelty_bonus and novelty_confidence (see tg_choose/6), keep_examples, action_gap
-(advantage learning, tg_update/2); the engine's reward_positive and reward_negative.
+(advantage learning, tg_update/2), return_lambda (optional, 0 when not given: the episode's
+return in the Q-target, tg_update/2); the engine's reward_positive and reward_negative.
 */
 
 % ---- starting ------------------------------------------------------------------------------
@@ -119,6 +121,11 @@ tg_init(Key, KB, Params) :-
     tg_put_data(Key, tg(p(Alpha, Gamma, Epsilon, Tau, Level, MinEx, Kappa, Half,
                           novelty(Beta, Conf), Keep, Gap), Leaves0, none, 0, 0, Index)),
     tg_put_tree(Key, tree(Root, 2, Bias, Responses)),
+    (   memberchk(return_lambda=Lambda, Params)     % (optional: 0 when not given)
+    ->  must_be(number, Lambda)
+    ;   Lambda = 0
+    ),
+    kb_set(Key, returns, ret(Lambda, none)),
     tg_forget_leaves(Key),
     tg_compile_leaf(Key, Root),
     tg_compile_tree(Key, Root).
@@ -147,6 +154,10 @@ tg_state(KB, Facts) :-
 %   representative of each class of responses (tg_classes.pl): the members of a class have
 %   the same Q. With action_gap G > 0 the target is lowered by G * (V(S0) - Q(S0, A0)),
 %   V(S0) the largest Q of the responses Allowed0 (advantage learning, docs/tg.md).
+%   With return_lambda L > 0 and the update before this one from S1 (a world's episode is
+%   learned last first), max Q(S1) in the target is (1 - L) * max Q(S1) + L * G1, G1 that
+%   update's target before its gap: the lambda-return of the steps the episode took (Peng
+%   and Williams' Q(lambda), its returns computed backwards over the episode).
 
 tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
@@ -162,15 +173,28 @@ tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
         Gapped = gap(Gap, V0)
     ;   Gapped = none
     ),
+    kb_get(KB, returns, Returns),
+    (   Returns = ret(Lambda, Last)
+    ->  true
+    ;   Lambda = 0, Last = none
+    ),
     (   S1 == terminal                          % the episode ended (a world's goal)
     ->  Target = Reward
     ;   tg_look_up(KB, D, S1, N1, Allowed1, best, Next, Classes, Ids),
         max_q(Leaves, Ids, Max),
-        Target is Reward + Gamma * Max,
+        (   Lambda > 0,                         % the return from S1 this episode took
+            Last = seen(S1b, N1b, G1), S1b == S1, N1b == N1
+        ->  Target is Reward + Gamma * ((1 - Lambda) * Max + Lambda * G1)
+        ;   Target is Reward + Gamma * Max
+        ),
         (   Next = actions(_, _)                % a world's: only the best classes were
         ->  nb_setarg(3, D, none)               % found, not what a choice needs
         ;   nb_setarg(3, D, last(S1, N1, Next, Classes, Ids, Version, none))
         )
+    ),
+    (   Lambda > 0
+    ->  kb_set(KB, returns, ret(Lambda, seen(S0, N0, Target)))
+    ;   true
     ),
     insert(KB, D, S0, A0, N0, Known, Target, Gapped).
 
@@ -493,7 +517,12 @@ relrl_engine:learner_property(tg, Cap) :-
 %   (action_gap 0.9): a leaf's value there averages states near and far from the goal, and
 %   without it a leaf of wasted moves outranked the right moves of far states; 0.9 lets one
 %   bias serve every task of blocks world (0.5 left unstack at 0.72 and on(A, B) at
-%   0.44-0.59 of optimal on 10 blocks in seeds 0-1, docs/worlds.md).
+%   0.44-0.59 of optimal on 10 blocks in seeds 0-1, docs/worlds.md). Each one-step target
+%   is mixed with the return the episode earned from the next state (return_lambda 0.8,
+%   a Q(lambda)-return, learned last first): a tree whose tests cannot count the moves to
+%   the goal values the states after a right and a wasted move alike, and only the return
+%   carries the difference; exploring at temperature 0.1 (rewards of size 1) keeps that
+%   return near the greedy policy's (docs/worlds.md, One bias for every task).
 relrl_engine:learner_parameter(tg, alpha, 0.2, unit).
 relrl_engine:learner_parameter(tg, gamma, 0.9, unit).
 relrl_engine:learner_parameter(tg, epsilon, 0.05, unit).
@@ -507,9 +536,11 @@ relrl_engine:learner_parameter(tg, novelty_bonus, 20.0, nonneg).
 relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
 relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
 relrl_engine:learner_parameter(tg, action_gap, 0.0, unit).
+relrl_engine:learner_parameter(tg, return_lambda, 0.0, unit).
 relrl_engine:learner_serves(tg, domains, []).
 relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
-                                         action_gap=0.9]).
+                                         action_gap=0.9, return_lambda=0.8,
+                                         temperature=0.1]).
 
 :- learner_hooks(tg, [forget-tg_forget, init-tg_init, choose-tg_choose, update-tg_update,
                      explain-tg_explain, size-tg_size, save-tg_save,

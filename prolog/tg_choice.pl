@@ -13,6 +13,7 @@
 :- use_module(library(random)).
 :- use_module(library(pairs)).
 :- use_module(engine, [engine_all_allowed/2]).
+:- use_module(choice).
 :- use_module(tg_tree).
 :- use_module(tg_classes).
 :- use_module(world, [world_action_list/2]).
@@ -401,28 +402,3 @@ ucb(u(W, Conf, Beta), M, S, SS, B0, B) :-
     ;   B is max(B0, min(Beta, (S + Conf * sqrt(max(0.0, W * (SS * M - S * S) / M))) / M))
     ).
 
-ties([], [], _, []).
-ties([Q|Qs], [A|As], Best, Ties) :-
-    (   Q =:= Best
-    ->  Ties = [A|Ties1]
-    ;   Ties = Ties1
-    ),
-    ties(Qs, As, Best, Ties1).
-
-softmax_member(Qs, Allowed, Best, Tau, Action) :-
-    weights(Qs, Best, Tau, Ws, 0.0, Total),
-    X is random_float * Total,
-    pick(Ws, Allowed, X, Action).
-
-weights([], _, _, [], T, T).
-weights([Q|Qs], Best, Tau, [W|Ws], T0, T) :-
-    W is exp((Q - Best) / Tau),
-    T1 is T0 + W,
-    weights(Qs, Best, Tau, Ws, T1, T).
-
-pick([W|Ws], [A|As], X, Action) :-
-    (   ( X < W ; Ws == [] )
-    ->  Action = A
-    ;   X1 is X - W,
-        pick(Ws, As, X1, Action)
-    ).

@@ -9,6 +9,7 @@
 :- use_module(library(aggregate)).
 :- use_module(engine).
 :- use_module(kbstate).
+:- use_module(choice).
 :- use_module(declarations).
 :- use_module(world, [world_action_list/2]).
 
@@ -85,31 +86,7 @@ choose(KB, S, N, Allowed0, Mode, Action) :-
         ;   ties(Qs, Allowed, Best, Ties),
             random_member(Action, Ties)
         )
-    ;   boltzmann(Qs, Allowed, Best, Tau, Action)
-    ).
-
-ties([], [], _, []).
-ties([Q|Qs], [A|As], Best, Ties) :-
-    (   Q =:= Best
-    ->  Ties = [A|Ties1]
-    ;   Ties = Ties1
-    ),
-    ties(Qs, As, Best, Ties1).
-
-boltzmann(Qs, As, Best, Tau, Action) :-
-    foldl(weight(Best, Tau), Qs, Ws, 0.0, Total),
-    X is random_float * Total,
-    pick(Ws, As, X, Action).
-
-weight(Best, Tau, Q, W, T0, T) :-
-    W is exp((Q - Best) / Tau),
-    T is T0 + W.
-
-pick([W|Ws], [A|As], X, Action) :-
-    (   ( X < W ; Ws == [] )
-    ->  Action = A
-    ;   X1 is X - W,
-        pick(Ws, As, X1, Action)
+    ;   softmax_member(Qs, Allowed, Best, Tau, Action)
     ).
 
 %   A table reads every legal action: the runner's actions(A, Goal) term (world.pl's

@@ -272,7 +272,7 @@ test(nested_record, [V-Gone == 1-true]) :-
     relrl_kbstate:kb_nest(krec5, krec5_inner, opts),
     relrl_kbstate:kb_set(krec5_inner, learner, 1),
     relrl_kbstate:kb_get(krec5_inner, learner, V),
-    relrl_kbstate:kb_get(krec5, inner, inner(krec5_inner, opts, kb(_, _, _, 1, _, _, _, _))),
+    relrl_kbstate:kb_get(krec5, inner, inner(krec5_inner, opts, kb(_, _, _, 1, _, _, _, _, _))),
     \+ relrl_kbstate:kb_record_exists(krec5_inner),
     relrl_kbstate:kb_forget(krec5),
     (   relrl_kbstate:inner_(krec5_inner, _) -> Gone = false ; Gone = true ).

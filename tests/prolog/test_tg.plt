@@ -306,6 +306,43 @@ test(update_uses_the_next_state, [true(abs(Q - 19.0) < 1.0e-9)]) :-
     tg_q(KB, [gaze(face, p1)], look(p1), curiosity, Q0),
     Q is 2 * Q0 - 10.                    % the leaf's mean of 10 and the target
 
+test(return_lambda_mixes_the_episode_return_into_the_target,
+     [true(abs(Q - Expected) < 1.0e-9)]) :-
+    % one leaf, alpha 0 (the running mean). An episode learned last first: its last step
+    % (from Sb, terminal, reward 4: target 4), then the step into Sb (reward 0): its target
+    % is 0.9 * ((1 - 0.5) * max Q(Sb) + 0.5 * 4), the return Sb's step earned in half
+    return_learner(KB, 0.5),
+    Sa = [gaze(face, p1)], Sb = [gaze(face, p2)],
+    tg_insert(KB, Sa, look(p1), curiosity, 10),
+    tg_update(KB, transition(Sb, look(p1), curiosity, [look(p1)], 4, true, terminal,
+                             curiosity, [])),
+    tg_q(KB, Sb, look(p1), curiosity, Max),            % 7: the mean of 10 and 4
+    tg_update(KB, transition(Sa, look(p2), curiosity, [look(p2)], 0, true, Sb, curiosity,
+                             [look(p1)])),
+    tg_q(KB, Sa, look(p2), curiosity, Q),
+    Target is 0.9 * (0.5 * Max + 0.5 * 4),
+    Expected is (10 + 4 + Target) / 3.
+
+test(return_lambda_needs_the_next_state_learned_last, [true(abs(Q - Expected) < 1.0e-9)]) :-
+    % the step before was from another state (steps learned first to last, or another
+    % episode's): the target is the one-step target alone
+    return_learner(KB, 0.5),
+    Sa = [gaze(face, p1)], Sb = [gaze(face, p2)],
+    tg_insert(KB, Sa, look(p1), curiosity, 10),
+    tg_update(KB, transition(Sa, look(p1), curiosity, [look(p1)], 4, true, terminal,
+                             curiosity, [])),
+    tg_q(KB, Sb, look(p1), curiosity, Max),
+    tg_update(KB, transition(Sa, look(p2), curiosity, [look(p2)], 0, true, Sb, curiosity,
+                             [look(p1)])),
+    tg_q(KB, Sa, look(p2), curiosity, Q),
+    Target is 0.9 * Max,
+    Expected is (10 + 4 + Target) / 3.
+
+return_learner(KB, Lambda) :-
+    gaze_kb(KB),
+    params(0.001, 1000, Params),
+    tg_init(KB, [return_lambda=Lambda|Params]).
+
 test(action_gap_lowers_the_target_by_the_gap, [true(abs(Q - Expected) < 1.0e-9)]) :-
     % a split tree: following the gaze (Q near 10), not (near 0). A look away from the gaze
     % with reward 0 in a terminal step: its target 0 is lowered by 0.5 times the gap
