@@ -13,7 +13,7 @@ data, and the masked CRC-32C of the data. The first event says the file's versio
 (``brain.Event:2``); each later one holds a step, its wall time and a summary with one value
 per tag (``tag``, ``simple_value``). One event carries every scalar of a step, so a time
 unit costs one record, not one per scalar, and the checksum is compiled
-(:mod:`relrl._crc_kernel`); what that costs a session is measured in docs/rl-tools.md.
+(:mod:`relrl._crc_kernel`).
 """
 
 from __future__ import annotations
