@@ -136,6 +136,7 @@ python_api(world_info, relrl_world:world_info/2).
 python_api(world_task, relrl_world:world_task/3).
 python_api(world_verify, relrl_world:world_verify/5).
 python_api(world_reachable, relrl_world:world_reachable/5).
+python_api(world_absent, relrl_world:world_absent/4).
 python_api(world_for_task, relrl_world:world_for_task/2).
 python_api(world_check, relrl_world_check:world_problems/2).
 python_api(world_episodes_from, relrl_world:world_episodes_from/3).

@@ -24,7 +24,7 @@
               world_defines/2       % +KB, ?Name/Arity
             ]).
 :- reexport(world_episodes).        % world_episodes/3, world_episodes_from/3
-:- reexport(world_search).          % world_optimal/5, world_bfs/5, world_reachable/5,
+:- reexport(world_search).          % world_optimal/5, world_bfs/5, world_reachable/5, world_absent/4,
                                     % world_verify/5
 
 /** <module> Worlds written in Prolog

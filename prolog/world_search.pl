@@ -2,6 +2,7 @@
           [ world_optimal/5,      % +KB, +Goal, +State, +Limit, -Steps
             world_bfs/5,          % +KB, +Goal, +State, +Limit, -Steps
             world_reachable/5,    % +KB, +Task, +Size, +Limit, -Verdict
+            world_absent/4,       % +KB, +Task, +Size, -Absent
             world_verify/5        % +KB, +Task, +Size, +Count, -Pairs
           ]).
 :- use_module(library(error)).
@@ -117,6 +118,28 @@ reach_verdict(Steps, reachable) :-
     !.
 reach_verdict(unreachable, unreachable) :- !.
 reach_verdict(_, unknown).
+
+%!  world_absent(+KB, +Task, +Size, -Absent:list) is det.
+%
+%   Absent lists the arguments of the task instance Task (on(b1, b99): b1 and b99; numbers
+%   pass) that stand in no fact of the three start states of Size objects world_reachable/5
+%   draws: objects the world does not have at that size, found without a search (which a
+%   large world cannot afford).
+
+world_absent(KB, Task, Size, Absent) :-
+    must_be(positive_integer, Size),
+    set_random(seed(0)),
+    findall(S, ( between(1, 3, _), world_start(KB, Task, Size, S, _) ), States),
+    Task =.. [_|Args],
+    exclude(named_in(States), Args, Absent0),
+    exclude(number, Absent0, Absent).
+
+named_in(States, Arg) :-
+    member(State, States),
+    member(Fact, State),
+    sub_term(X, Fact),
+    X == Arg,
+    !.
 
 %!  world_verify(+KB, +Task, +Size, +Count, -Pairs:list) is det.
 %

@@ -45,6 +45,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="random seed: start states, a task's drawn goal, ties (0)")
     parser.add_argument("--actions", action="store_true",
                         help="keep each episode's actions in results.json")
+    from relrl.cli.learn import add_rule_seconds
+
+    add_rule_seconds(parser)
     add_out_options(parser, default="runs/evaluate",
                     what="output folder: results.json, episodes.csv")
 
@@ -61,15 +64,17 @@ def run(args: argparse.Namespace) -> int:
     world = Path(args.world)
     if not world.is_file():
         raise ConfigError(f"--world {args.world}: no such world file")
-    if not Path(args.policy).is_file():
-        raise ConfigError(f"{args.policy}: no such policy file")
+    from relrl.policy import not_a_policy_file
+
+    if (problem := not_a_policy_file(args.policy)) is not None:
+        raise ConfigError(f"{args.policy}: {problem}")
     if args.states is not None and args.sizes is not None:
         raise ConfigError("give --states or --sizes, not both")
     if args.episodes < 1:
         raise ConfigError(f"--episodes must be at least 1, not {args.episodes}")
     if args.seed < 0:
         raise ConfigError(f"--seed must be a whole number >= 0, not {args.seed}")
-    with World(world) as w:
+    with World(world, rule_seconds=args.rule_seconds) as w:
         problems = w.problems()
         if problems:
             raise ConfigError(f"{problems[0]} (and {len(problems) - 1} more: relrl check "

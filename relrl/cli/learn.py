@@ -148,6 +148,13 @@ def run(args: argparse.Namespace) -> int:
         test = (_sizes(args.eval_sizes, "--eval-sizes") if args.eval_sizes is not None
                 else world.test_sizes)
         world.check_instance(task_text, [*train, *test])
+        if args.policy:                        # read it now: a bad one claims no folder
+            from relrl.policy import not_a_policy_file
+
+            if (problem := not_a_policy_file(args.policy)) is not None:
+                raise ConfigError(f"--policy {args.policy}: {problem}")
+            world.attach(world.learner(args.learner, **dict(args.param)), 0, task_text)
+            world.load_policy(args.policy)
     if args.size is not None and args.sizes:
         raise ConfigError("give --size or --sizes, not both")
     if args.episodes < 0 or (args.episodes == 0 and not args.policy):
@@ -163,11 +170,6 @@ def run(args: argparse.Namespace) -> int:
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")
     params = dict(args.param)
-    if args.policy:
-        from relrl.policy import not_a_policy_file
-
-        if (problem := not_a_policy_file(args.policy)) is not None:
-            raise ConfigError(f"--policy {args.policy}: {problem}")
     config = LearnConfig(world=str(path.resolve()), task=task_text, learner=args.learner,
                          params=params, train_sizes=train, test_sizes=test,
                          episodes=args.episodes, block=block,

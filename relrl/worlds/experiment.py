@@ -95,16 +95,28 @@ def run_worlds_job(config: WorldsConfig, world: str, task: str, learner: str, se
     """One job: :func:`learn_task` of (world, task, learner, seed); the learned policy comes
     back as text (``policy``), for the run folder's ``policies/``. A job that fails reports
     the policy it had saved (``{"kind": "policy", "text": ...}``, before each evaluation)
-    before its error goes on, so that it is kept too."""
+    before its error goes on, and each evaluation point comes after the policy it
+    evaluated, so that a job stopped by a signal or an error keeps its policy too."""
     import tempfile
 
     from relrl.errors import RelrlError
 
     with tempfile.TemporaryDirectory(prefix="relrl-worlds-") as tmp:
         path = Path(tmp) / "policy.pl"
+        sent = [""]
+
+        def send(event: dict[str, Any]) -> None:
+            if event.get("kind") == "point" and path.is_file():
+                text = path.read_text(encoding="utf-8")
+                if text != sent[0]:
+                    report({"kind": "policy", "text": text})
+                    sent[0] = text
+            report(event)
+
         try:
             result = learn_task(config.learn_config(world, task, learner, seed),
-                                report=report, policy_out=path)
+                                report=send if report is not None else None,
+                                policy_out=path)
         except RelrlError:
             if report is not None and path.is_file():
                 report({"kind": "policy", "text": path.read_text(encoding="utf-8")})
@@ -198,7 +210,7 @@ def run_worlds(config: WorldsConfig, out_dir: str | Path, *, workers: int = 1,
 def _unfinished(task: tuple, events: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """A job that did not finish, as the evaluation points it reported (none: nothing),
     marked ``"partial": true``: in ``jobs`` and curves.csv, not in the summary (its policy,
-    when it failed after saving one, in ``policies/`` as a finished job's)."""
+    the last one it saved, in ``policies/`` as a finished job's)."""
     curve = [ev["entry"] for ev in events if ev.get("kind") == "point"]
     if not curve:
         return []

@@ -12,6 +12,7 @@ Example:
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
@@ -28,6 +29,8 @@ from relrl.learners import Learner, make_world_learner
 from relrl.terms import Term, Var, format_term
 
 __all__ = ["Episode", "World", "score"]
+
+_log = logging.getLogger(__name__)
 
 
 #: Breadth-first search bound (states) for the optimal number of steps of a world that
@@ -190,9 +193,12 @@ class World:
 
     def check_instance(self, text: str, sizes: Sequence[int]) -> None:
         """Refuse a task instance (``on(b1, b2)``; a task's name passes) whose goal cannot be
-        reached at one of ``sizes``: an object the world does not have (``on(b1, b99)``,
-        ``on(b1, shell(x))``) or a goal no state holds (``on(b1, b1)``), found by a
-        breadth-first search of at most :data:`REACH_LIMIT` states (larger sizes pass).
+        reached at one of ``sizes``: an object the world does not have at that size
+        (``on(b1, b99)``, ``on(b1, shell(x))``), or a goal no state holds (``on(b1, b1)``),
+        found by a breadth-first search of at most :data:`REACH_LIMIT` states. Where a size
+        has too many states to search, the objects are still checked, and a goal that no
+        smaller size the search can finish reaches is a warning (a goal may need more
+        objects than a small world has).
 
         Raises:
             ConfigError: naming the task and the size.
@@ -201,15 +207,45 @@ class World:
         if re.fullmatch(r"[a-z][A-Za-z0-9_]*", text):
             return
         task = self.task(text)
+        tasks = f"tasks of {_display_path(str(self.path))}: {', '.join(self.task_names())}"
+        too_large = []
         for size in sorted(set(sizes)):
+            absent = self._ask("world_absent", self.kb.module, task, int(size))
+            if absent:
+                names = ", ".join(_text(x) for x in absent)  # type: ignore[union-attr]
+                raise ConfigError(f"--task {text!r}: its goal cannot be reached: it names "
+                                  f"{names}, which no start state of {size} objects holds "
+                                  f"({tasks})")
             verdict = self._ask("world_reachable", self.kb.module, task, int(size),
                                 REACH_LIMIT)
             if verdict == "unreachable":
                 raise ConfigError(f"--task {text!r}: its goal cannot be reached in a world of "
                                   f"{size} objects (a search of every state reachable from "
-                                  f"its start states; tasks of "
-                                  f"{_display_path(str(self.path))}: "
-                                  f"{', '.join(self.task_names())})")
+                                  f"its start states; {tasks})")
+            if verdict != "reachable":
+                too_large.append(size)
+        if too_large and (searched := self._unreached_below(task, min(too_large))):
+            _log.warning("--task %r: its goal is reached in no world of %s objects (searched "
+                         "whole); %s objects are too many to search, so it is learned as "
+                         "asked", text, searched, ", ".join(map(str, too_large)))
+
+    def _unreached_below(self, task: Term, size: int) -> str | None:
+        """The sizes below ``size`` that hold the task's objects and whose search finished,
+        as ``"2 to 5"``, when none of them reaches the goal; None when one does, or none
+        could be searched."""
+        searched = []
+        for n in range(1, size):
+            if self._ask("world_absent", self.kb.module, task, n):
+                continue
+            verdict = self._ask("world_reachable", self.kb.module, task, n, REACH_LIMIT)
+            if verdict == "reachable":
+                return None
+            if verdict != "unreachable":
+                break
+            searched.append(n)
+        if not searched:
+            return None
+        return str(searched[0]) if len(searched) == 1 else f"{searched[0]} to {searched[-1]}"
 
     def _task(self, task: Term | str) -> Term:
         return self.task(task) if isinstance(task, str) else task

@@ -7,7 +7,7 @@ domain. Outputs that must *not* be written are
 checked in ``test_outputs.py``; lost devices, faults, signals and full disks in
 ``test_nothing_lost.py``.
 
-The corpus holds 275 cases: 199 bad inputs in ``CASES`` and 32 more tests here, 26 in
+The corpus holds 277 cases: 201 bad inputs in ``CASES`` and 32 more tests here, 26 in
 ``test_outputs.py``, 18 in ``test_nothing_lost.py`` (each parametrized case counted once;
 :func:`test_the_corpus_says_how_many_cases_it_holds` keeps these numbers true).
 """
@@ -301,6 +301,10 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("evaluate-missing-policy", ["evaluate", "{d}/nope.pl", "--world",
                                  BLOCKS, "--task", "stack"],
      ["nope.pl", "no such"]),
+    ("evaluate-policy-a-folder", ["evaluate", "{d}/adir", "--world", BLOCKS, "--task", "stack"],
+     ["adir", "a folder, not a policy file"]),
+    ("evaluate-policy-dev-zero", ["evaluate", "/dev/zero", "--world", BLOCKS, "--task",
+                                  "stack"], ["/dev/zero", "not a regular file"]),
     ("learn-world-a-folder", ["learn", "{d}/adir"], ["adir", "no such world file"]),
     ("learn-random-bytes", ["learn", "{d}/random.toml"], ["random.toml"]),
     ("learn-unknown-task", LEARN + ["--task", "fly"], ["fly", "no such task"]),

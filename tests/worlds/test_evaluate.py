@@ -173,3 +173,16 @@ def test_evaluate_refuses_a_task_instance_that_cannot_be_reached(policies, tmp_p
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "cannot be reached" in err[0], err
     assert not (out / "results.json").exists()
+
+
+def test_evaluate_refuses_an_object_the_world_lacks_at_its_default_sizes(policies,
+                                                                        tmp_path: Path,
+                                                                        capsys) -> None:
+    """At 10, 20 and 50 blocks (too many states to search) b99 is still no block of the
+    world: one line, exit 2 (it evaluated, with an 'optimum' from the world's formula)."""
+    out = tmp_path / "bad"
+    assert _evaluate(policies["on"], "on(b1, b99)", "--episodes", "2",
+                     "--out", str(out)) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "names b99" in err[0] and "10 objects" in err[0], err
+    assert not (out / "results.json").exists()

@@ -291,6 +291,42 @@ def test_a_stopped_experiment_worlds_keeps_every_finished_point(tmp_path: Path,
         [("tg", "0"), ("tg", "10"), ("ptg", "0"), ("ptg", "10")]
 
 
+def test_a_real_sigint_to_experiment_worlds_keeps_each_unfinished_jobs_policy(
+        tmp_path: Path) -> None:
+    """B's sibling on experiment worlds: a job stopped by Ctrl-C keeps its evaluation
+    points and the policy it last saved (it kept the points only)."""
+    import json
+    import signal
+    import time
+
+    out = tmp_path / "out"
+    proc = started("experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack",
+                   "--learners", "tg", "--seeds", "0", "--episodes", "10000000", "--block",
+                   "20", "--eval-episodes", "2", "--sizes", "3", "--test-sizes", "4",
+                   "--workers", "1", "--no-speed", "--out", str(out))
+    time.sleep(15)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    results = json.loads((out / "results.json").read_text())
+    assert results["partial"] and results["jobs"][0]["partial"], results["jobs"]
+    policies = list((out / "policies").glob("*.pl"))
+    assert [p.name for p in policies] == ["blocks-stack-tg-s0.pl"], err
+    assert "tg_tree(" in policies[0].read_text()
+
+
+def test_a_bad_policy_to_start_from_claims_no_folder(tmp_path: Path) -> None:
+    """`relrl learn --policy BAD.pl` refuses the policy in one line before it makes the
+    output folder (it wrote results.json and the rest, marked partial, for a bad input)."""
+    bad = tmp_path / "twice.pl"
+    bad.write_bytes(b"% caf\xe9\nrelrl_policy(tg, []).\n")
+    out = tmp_path / "out"
+    line = one_line(relrl("learn", str(BLOCKS), "--task", "stack", "--policy", str(bad),
+                          "--out", str(out)))
+    assert "twice.pl" in line and "UTF-8" in line, line
+    assert not out.exists()
+
+
 # ---- G, H: relrl learn's seed, traces and task instances -------------------------------------
 
 LEARN = ["learn", str(BLOCKS), "--episodes", "1", "--eval-episodes", "1", "--no-speed"]
@@ -305,6 +341,10 @@ LEARN = ["learn", str(BLOCKS), "--episodes", "1", "--eval-episodes", "1", "--no-
     (["--task", "on(b1, b99)"], ["on(b1, b99)", "cannot be reached"]),
     (["--task", "on(b1, shell(x))"], ["on(b1, shell(x))", "cannot be reached"]),
     (["--task", "on(b4, b5)", "--sizes", "5,3"], ["on(b4, b5)", "3 objects"]),
+    # sizes too large to search: the objects are still checked (no search needed)
+    (["--task", "on(b1, b99)", "--sizes", "10", "--eval-sizes", "50"],
+     ["on(b1, b99)", "names b99", "10 objects"]),
+    (["--task", "on(b1, shell(x))", "--sizes", "10"], ["names shell(x)", "10 objects"]),
 ])
 def test_learn_options_are_checked(capsys, argv: list[str], needles: list[str]) -> None:
     from tests.cli.conftest import one_line_exit_2
@@ -343,6 +383,20 @@ def test_ctrl_c_stops_a_domain_directive_that_never_ends_at_once(tmp_path: Path)
     _, err = proc.communicate(timeout=60)
     assert time.monotonic() - t0 < 3, err
     assert proc.returncode == 130 and "Traceback" not in err, err
+
+
+def test_a_goal_no_searchable_size_reaches_is_a_warning_at_larger_sizes(tmp_path: Path) -> None:
+    """H at sizes too large to search: on(b1, b1) at 10 blocks is learned as asked, with a
+    warning that no world of 1 to 5 blocks (searched whole) reaches it; on(b1, b2) is not."""
+    warned = relrl("learn", str(BLOCKS), "--task", "on(b1, b1)", "--sizes", "10",
+                   "--eval-sizes", "10", "--episodes", "2", "--eval-episodes", "1",
+                   "--no-speed", "--out", str(tmp_path / "a"))
+    assert warned.returncode == 0, warned.stderr
+    assert "reached in no world of 1 to 5 objects" in warned.stderr, warned.stderr
+    quiet = relrl("learn", str(BLOCKS), "--task", "on(b1, b2)", "--sizes", "10",
+                  "--eval-sizes", "10", "--episodes", "2", "--eval-episodes", "1",
+                  "--no-speed", "--out", str(tmp_path / "b"))
+    assert quiet.returncode == 0 and "reached in no world" not in quiet.stderr, quiet.stderr
 
 
 def test_ctrl_c_while_a_domain_loads_is_a_stop_not_a_problem_of_the_file(tmp_path: Path) -> None:
