@@ -140,10 +140,11 @@ PYTHON_NEEDS: dict[str, str] = {
     "from stable_baselines3 import PPO": "sb3",
 }
 
-#: commands (as written) that take minutes: run with ``-m slow``.
+#: commands (as written) that take seconds to minutes: run with ``-m slow``, once a session.
 SLOW = {
     ".venv/bin/relrl experiment scaling --quick --out runs/scaling-quick",
     "relrl run examples/episodes/experiment2.toml --out runs/exp2",
+    "relrl run examples/episodes/watch.toml --out runs/watch --record",
     ".venv/bin/relrl bench --json runs/bench/results.json",
     "python -m bench.perception_speed",
     "python -m perception.fruits",
@@ -252,7 +253,8 @@ def _params() -> list:
     for block in all_blocks():
         if block.lang not in RUN or not _runs(block):
             continue
-        slow = block.lang != "python" and any(c in SLOW for c, _ in commands(block))
+        slow = block.lang != "python" and any(c in SLOW or BEFORE.get(c) in SLOW
+                                              for c, _ in commands(block))
         marks = [pytest.mark.slow] if slow or _slow_python(block) else []
         marks += [getattr(pytest.mark, PYTHON_NEEDS[x.strip()]) for x in block.lines
                   if block.lang == "python" and x.strip() in PYTHON_NEEDS]
@@ -380,15 +382,22 @@ def _check_shown(shown: list[str], printed: str, where: str, command: str) -> No
 _RAN: dict[str, tuple[Path, str]] = {}
 
 
-def _ran_before(command: str, tmp_path: Path) -> str:
+def _run_once(command: str, tmp_path: Path, env: dict[str, str], where: str,
+              stdin: str | None = None, *, fails: bool = False) -> str:
+    """:func:`_run`, or for a slow command an earlier block ran, what it printed and wrote."""
     import shlex
     import shutil
 
-    where, printed = _RAN[command]
+    if command not in SLOW or command not in _RAN:
+        printed = _run(command, tmp_path, env, where, stdin, fails=fails)
+        if command in SLOW:
+            _RAN[command] = (tmp_path, printed)
+        return printed
+    ran_in, printed = _RAN[command]
     args = shlex.split(command)
     if "--out" in args:
         out = args[args.index("--out") + 1]
-        shutil.copytree(where / out, tmp_path / out, symlinks=True)
+        shutil.copytree(ran_in / out, tmp_path / out, symlinks=True)
     return printed
 
 
@@ -427,14 +436,9 @@ def test_the_block_runs_as_written(block: Block, tmp_path: Path) -> None:
         if command in NOT_RUN:
             continue
         if command in BEFORE:
-            _run(BEFORE[command], tmp_path, env, f"{block.where} (before it)")
+            _run_once(BEFORE[command], tmp_path, env, f"{block.where} (before it)")
         queries = [x[3:] for x in shown if x.startswith("?- ")]
-        if command in SLOW and command in _RAN:
-            printed = _ran_before(command, tmp_path)
-        else:
-            printed = _run(command, tmp_path, env, block.where,
-                           stdin="\n".join(queries) + "\n" if queries else None,
-                           fails=bool(shown))
-            if command in SLOW:
-                _RAN[command] = (tmp_path, printed)
+        printed = _run_once(command, tmp_path, env, block.where,
+                            stdin="\n".join(queries) + "\n" if queries else None,
+                            fails=bool(shown))
         _check_shown(shown, printed, block.where, command)

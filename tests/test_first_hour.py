@@ -88,6 +88,7 @@ def _serve_and_read(line: str, cwd: Path, *, interrupt: bool) -> str:
     return "".join(out)
 
 
+@pytest.mark.slow
 def test_every_first_hour_command_runs_as_written(tmp_path: Path) -> None:
     (tmp_path / ".venv").symlink_to(ROOT / ".venv")
     (tmp_path / "examples").symlink_to(ROOT / "examples")

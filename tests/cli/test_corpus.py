@@ -373,6 +373,7 @@ def test_bad_input_is_one_line_and_exit_2(capsys, monkeypatch, corpus, argv, nee
     one_line_exit_2(capsys, argv, *needles)
 
 
+@pytest.mark.slow
 def test_report_renders_html_and_markdown_in_a_run_as_text(capsys, corpus):
     """Names and commands from a run are shown as the characters they are: no HTML tag, no
     table column or line of their own, no block end, no link with a scheme."""
@@ -405,6 +406,7 @@ def _paths(value, path=()):
         yield from _paths(inner, (*path, key))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["exp1", "exp2", "bench", "worlds", "scaling", "transfer"])
 def test_report_on_a_results_json_with_a_key_missing_or_of_another_type(tmp_path, name):
     """Every key of a shipped run's results.json taken out, or made a string, null or a

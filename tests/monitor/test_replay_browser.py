@@ -75,6 +75,7 @@ def test_scrubbing_shows_each_time_unit(page, recorded: Path, tmp_path: Path) ->
     assert not page.errors, page.errors
 
 
+@pytest.mark.slow
 def test_the_recorded_folder_is_self_contained(recorded: Path) -> None:
     manifest = json.loads((recorded / "session.json").read_text())
     for name in manifest["files"].values():

@@ -209,6 +209,7 @@ def test_a_message_compressed_bag_is_read_through_its_folder(tmp_path: Path) -> 
              db3.name)  # the .db3 alone does not say its messages are compressed
 
 
+@pytest.mark.slow
 def test_db3_paced_at_recorded_times(tmp_path: Path) -> None:
     import time
 
@@ -221,6 +222,7 @@ def test_db3_paced_at_recorded_times(tmp_path: Path) -> None:
     assert cam.ended and abs(cam.seconds - 0.9) < 1e-6
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["fox_protobuf", "fox_json", "db3"])
 def test_perceive_prints_each_frames_facts(tmp_path: Path, kind: str) -> None:
     frames = scenes(2)
@@ -234,6 +236,7 @@ def test_perceive_prints_each_frames_facts(tmp_path: Path, kind: str) -> None:
 
 # ---- the targets: hello.toml on each kind of bag; the bag's end is the session's ------------
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["fox_protobuf", "fox_json", "db3"])
 def test_hello_runs_on_a_bag_to_its_end(tmp_path: Path, kind: str) -> None:
     """hello.toml asks for 12 time units; the bag holds 6 frames (2.5 s): the session ends
@@ -266,6 +269,7 @@ def test_hello_runs_on_a_bag_to_its_end(tmp_path: Path, kind: str) -> None:
     assert recorded.summary["recording_ended"] == summary["recording_ended"]
 
 
+@pytest.mark.slow
 def test_the_policy_is_evaluated_where_the_recording_ended(tmp_path: Path) -> None:
     """An episode with evaluations every 100 time units on a bag of a few: the policy as
     learned when the bag ended is evaluated (on the simulator), as at an episode's end."""
@@ -282,6 +286,7 @@ def test_the_policy_is_evaluated_where_the_recording_ended(tmp_path: Path) -> No
     assert [p["units"] for p in summary["evaluation"]] == [0, summary["units"]]
 
 
+@pytest.mark.slow
 def test_a_bag_longer_than_the_episode_ends_with_the_episode(tmp_path: Path) -> None:
     bag = write_foxglove(tmp_path / "fox.mcap", scenes(40), hz=2.0)
     out = relrl("run", "examples/episodes/hello.toml", "--camera", str(bag), "--out",
@@ -294,6 +299,7 @@ def test_a_bag_longer_than_the_episode_ends_with_the_episode(tmp_path: Path) -> 
 
 # ---- 34.M: a compressed frame's size is read from its header before it is decoded ---------
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["ros_cdr", "fox_protobuf", "fox_json", "db3"])
 def test_a_huge_png_in_a_bag_is_refused_before_decoding(tmp_path: Path, kind: str) -> None:
     """A small bag holding a PNG of 16000x16000 pixels: refused from its header, in one line
@@ -438,6 +444,7 @@ def _replace_message(bag: Path, data: bytes | None, *, schema_name: str | None =
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case, says", [
     ("image_named_compressed_defined", "no field 'width'"),
     ("db3_image_named_compressed_defined", "no field 'width'"),

@@ -50,6 +50,7 @@ def messages(tmp_path_factory) -> dict[str, list]:
     return got
 
 
+@pytest.mark.slow
 def test_the_schemas_are_foxglove_sdks(messages) -> None:
     from foxglove.messages import FrameTransforms, ImageAnnotations, SceneUpdate
 

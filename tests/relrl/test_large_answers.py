@@ -7,6 +7,8 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import pytest
+
 from tests.conftest import ROOT
 
 SCRIPT = """
@@ -19,6 +21,7 @@ with KnowledgeBase() as kb:
 """
 
 
+@pytest.mark.slow
 def test_an_answer_of_a_million_atoms_does_not_abort_prolog() -> None:
     """In a process of its own: the abort it guards against would end the test run."""
     proc = subprocess.run([sys.executable, "-c", SCRIPT, "1200000"], cwd=ROOT, text=True,

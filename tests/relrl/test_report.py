@@ -40,6 +40,7 @@ def test_a_run_renders_its_numbers_and_where_they_come_from(sis_run: Path) -> No
     assert "paper (2012)" in short and "3,150" in short
 
 
+@pytest.mark.slow
 def test_blocks_are_rerendered_in_place_and_staleness_is_found(sis_run: Path,
                                                                tmp_path: Path) -> None:
     shutil.copytree(sis_run, tmp_path / "exp1")

@@ -65,6 +65,7 @@ def test_check_world_unreachable_goal_is_an_error(tmp_path: Path, capsys) -> Non
     assert code == 2 and "unreachable" in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_check_world_search_stopped_by_its_limit_is_a_warning(tmp_path: Path, capsys) -> None:
     path = _world(tmp_path, BASE.replace("Y < 3, ", "").replace("memberchk(at(3), S).",
                                                                "memberchk(at(-1), S)."))
@@ -110,6 +111,7 @@ def test_check_world_2000_unreachable_tasks_stop_after_ten(tmp_path: Path, capsy
                         "fix them and check again")
 
 
+@pytest.mark.slow
 def test_check_world_deep_recursion_reported_once(tmp_path: Path, capsys) -> None:
     """A goal rule without end: one line naming it, after one overflow (not one per
     episode and task)."""

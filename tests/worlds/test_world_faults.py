@@ -43,6 +43,7 @@ def one_line(proc: subprocess.CompletedProcess) -> str:
 
 # ---- A: halt in a world rule --------------------------------------------------------------
 
+@pytest.mark.slow
 @pytest.mark.parametrize("goal", ["halt", "halt(3)"])
 def test_halt_in_a_world_rule_is_one_line_naming_the_rule(tmp_path: Path, goal: str) -> None:
     world, line = world_with(tmp_path, f"precondition(move(_, _), _) :- {goal}.")
@@ -80,6 +81,7 @@ def wait_for(stream, marker: str, proc: subprocess.Popen, timeout: float = 240) 
     raise AssertionError(f"no {marker!r} (exit {proc.poll()}): {''.join(seen)[-2000:]}")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("body", ["repeat, fail", "sleep(1000)"])
 def test_a_world_rule_that_never_ends_is_stopped_at_the_rule_limit(tmp_path: Path,
                                                                      body: str) -> None:
@@ -97,6 +99,7 @@ def test_a_world_rule_that_never_ends_is_stopped_at_the_rule_limit(tmp_path: Pat
     assert f"w.pl:{line}: rule precondition(" in learn and "longer than 0.5 s" in learn
 
 
+@pytest.mark.slow
 def test_a_long_batch_of_a_world_is_not_a_rule_that_never_ends(tmp_path: Path) -> None:
     """Every step is a rule's end: a batch of episodes that runs many times the limit, each
     step slow but ending, is not stopped."""
@@ -107,6 +110,7 @@ def test_a_long_batch_of_a_world_is_not_a_rule_that_never_ends(tmp_path: Path) -
     assert proc.returncode == 0, proc.stderr[-2000:]
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_a_world_rule_that_never_ends_at_once(tmp_path: Path) -> None:
     """Ctrl-C reaches a rule that loops in `check --world` (the world's directive says when
     it has loaded): exit 130 within a second or so, not at the rule limit."""
@@ -192,6 +196,7 @@ def assert_partial(out: Path, points: int) -> dict:
     return results
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signame", ["SIGINT", "SIGTERM", "SIGHUP"])
 def test_a_stopped_learn_keeps_its_policy_and_partial_results(tmp_path: Path,
                                                                signame: str) -> None:
@@ -210,6 +215,7 @@ def test_a_stopped_learn_keeps_its_policy_and_partial_results(tmp_path: Path,
     assert_partial(out, 3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("gap", [0.0, 0.05])
 def test_a_second_ctrl_c_does_not_lose_what_was_learned(tmp_path: Path, gap: float) -> None:
     import signal
@@ -228,6 +234,7 @@ def test_a_second_ctrl_c_does_not_lose_what_was_learned(tmp_path: Path, gap: flo
     assert_partial(out, 2)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("goal, words", [("atom_length(S, _)", "atom_length/2"),
                                          ("halt", "called halt/0,1")])
 def test_a_rule_error_mid_run_keeps_the_policy_learned_before_it(tmp_path: Path, goal: str,
@@ -291,6 +298,7 @@ def test_a_stopped_experiment_worlds_keeps_every_finished_point(tmp_path: Path,
         [("tg", "0"), ("tg", "10"), ("ptg", "0"), ("ptg", "10")]
 
 
+@pytest.mark.slow
 def test_a_real_sigint_to_experiment_worlds_keeps_each_unfinished_jobs_policy(
         tmp_path: Path) -> None:
     """B's sibling on experiment worlds: a job stopped by Ctrl-C keeps its evaluation
@@ -315,6 +323,7 @@ def test_a_real_sigint_to_experiment_worlds_keeps_each_unfinished_jobs_policy(
     assert "tg_tree(" in policies[0].read_text()
 
 
+@pytest.mark.slow
 def test_a_bad_policy_to_start_from_claims_no_folder(tmp_path: Path) -> None:
     """`relrl learn --policy BAD.pl` refuses the policy in one line before it makes the
     output folder (it wrote results.json and the rest, marked partial, for a bad input)."""
@@ -360,6 +369,7 @@ def test_a_reachable_task_instance_is_learned() -> None:
         world.check_instance("on", [3])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("value", ["0", "-1", "nan", "inf", "soon"])
 def test_a_rule_limit_that_is_no_positive_number_is_refused(value: str) -> None:
     for argv in (LEARN, ["check", "--world", str(BLOCKS)], ["experiment", "worlds"]):
@@ -385,6 +395,7 @@ def test_ctrl_c_stops_a_domain_directive_that_never_ends_at_once(tmp_path: Path)
     assert proc.returncode == 130 and "Traceback" not in err, err
 
 
+@pytest.mark.slow
 def test_a_goal_no_searchable_size_reaches_is_a_warning_at_larger_sizes(tmp_path: Path) -> None:
     """H at sizes too large to search: on(b1, b1) at 10 blocks is learned as asked, with a
     warning that no world of 1 to 5 blocks (searched whole) reaches it; on(b1, b2) is not."""
@@ -399,6 +410,7 @@ def test_a_goal_no_searchable_size_reaches_is_a_warning_at_larger_sizes(tmp_path
     assert quiet.returncode == 0 and "reached in no world" not in quiet.stderr, quiet.stderr
 
 
+@pytest.mark.slow
 def test_ctrl_c_while_a_domain_loads_is_a_stop_not_a_problem_of_the_file(tmp_path: Path) -> None:
     """Ctrl-C while `relrl run` reads a domain's clauses (not in a directive): exit 130 and
     "interrupted", as anywhere else (it said "d.pl: interrupted", exit 2)."""
@@ -422,6 +434,7 @@ def test_ctrl_c_while_a_domain_loads_is_a_stop_not_a_problem_of_the_file(tmp_pat
     assert "d.pl" not in err, err
 
 
+@pytest.mark.slow
 def test_a_failed_experiment_worlds_job_keeps_its_points_and_policy(tmp_path: Path) -> None:
     """A job whose rule fails on the larger test size: the run stops (exit 2, one line), the
     job's evaluation points and the policy it saved before that evaluation are kept."""
@@ -452,6 +465,7 @@ goal(reach, S) :- memberchk(pos(3), S).
 """
 
 
+@pytest.mark.slow
 def test_an_answer_too_deep_to_cross_is_one_line_and_keeps_the_policy(tmp_path: Path) -> None:
     """S's other way: an answer relrl cannot read (the kept greedy episodes' states hold a
     term 600 deep) fails with one line, exit 2 -- not a traceback -- after the policy and
@@ -469,6 +483,7 @@ def test_an_answer_too_deep_to_cross_is_one_line_and_keeps_the_policy(tmp_path: 
     assert (out / "policy.pl").is_file()
 
 
+@pytest.mark.slow
 def test_a_world_directive_that_never_ends_is_stopped_at_the_rule_limit(tmp_path: Path) -> None:
     """Loading a world is bounded by --rule-seconds too (it waited 600 s)."""
     import time

@@ -265,6 +265,7 @@ def test_evaluation_draws_the_same_states_whatever_was_learned() -> None:
     assert evaluation_seed(2, "size 4") != evaluation_seed(3, "size 4")
 
 
+@pytest.mark.slow
 def test_experiment_worlds_policies_do_not_depend_on_evaluation(tmp_path: Path) -> None:
     """relrl experiment worlds learns the same policies whatever its evaluation flags."""
     common = ["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "on",
@@ -279,6 +280,7 @@ def test_experiment_worlds_policies_do_not_depend_on_evaluation(tmp_path: Path) 
     assert texts[0] == texts[1]
 
 
+@pytest.mark.slow
 def test_experiment_worlds_runs_each_worlds_own_tasks(tmp_path: Path) -> None:
     """Without --tasks every world runs the tasks it declares (blocks' four, delivery's
     one); --seeds takes a range; the summary has the worst seed and the share reaching the
