@@ -559,23 +559,41 @@ _CLOCK = {"process CPU time": "CPU", "wall": "wall-clock"}
 
 @view("worlds", "cost")
 def _worlds_cost(run: Run) -> str:
+    return worlds_cost_table(run.timing)
+
+
+def worlds_cost_table(timing: dict[str, Any]) -> str:
+    """A worlds run's cost, one row per job measured (made without ``--no-speed``): the
+    learning steps per second, a learning step's CPU cost at each size, its growth (the
+    slope k of cost ∝ size^k over every size and over the test sizes alone) and a greedy
+    episode's CPU cost at the largest test size."""
     rows, clocks = [], set()
-    for t in run.timing.get("jobs", []):
+    largest = None
+    for t in timing.get("jobs", []):
         cost = t.get("step_cost_by_size")
         if not cost:
             continue
         clocks.add(cost.get("clock", "wall"))      # runs before the CPU clock: wall time
         sizes = cost["sizes"]
+        greedy = (t.get("greedy_episode_cost_by_size") or {}).get("sizes") or {}
+        big = max(greedy, key=int, default=None)
+        largest = big if largest is None or big is None else max(largest, big, key=int)
+        fit = cost.get("fit_sizes") or []
         rows.append([Path(t["world"]).stem, t["task"], t["learner"], t["seed"],
                      _f(t.get("learning_steps_per_second"), 0),
                      " / ".join(_f(cost["us_per_step"][str(s)], 0) for s in sizes),
                      _f(cost["cost_ratio"][str(sizes[-1])]),
                      _f(cost["size_ratio"][str(sizes[-1])]),
-                     _f(cost.get("slope"))])
+                     _f(cost.get("slope")),
+                     (f"{_f(cost.get('fit_slope'))} ({fit[0]}–{fit[-1]})" if fit else "—"),
+                     (f"{_f(greedy[big]['cpu_ms_per_episode'], 1)} ({big}: "
+                      f"{_f(greedy[big]['steps'] / greedy[big]['episodes'], 1)} steps)"
+                      if big else "—")])
     return table(["world", "task", "learner", "seed", "learning steps/s",
                   f"{' or '.join(sorted(_CLOCK.get(c, c) for c in clocks)) or 'CPU'} µs "
                   "per learning step by size", "cost ratio, largest / smallest",
-                  "size ratio", "slope k (cost ∝ size^k)"], rows)
+                  "size ratio", "slope k (cost ∝ size^k)", "slope k over the test sizes",
+                  "CPU ms per greedy episode, largest test size (its mean steps)"], rows)
 
 
 _CLAIM_ROWS = {"after_first_run": "all three near 0.8 CGI after the first 500-unit run",

@@ -214,7 +214,11 @@ TIMING: dict[str, Any] = {
     "machine_info?": Maybe(_MACHINE), "machine?": Maybe(str),
     "jobs?": ListOf({"step_cost_by_size?": Maybe({
         "clock?": str, "sizes": ListOf(int, least=1), "us_per_step": MapOf(float),
-        "cost_ratio": MapOf(float), "size_ratio": MapOf(float), "slope?": Maybe(float)})}),
+        "cost_ratio": MapOf(float), "size_ratio": MapOf(float), "slope?": Maybe(float),
+        "fit_sizes?": ListOf(int), "fit_slope?": Maybe(float)}),
+        "greedy_episode_cost_by_size?": Maybe({"clock?": str, "sizes": MapOf({
+            "episodes": int, "steps": int, "cpu_ms_per_episode": float,
+            "cpu_us_per_step?": Maybe(float)})})}),
 }
 #: ``.relrl-run.json`` (the command and when it ran).
 MANIFEST: dict[str, Any] = {"command?": Maybe(str), "started?": Maybe(str),

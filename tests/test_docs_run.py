@@ -87,6 +87,12 @@ NOT_RUN: dict[str, str] = {
     "--learners tg --seeds 0-9 --workers 2 --no-speed --out runs/worlds":
         "the ten-seed benchmark of worlds.md's results, tens of minutes on two cores; "
         "docs/results/worlds is its run",
+    "relrl experiment worlds --worlds examples/worlds/gripper.pl --learners tg --seeds 0-9 "
+    "--workers 1 --no-speed --out runs/gripper":
+        "worlds.md's gripper run, minutes on two cores; docs/results/gripper is its run",
+    "relrl experiment worlds --worlds examples/worlds/blocks.pl --learners tg --seeds 0 "
+    "--workers 1 --out runs/worlds-cost":
+        "worlds.md's cost run, minutes on two cores; docs/results/worlds-cost is its run",
     "relrl report runs/worlds": "renders the run of the line before it (an hour); "
                                 "docs/outputs.md runs relrl report on a shipped run",
     ".venv/bin/relrl experiment scaling --world colours=3,kinds=2,scene=true --sizes 5,9,17 "

@@ -13,8 +13,9 @@
     the other room), pick(O) (a ball in the robot's room into the first free gripper, left
     before right), drop(O) (a held ball onto the floor of the robot's room). Task deliver: every ball on the floor
     of roomb. Start states: each ball in either room and the robot in either, uniformly,
-    the grippers empty. Reward 1 when the goal is reached (discount 0.9, tg's default), as in
-    blocks.pl.
+    the grippers empty. Reward -1 a step, 0 for the step that reaches the goal, discount 0.95,
+    as in delivery.pl: a Q-value is about minus the steps still to take, so a wasted trip
+    costs as much far from the goal as near it.
 */
 
 % ---- states ------------------------------------------------------------------------------
@@ -32,6 +33,14 @@ ball_at(I, at(O, R)) :-
 % ---- tasks -------------------------------------------------------------------------------
 
 task(deliver).
+
+discount(0.95).
+
+reward(Goal, _, _, State, R) :-
+    (   goal(Goal, State)
+    ->  R = 0
+    ;   R = -1
+    ).
 
 goal(deliver, State) :-
     \+ memberchk(carry(_, _), State),

@@ -550,11 +550,17 @@ def build_worlds_config(args: argparse.Namespace):
 
 
 def _run_worlds(args: argparse.Namespace) -> int:
+    from relrl.report import worlds_cost_table
     from relrl.worlds.experiment import OUTPUTS, run_worlds, worlds_table
 
     results, files, out, signum = _claimed_run(args, "runs/worlds", OUTPUTS, run_worlds,
                                                build_worlds_config(args))
     print(worlds_table(results))
+    timing = json.loads((out / "timing.json").read_text())
+    if any(t.get("step_cost_by_size") for t in timing.get("jobs", [])):
+        print("\ncost (process CPU time; a learning step at each size from the learned policy, "
+              "the median of five rounds):\n")
+        print(worlds_cost_table(timing))
     return _finish(results, files, out, signum)
 
 

@@ -317,7 +317,15 @@ def _summary(result: dict, t: dict) -> None:
                           f"{cost['size_ratio'][s]:.2f})" for s in cost["us_per_step"]
                           if cost["us_per_step"][s] is not None)
               + (f"; slope {slope:.2f} (cost ∝ size^k, linear: k = 1)" if slope is not None
-                 else ""))
+                 else "")
+              + (f", {cost['fit_slope']:.2f} over sizes {cost['fit_sizes'][0]}-"
+                 f"{cost['fit_sizes'][-1]}" if cost.get("fit_slope") is not None else ""))
+    greedy = (t.get("greedy_episode_cost_by_size") or {}).get("sizes")
+    if greedy:
+        print("greedy episode cost by size (CPU ms/episode, us/step): "
+              + ", ".join(f"{s}: {g['cpu_ms_per_episode']:.1f} ("
+                          + (f"{g['cpu_us_per_step']:.0f}" if g["cpu_us_per_step"] else "-")
+                          + ")" for s, g in greedy.items()))
 
 
 def _write(out: Path, config, result: dict) -> list[Path]:

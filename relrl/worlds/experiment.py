@@ -300,12 +300,14 @@ def write_outputs(out: Path, results: dict[str, Any], timing: dict[str, Any]) ->
                        for j in results["jobs"] for s, v in j["test"].items()]))
     files.append(_csv(out / "step_cost.csv",
                       ["world", "task", "learner", "seed", "size", "cpu_us_per_step",
-                       "cost_ratio", "size_ratio", "slope", "learning_steps_per_second"],
+                       "cost_ratio", "size_ratio", "slope", "fit_slope",
+                       "learning_steps_per_second"],
                       [[t["world"], t["task"], t["learner"], t["seed"], int(s),
                         t["step_cost_by_size"]["us_per_step"][s],
                         t["step_cost_by_size"]["cost_ratio"][s],
                         t["step_cost_by_size"]["size_ratio"][s],
                         t["step_cost_by_size"].get("slope"),
+                        t["step_cost_by_size"].get("fit_slope"),
                         t["learning_steps_per_second"]]
                        for t in timing["jobs"] if "step_cost_by_size" in t
                        for s in t["step_cost_by_size"]["us_per_step"]]))

@@ -113,6 +113,7 @@ class _Run:
         self.curve: list[dict[str, Any]] = []
         self.test: dict[str, Any] = {}
         self.kept: dict[str, list[dict[str, Any]]] = {}
+        self.eval_cost: dict[str, dict[str, Any]] = {}
         self.memory: dict[str, Any] = {}
         self.learn_seconds, self.learn_steps, self.done = 0.0, 0, 0
         self.policy_episodes: int | None = None     # learning episodes of the saved policy
@@ -193,14 +194,19 @@ class _Run:
             # traced episodes of 50 blocks is millions of terms); the rest follow from a
             # stream of their own
             kept = min(traces, config.eval_episodes)
+            t0 = time.process_time()
             eps = world.episodes(task, [size], kept, "greedy", optimal=True, trace=True,
                                  seed=evaluation_seed(config.seed, f"size {size}")) \
                 if kept else []
+            timed = eps
             if config.eval_episodes > kept:
-                eps += world.episodes(task, [size], config.eval_episodes - kept, "greedy",
-                                      optimal=True,
-                                      seed=evaluation_seed(config.seed,
-                                                           f"size {size} untraced"))
+                t0 = time.process_time()
+                timed = world.episodes(task, [size], config.eval_episodes - kept, "greedy",
+                                       optimal=True,
+                                       seed=evaluation_seed(config.seed,
+                                                            f"size {size} untraced"))
+                eps += timed
+            self._eval_cost(size, timed, time.process_time() - t0)
             self.test[str(size)] = score(eps)
             if traces:
                 self.kept[str(size)] = [{"goal": e.goal, "steps": e.steps,
@@ -209,7 +215,9 @@ class _Run:
         timing = self._timing()
         if config.speed:
             sizes = config.cost_sizes or sorted({*config.train_sizes, *config.test_sizes})
-            timing["step_cost_by_size"] = step_cost_by_size(world, task, self.saved, sizes)
+            timing["step_cost_by_size"] = step_cost_by_size(
+                world, task, self.saved, sizes,
+                fit_sizes=[s for s in sizes if s >= min(config.test_sizes, default=0)])
             timing["shape"] = _shape(world, task, self.saved, config.train_sizes)
         out = {"world": Path(config.world).name, "task": config.task,
                "learner": config.learner, "seed": config.seed, "curve": curve,
@@ -220,10 +228,25 @@ class _Run:
             out["graph"] = world.engine.graph()
         return out
 
+    def _eval_cost(self, size: int, eps: Sequence[Any], seconds: float) -> None:
+        """Keep what the greedy episodes of one test size cost: CPU milliseconds per
+        episode and microseconds per step (the untraced episodes when there are some: a
+        traced episode's steps cross back into Python)."""
+        if eps:
+            steps = sum(e.steps for e in eps)
+            self.eval_cost[str(size)] = {
+                "episodes": len(eps), "steps": steps,
+                "cpu_ms_per_episode": 1e3 * seconds / len(eps),
+                "cpu_us_per_step": 1e6 * seconds / steps if steps else None}
+
     def _timing(self) -> dict[str, Any]:
-        return {"learning_seconds": self.learn_seconds, "learning_steps": self.learn_steps,
-                "learning_steps_per_second": self.learn_steps / self.learn_seconds
-                if self.learn_seconds else None}
+        out = {"learning_seconds": self.learn_seconds, "learning_steps": self.learn_steps,
+               "learning_steps_per_second": self.learn_steps / self.learn_seconds
+               if self.learn_seconds else None}
+        if self.eval_cost:
+            out["greedy_episode_cost_by_size"] = {"clock": "process CPU time",
+                                                  "sizes": dict(self.eval_cost)}
+        return out
 
     def partial(self, exc: BaseException) -> dict[str, Any]:
         """What the run has done, for a stop or an error (no call into Prolog: the crossing
@@ -274,7 +297,8 @@ def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str,
 
 
 def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int], *,
-                      episodes: int = 20, rounds: int = 5) -> dict[str, Any]:
+                      episodes: int = 20, rounds: int = 5,
+                      fit_sizes: Sequence[int] = ()) -> dict[str, Any]:
     """CPU microseconds per learning step at each size, from the same saved policy.
 
     For each of ``rounds`` rounds, each size in turn: load ``policy`` (not timed), learn
@@ -284,7 +308,10 @@ def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int
     touches every size alike. Returns per size the median over rounds of microseconds per
     step; the ratio of each size's cost to the smallest size's beside the ratio of the
     sizes (linear growth: the two equal); and ``slope``, the exponent k of cost ∝ size^k
-    fitted on logarithms over all the sizes (linear growth: k = 1).
+    fitted on logarithms over all the sizes (linear growth: k = 1); with ``fit_sizes`` (two
+    or more of ``sizes``: the test sizes, 10-50 blocks) also ``fit_slope``, k over those
+    sizes alone, where a cost that grows faster than the world shows (a fixed cost per
+    step weighs on the small sizes and flattens ``slope``).
     """
     from relrl.experiments.results import loglog_slope
 
@@ -306,7 +333,10 @@ def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int
             "cost_ratio": {str(s): (med[s] / med[base]) if med[s] and med[base] else None
                            for s in sizes},
             "size_ratio": {str(s): s / base for s in sizes},
-            "slope": loglog_slope(sizes, [med[s] for s in sizes])}
+            "slope": loglog_slope(sizes, [med[s] for s in sizes]),
+            **({"fit_sizes": list(fit_sizes),
+                "fit_slope": loglog_slope(fit_sizes, [med[s] for s in fit_sizes])}
+               if len(fit_sizes) >= 2 else {})}
 
 
 def _shape(world: World, task: Any, policy: Path, sizes: Sequence[int], *,

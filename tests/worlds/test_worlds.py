@@ -191,13 +191,13 @@ def test_learn_bad_flags_exit_2(argv: list[str], message: str, capsys) -> None:
 
 
 @pytest.mark.slow
-def test_experiment_worlds_and_report(tmp_path: Path) -> None:
+def test_experiment_worlds_and_report(tmp_path: Path, capsys) -> None:
     from relrl.report import load_run, render
 
     out = tmp_path / "exp"
     assert main(["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack",
                  "--learners", "tg,ptg,qtable", "--seeds", "0", "--episodes", "20", "--block",
-                 "10", "--eval-episodes", "5", "--sizes", "3", "--test-sizes", "4",
+                 "10", "--eval-episodes", "5", "--sizes", "3", "--test-sizes", "4,5",
                  "--workers", "1", "--out", str(out)]) == 0
     results = json.loads((out / "results.json").read_text())
     assert {r["learner"] for r in results["summary"]} == {"tg", "ptg", "qtable"}
@@ -211,10 +211,21 @@ def test_experiment_worlds_and_report(tmp_path: Path) -> None:
     assert "| blocks | stack | tg | 1 |" in text
     cost = json.loads((out / "timing.json").read_text())["jobs"][0]["step_cost_by_size"]
     assert cost["clock"] == "process CPU time" and cost["rounds"] == 5
-    # two sizes (3 and 4): the slope is the log of the cost ratio over the log of the sizes'
-    assert cost["slope"] == pytest.approx(math.log(cost["cost_ratio"]["4"]) / math.log(4 / 3))
-    assert "slope" in (out / "step_cost.csv").read_text().splitlines()[0].split(",")
-    assert "slope k (cost ∝ size^k)" in render(load_run(out), "cost")
+    # the test sizes alone (4 and 5): the slope is the log of their costs' ratio over the
+    # log of theirs
+    us = cost["us_per_step"]
+    assert cost["sizes"] == [3, 4, 5] and cost["fit_sizes"] == [4, 5]
+    assert cost["fit_slope"] == pytest.approx(math.log(us["5"] / us["4"]) / math.log(5 / 4))
+    assert {"slope", "fit_slope"} <= set((out / "step_cost.csv").read_text().splitlines()[0]
+                                         .split(","))
+    greedy = json.loads((out / "timing.json").read_text())["jobs"][0][
+        "greedy_episode_cost_by_size"]["sizes"]
+    assert set(greedy) == {"4", "5"} and all(g["episodes"] == 5 and g["cpu_ms_per_episode"] > 0
+                                             for g in greedy.values())
+    view = render(load_run(out), "cost")
+    assert "slope k (cost ∝ size^k)" in view and "slope k over the test sizes" in view
+    assert "(4–5)" in view and "CPU ms per greedy episode" in view
+    assert "slope k over the test sizes" in capsys.readouterr().out
 
 
 @pytest.mark.slow
