@@ -6,6 +6,6 @@ reached through one gateway (:mod:`relrl.kb`); numbers, pixels and wires live in
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = ["__version__"]
