@@ -132,6 +132,7 @@ class SessionTap:
         self.recorder, self._own = recorder, False
         self.quality = int(record_quality)
         self.frames = 0
+        self.traced = 0  # trace lines written
         self._frame_rate = _Rate(record_rate if self.recording else live_rate)
         self._live = _Rate(0 if self.recording else live_rate)  # units sent when live only
         self.files: dict[str, str] = {}
@@ -226,6 +227,7 @@ class SessionTap:
         if self.trace is not None:
             self.trace.write(line + "\n")
             self.trace.flush()
+            self.traced += 1
             self.scalars.add(run.t, _scalars(row))
         if publish:
             hub.publish(dict(row), frame)

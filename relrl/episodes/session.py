@@ -228,7 +228,13 @@ def _on_step(run: _Run, record: Any, phase: str) -> None:
     stats["steps"] += 1
     stats["reward"] += float(record.out.reward)
     stats["attention"] += int(info["record"].attention)
-    run.tap.step(record, phase, outcome=outcome, said=said)
+    traced = run.tap.traced
+    try:
+        run.tap.step(record, phase, outcome=outcome, said=said)
+    except BaseException:
+        if run.tap.traced > traced:  # its trace line was written before the recording or
+            run.done += 1            # the monitor failed: the step is the trace's
+        raise
     run.done += 1  # traced: a step whose trace line could not be written is not counted
     if run.opts.live:
         print(_live_line(run.t, phase, record, outcome, said), file=run.opts.stream,
