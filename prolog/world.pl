@@ -10,19 +10,12 @@
 :- use_module(rules).
 :- use_module(kbstate).
 :- use_module(world_bias).
-:- reexport(world_step,
-            [ world_start/5,        % +KB, +Task, +Size, -State, -Goal
-              world_legal/3,        % +KB, +State, -Actions
-              world_action/3,       % +KB, +State, ?Action
-              world_actions/3,      % +KB, +State, -Actions
-              world_action_list/2,  % +Actions, -List
-              world_next/6,         % +KB, +Goal, +State0, +Action, -State, -Outcome
-              world_view/4,         % +KB, +Goal, +State, -View
-              world_bound/4,        % +KB, +Goal, +State, -Steps
-              world_max_reward/1,   % -Max
-              world_predicate/2,    % ?Name/Arity, ?Required
-              world_defines/2       % +KB, ?Name/Arity
-            ]).
+:- reexport(world_step,                % the vocabulary and one step: world_start/5,
+            except([ world_task_goal/4,  % world_legal/3, world_action(s)/3, world_next/6,
+                     world_state_set/4,  % world_view/4, world_bound/4, ... (world_step.pl);
+                     world_holds_goal/3, % these four serve world.pl's sibling modules only
+                     world_contract/4
+                   ])).
 :- reexport(world_episodes).        % world_episodes/3, world_episodes_from/3
 :- reexport(world_search).          % world_optimal/5, world_bfs/5, world_reachable/5, world_absent/4,
                                     % world_verify/5
