@@ -110,23 +110,23 @@ context_record(Record) :-
 %   Run Goal once. Result is `true` (Goal's bindings are kept), `false`, or
 %   error(Kind, Message) (see error_result/2), also for a halt/0,1 called while Goal ran.
 %
-%   The flag that says a guarded call runs is set and restored inside one catch/3, and its
-%   handler restores it too: an exception at any point — the goal's, the time limit's,
-%   Ctrl-C's, even while the flag is restored — leaves it as it was, and abort/0 runs the
-%   handler before it unwinds on.
+%   The flag that says a guarded call runs is set in the setup and restored in the cleanup
+%   of one setup_call_cleanup/3, which SWI-Prolog runs with signals blocked and, when Goal
+%   raises, before the catch/3 handler: an exception at any point — the goal's, the time
+%   limit's, Ctrl-C's — leaves it as it was, and a time limit or Ctrl-C raised again while
+%   the handler runs (the watchdog raises every tenth of a second until the call returns;
+%   a second Ctrl-C raises at once) finds the flag down and does nothing, so no exception
+%   gets past the guard. abort/0 runs the handler before it unwinds on.
 
 guarded(Goal, Result) :-
     call_context(active, Was),
-    catch(guarded_call(Goal, Was, Result0), E, guarded_error(E, Was, Result0)),
+    catch(guarded_call(Goal, Was, Result0), E, error_result(E, Result0)),
     halt_result(Result0, Result).
 
 guarded_call(Goal, Was, Result) :-
-    set_call_context(active, true),
-    once_result(Goal, Result),
-    set_call_context(active, Was).
-
-guarded_error(E, Was, Result) :-
-    call_cleanup(error_result(E, Result), set_call_context(active, Was)).
+    setup_call_cleanup(set_call_context(active, true),
+                       once_result(Goal, Result),
+                       set_call_context(active, Was)).
 
 once_result(Goal, Result) :-
     (   call(Goal)

@@ -115,7 +115,7 @@ class Prolog:
             try:
                 a0 = lib.new_term_refs(2)
                 marshal.put(a0, goal, {})
-                if not self._timed(timeout, lib.call_predicate, None, L.Q_FLAGS,
+                if not self._timed(timeout, lib.call_predicate, None, L.CALL_FLAGS,
                                    self._gw_run, a0, tick=watched):
                     self._raise_exception()
                 result = marshal.get(a0 + 1)
@@ -165,7 +165,7 @@ class Prolog:
         (the guard's handlers then do nothing)."""
         if self._flush_pending:
             self._flush_pending = False
-            if not self.lib.call_predicate(None, L.Q_FLAGS, self._true, 0):
+            if not self.lib.call_predicate(None, L.CALL_FLAGS, self._true, 0):
                 self.lib.clear_exception()
 
     def _check_thread(self) -> None:
@@ -174,17 +174,22 @@ class Prolog:
                              "use processes, not threads, for parallel runs")
 
     def _raise_exception(self) -> NoReturn:
-        """The error of a call that raised past the guard (abort/0 unwinds past it)."""
+        """The error of a call that raised past the guard: abort/0 unwinds past it; nothing
+        else should (a Ctrl-C or a time limit raised again while the guard's handler runs
+        finds the guard down: prolog/guard.pl), but what does is named, never taken for an
+        abort."""
         ex = self.lib.exception(0)
-        if not ex:
-            self.lib.clear_exception()
+        detail = self.marshal.get(ex) if ex else None
+        self.lib.clear_exception()
+        if detail is None or detail == "$aborted":
             out = self.api("take_abort", Var())
             where = out[0] if out else "goal"
             if isinstance(where, tuple) and where[0] == ":":
                 raise Aborted(str(where[1]), where[2] or None)
-            raise Aborted(None, None)
-        detail = self.marshal.get(ex)
-        self.lib.clear_exception()
+            if detail == "$aborted" or where != "none":
+                raise Aborted(None, None)
+        if detail == "relrl_interrupted":
+            raise KeyboardInterrupt
         raise PrologError(f"gateway call failed: {detail!r}", detail)
 
     # -- the control step ------------------------------------------------------------------
@@ -259,7 +264,7 @@ class Prolog:
         io = np.zeros(k.IO_SIZE, np.int64)
         fo = np.zeros(k.FIRST_OUTPUT + 64, np.float64)
         io[k.PRED] = self.lib.predicate(b"gw_step", k.ARITY, b"relrl_gateway")
-        io[k.FLAGS] = L.Q_FLAGS
+        io[k.FLAGS] = L.CALL_FLAGS
         io[k.TRUE] = self._true_atom = self.marshal.hold("true")
         self._kernel = (k, io, fo)
         return self._kernel
@@ -341,7 +346,7 @@ def _load(lib: L.Lib, gateway: Path) -> None:
         t = lib.new_term_ref()
         text = f"use_module({_quoted(str(gateway))})".encode()
         if not (lib.chars_to_term(text, t) and lib.call_predicate(
-                None, L.Q_FLAGS, lib.predicate(b"call", 1, b"user"), t)):
+                None, L.CALL_FLAGS, lib.predicate(b"call", 1, b"user"), t)):
             raise RelrlError(f"cannot load {gateway}")
     finally:
         lib.discard_foreign_frame(fid)

@@ -52,7 +52,10 @@ BUILT_FOR = 9
 VARIABLE, ATOM, INTEGER, RATIONAL, FLOAT, STRING, TERM, NIL, BLOB, LIST_PAIR = range(1, 11)
 REP_UTF8 = 0x00100000
 CVT_ATOM, CVT_STRING, CVT_INTEGER, CVT_VARIABLE, CVT_WRITEQ = 0x1, 0x2, 0x8, 0x40, 0xC0
-Q_FLAGS = 0x04 | 0x08          # PL_Q_NODEBUG | PL_Q_CATCH_EXCEPTION
+Q_FLAGS = 0x04 | 0x08          # PL_Q_NODEBUG | PL_Q_CATCH_EXCEPTION: an open query's
+#: PL_call_predicate's: PL_Q_NODEBUG | PL_Q_PASS_EXCEPTION, so that an exception raised past
+#: the gateway's catch is still there to read (PL_exception(0)) when the call returns.
+CALL_FLAGS = 0x04 | 0x10
 PL_VERSION_SYSTEM = 1
 
 #: Every foreign function relrl calls, the one table of their signatures: name: (result,

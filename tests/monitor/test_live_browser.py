@@ -67,10 +67,19 @@ def test_live_page_from_its_first_seconds(page, relrl_process, tmp_path: Path) -
     assert _attr(page, "#cgi-plot", "data-points") >= 1
     # the tree, with the leaf of the time unit shown and its path from the root
     wait_until(lambda: page.locator("#tree svg g.node").count() > 1, 60, "a tree with tests")
-    wait_until(lambda: page.get_attribute("#tree-box", "data-leaf")
-               and _attr(page, "#tree-box", "data-path") >= 1, 30, "a leaf below the root")
-    assert page.locator("#tree g.node.current").count() == 1
-    assert page.locator("#tree g.node.on-path").count() == _attr(page, "#tree-box", "data-path")
+    # the leaf marked, its path counted, read in one task of the page (it marks each new
+    # time unit's leaf, and one not drawn yet marks nothing until the tree is redrawn)
+    marks: list = []
+
+    def leaf_marked() -> bool:
+        marks[:] = page.evaluate("""() => [
+            document.querySelectorAll('#tree g.node.current').length,
+            document.querySelectorAll('#tree g.node.on-path').length,
+            Number(document.getElementById('tree-box').dataset.path)]""")
+        return marks[0] == 1 and marks[2] >= 1
+
+    wait_until(leaf_marked, 30, "a leaf below the root")
+    assert marks[1] == marks[2], marks     # one node on the path for each step from the root
     # an evaluation during learning is said, and then learning goes on
     wait_until(lambda: _activity(page) == "evaluating", 90, "the evaluation after 60 units")
     shown = screen(page, tmp_path / "live-evaluating.png")

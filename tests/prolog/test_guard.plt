@@ -56,3 +56,27 @@ test(limit_must_be_a_number, error(type_error(number, soon))) :-
     progress_watch(soon, true).
 
 :- end_tests(progress_watch).
+
+:- begin_tests(stop_signals).
+
+%   A message that takes a Ctrl-C as it is formatted: the guard's handler formats the
+%   error of a goal (error_result/2), and the watchdog raises Ctrl-C again every tenth of a
+%   second (at once for a second Ctrl-C) until the call returns. The handler runs as that
+%   raise finds it: the interrupt handler called from within the message.
+:- multifile prolog:message//1.
+prolog:message(relrl_test_signal_in_handler) -->
+    { relrl_guard:interrupt(usr1) },
+    [ 'an error whose message takes a Ctrl-C' ].
+
+test(a_ctrl_c_while_the_guard_handles_an_error_stays_inside_it,
+     R = error(relrl_test_signal_in_handler, _)) :-
+    guarded(throw(relrl_test_signal_in_handler), R).
+
+test(a_ctrl_c_in_the_goal_is_the_result, R == error(interrupted, "interrupted")) :-
+    guarded(relrl_guard:interrupt(usr1), R).
+
+test(the_flag_is_down_after_an_interrupted_call) :-
+    guarded(relrl_guard:interrupt(usr1), _),
+    call_context(active, false).
+
+:- end_tests(stop_signals).
