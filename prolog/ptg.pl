@@ -167,7 +167,7 @@ ptg_update(KB, T) :-
         partition(optimal_leaf(KB, Cut), Ids, Optimal, Other),
         ptg_key(KB, PK),
         forall(between(1, Pairs, _),
-               label_pair(KB, PK, Search, S1, N1, Optimal, Other))
+               label_pair(KB, PK, Search, S1, N1, Actions, Optimal, Other))
     ).
 
 optimal_leaf(KB, Cut, Id) :-
@@ -178,14 +178,13 @@ optimal_leaf(KB, Cut, Id) :-
 %   An optimal action, uniformly among the legal actions of the optimal leaves (their
 %   members), and one that is not, uniformly among the other legal actions (the legal
 %   actions in a random order, each sorted until one reaches a leaf that is not optimal).
-label_pair(KB, PK, Search, S, N, Optimal, Other) :-
+label_pair(KB, PK, Search, S, N, Actions, Optimal, Other) :-
     findall(A, ( member(Id, Optimal),
                  tg_leaf_reached(Search, Id, C),
                  tg_class_members(C, Ms),
                  member(A, Ms) ), Good),
     random_member(G, Good),
     tg_insert(PK, S, G, N, 1),
-    Search = search(_, _, _, Actions, _),
     world_action_list(Actions, Legal),
     random_permutation(Legal, Order),
     (   member(B, Order),

@@ -4,6 +4,8 @@
             root_refinements/2,   % +KB, -Texts
             literal_goal/6,       % +Literal, +Facts, +Action, +Necessity, +Last, -Goal
             conj_goal/6,          % +Literals, +Facts, +Action, +Necessity, +Bound, -Goal
+            facts_index/2,        % +Facts, -Index
+            fact_member/2,        % ?Literal, +Index
             literal_holds/4,      % +Literal, +Facts, +Action, +Necessity
             bias_problem/2,       % +KB, -Problem
             bias_warning/2,       % +KB, -Warning
@@ -16,6 +18,7 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
+:- use_module(library(assoc)).
 :- use_module(declarations).
 
 /** <module> The language bias of the TG learner
@@ -194,7 +197,9 @@ canonical(PV, _-(_-cand(Lits, _)), Key) :-
 literal_goal(action(T), _, Action, _, _, T = Action) :- !.
 literal_goal(necessity(T), _, _, N, _, T = N) :- !.
 literal_goal(Lit, Facts, _, _, Last, Goal) :-
-    (   Last == true
+    (   Last == index
+    ->  Goal = relrl_tg_bias:fact_member(Lit, Facts)
+    ;   Last == true
     ->  Goal = memberchk(Lit, Facts)
     ;   Goal = member(Lit, Facts)
     ).
@@ -202,16 +207,76 @@ literal_goal(Lit, Facts, _, _, Last, Goal) :-
 %!  conj_goal(+Literals, +Facts, +Action, +Necessity, +Bound, -Goal) is det.
 %
 %   Goal proves the conjunction Literals (a list); Bound is `last` when the conjunction is
-%   proved once (its last literal becomes deterministic), `all` when every solution counts.
+%   proved once (its last literal becomes deterministic), `all` when every solution counts,
+%   `index` when every solution counts and Facts is an index of the facts (facts_index/2).
 
 conj_goal([], _, _, _, _, true).
 conj_goal([L], Facts, A, N, Bound, G) :-
     !,
-    ( Bound == last -> Last = true ; Last = false ),
+    (   Bound == last
+    ->  Last = true
+    ;   Bound == index
+    ->  Last = index
+    ;   Last = false
+    ),
     literal_goal(L, Facts, A, N, Last, G).
 conj_goal([L|Ls], Facts, A, N, Bound, (G, Gs)) :-
-    literal_goal(L, Facts, A, N, false, G),
+    (   Bound == index
+    ->  Last = index
+    ;   Last = false
+    ),
+    literal_goal(L, Facts, A, N, Last, G),
     conj_goal(Ls, Facts, A, N, Bound, Gs).
+
+%!  facts_index(+Facts:list, -Index) is det.
+%
+%   Index finds the facts of Facts (a list of ground facts) that may match a literal without
+%   a pass over them (fact_member/2). It is made at once; its parts are made on first use
+%   and kept in it: for a relation and an argument position, a map from each value there
+%   to the facts that hold it, in Facts' order (one pass and a sort, n log n for n facts).
+%   A query that proves a literal of a leaf's path once per solution of the literals before
+%   it (a path query with the action open, tg_classes.pl) then costs a look-up per literal,
+%   not a pass over the state: it grows with its solutions, not with their product with the
+%   state.
+
+facts_index(Facts, facts(Facts, maps([]))).
+
+%!  fact_member(?Literal, +Index) is nondet.
+%
+%   As member(Literal, Facts) for the facts Index was made from (facts_index/2): the same
+%   solutions in the same order. A literal with a ground argument is looked up by the first
+%   such (the facts whose argument there is that value, in order); one with none is a
+%   member of all the facts.
+
+fact_member(Lit, facts(Facts, Maps)) :-
+    (   compound(Lit),
+        ground_arg(Lit, I, V)
+    ->  compound_name_arity(Lit, Name, Arity),
+        position_map(Maps, Facts, Name, Arity, I, Map),
+        get_assoc(V, Map, Run),
+        member(Lit, Run)
+    ;   member(Lit, Facts)
+    ).
+
+%   I is the first position of a ground argument V of Lit.
+ground_arg(Lit, I, V) :-
+    arg(I, Lit, V),
+    ground(V),
+    !.
+
+%   The map of relation Name/Arity at position I: value - the facts with it there (in
+%   order: keysort/2 is stable), made on first use and kept (nb_setarg/3).
+position_map(Maps, Facts, Name, Arity, I, Map) :-
+    arg(1, Maps, Made),
+    (   memberchk(m(Name, Arity, I, Map0), Made)
+    ->  Map = Map0
+    ;   compound_name_arity(T, Name, Arity),
+        findall(V-T, ( member(T, Facts), arg(I, T, V) ), Pairs),
+        keysort(Pairs, Sorted),
+        group_pairs_by_key(Sorted, Grouped),
+        ord_list_to_assoc(Grouped, Map),
+        nb_setarg(1, Maps, [m(Name, Arity, I, Map)|Made])
+    ).
 
 %!  literal_holds(+Literal, +Facts, +Action, +Necessity) is nondet.
 %

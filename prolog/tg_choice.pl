@@ -106,7 +106,7 @@ class_choose(D, KB, Facts, N, Allowed, Mode, Action) :-
             random_member(Item, Ties)
         ),
         (   Item = hits(Class, Leaf, Hits)
-        ->  (   Class = cls(_, leaf(_, _, _, _, _))
+        ->  (   Class = cls(_, leaf(_, _, _, _, _, _))
             ->  Noted = none                    % the hits were the witness's, not the
             ;   Noted = chose(Action, Leaf, Hits)   % member's that is drawn
             )

@@ -17,7 +17,7 @@
 :- use_module(library(pairs)).
 :- use_module(library(assoc)).
 :- use_module(library(random)).
-:- use_module(tg_bias, [bias_constants/2, term_constant/2]).
+:- use_module(tg_bias, [bias_constants/2, term_constant/2, facts_index/2]).
 :- use_module(tg_tree, [tg_sort_/5, tg_path_/5, tg_leaves_/3]).
 
 /** <module> Classes of responses the TG learner cannot tell apart
@@ -261,18 +261,20 @@ group_class(Rs, [I|Is], cls(Rep, Pick)) :-
 %   leaf is searched at most once per Search, when first asked about or when an action
 %   found for another leaf reaches it.
 
-tg_leaf_search(KB, Facts, N, Actions, search(KB, Facts, N, Actions, Seen)) :-
+tg_leaf_search(KB, Facts, N, Actions, search(KB, Facts, Index, N, Actions, Seen)) :-
     must_be(compound, Actions),
+    facts_index(Facts, Index),          % the path queries' look-ups (tg_tree:tg_path_/5)
     tg_leaves_(KB, _, Max),
     functor(Seen, seen, Max).           % per leaf: unknown (a variable), w(Witness), empty
 
 %!  tg_leaf_reached(+Search, +LeafId, -Class) is semidet.
 %
 %   Some legal action reaches leaf LeafId; Class is its class, cls(Witness, leaf(KB,
-%   LeafId, Facts, Necessity, Actions)), Witness the first such action found.
+%   LeafId, Facts, Index, Necessity, Actions)), Witness the first such action found (Index:
+%   the search's index of Facts).
 
-tg_leaf_reached(Search, Id, cls(W, leaf(KB, Id, Facts, N, Actions))) :-
-    Search = search(KB, Facts, N, Actions, Seen),
+tg_leaf_reached(Search, Id, cls(W, leaf(KB, Id, Facts, Index, N, Actions))) :-
+    Search = search(KB, Facts, Index, N, Actions, Seen),
     search_leaf(Search, Id),
     arg(Id, Seen, w(W)).
 
@@ -299,11 +301,11 @@ first_group([Group|Groups], Search, Pairs) :-
 %   Unless leaf Id was searched or is known to be reached: the candidates of its path
 %   query, completed by the world and sorted, each marking the leaf it reaches, until one
 %   reaches Id; none: Id is empty.
-search_leaf(search(KB, Facts, N, actions(A, Goal), Seen), Id) :-
+search_leaf(search(KB, Facts, Index, N, actions(A, Goal), Seen), Id) :-
     arg(Id, Seen, S),
     (   nonvar(S)
     ->  true
-    ;   \+ \+ ( tg_path_(KB, Id, Facts, A, N),    % (the bindings are undone: \+ \+)
+    ;   \+ \+ ( tg_path_(KB, Id, Index, A, N),    % (the bindings are undone: \+ \+)
                 call(Goal),
                 tg_sort_(KB, Facts, A, N, Leaf),
                 arg(Leaf, Seen, S1),
@@ -360,8 +362,8 @@ tg_symmetric(sym(Known, Sizes), Action, Actions, Count) :-
 tg_class_members(cls(_, Pick), Members) :-
     leaf_members(Pick, Members).
 
-leaf_members(leaf(KB, Id, Facts, N, actions(A, Goal)), Members) :-
-    findall(A, ( tg_path_(KB, Id, Facts, A, N),
+leaf_members(leaf(KB, Id, Facts, Index, N, actions(A, Goal)), Members) :-
+    findall(A, ( tg_path_(KB, Id, Index, A, N),
                  call(Goal),
                  tg_sort_(KB, Facts, A, N, Id) ),
             Members0),
@@ -397,7 +399,7 @@ tg_class_member(rindex(Rs, _, Groups, _, _), cls(Rep, Pick), Action) :-
     ;   Pick = among(Is)
     ->  random_member(I, Is),
         arg(I, Rs, Action)
-    ;   Pick = leaf(_, _, _, _, _)
+    ;   Pick = leaf(_, _, _, _, _, _)
     ->  leaf_members(Pick, Members),
         random_member(Action, Members)
     ;   Pick = rest(G, Excluded),
@@ -424,7 +426,7 @@ tg_class_size(rindex(_, _, Groups, _, _), cls(_, Pick), Size) :-
     ->  Size = 1
     ;   Pick = among(Is)
     ->  length(Is, Size)
-    ;   Pick = leaf(_, _, _, _, _)
+    ;   Pick = leaf(_, _, _, _, _, _)
     ->  leaf_members(Pick, Members),
         length(Members, Size)
     ;   Pick = rest(G, Excluded),

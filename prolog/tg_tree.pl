@@ -14,7 +14,7 @@
             tg_tree_leaf/2,       % +Tree, ?Leaf
             tg_sort_/5,           % +KB, +Facts, +Action, +Necessity, -LeafId
             tg_cands_/6,          % +KB, +LeafId, +Facts, +Action, +Necessity, -Hits
-            tg_path_/5,           % +KB, +LeafId, +Facts, ?Action, +Necessity
+            tg_path_/5,           % +KB, +LeafId, +Index, ?Action, +Necessity
             tg_leaves_/3          % +KB, -LeafIds, -MaxId
           ]).
 :- use_module(library(error)).
@@ -29,8 +29,9 @@ What the TG learner (tg.pl) knows, kept per knowledge base, and the tree compile
 clauses: tg_sort_/5 sorts an example (facts, action, necessity) to its leaf, tg_cands_/6
 tests every candidate of a leaf on an example, tg_path_/5 proves a leaf's path query (the
 tests on the yes-branches above it) with the action left open, so that it binds the
-action's arguments from the facts (tg_classes.pl: the leaves some legal action of a world
-reaches), and tg_leaves_/3 lists the leaves. They are recompiled when the tree changes
+action's arguments from the facts, looked up in an index of them (tg_bias:facts_index/2;
+tg_classes.pl: the leaves some legal action of a world reaches), and tg_leaves_/3 lists
+the leaves. They are recompiled when the tree changes
 (a split, a restore), never on the hot path. tg.pl learns with them; tg_knowledge.pl
 explains, draws, saves and restores them.
 */
@@ -38,7 +39,7 @@ explains, draws, saves and restores them.
 :- dynamic
     tg_sort_/5,      % KB, Facts, Action, Necessity, LeafId   (the compiled tree)
     tg_cands_/6,     % KB, LeafId, Facts, Action, Necessity, Hits (a leaf's candidates)
-    tg_path_/5,      % KB, LeafId, Facts, Action, Necessity    (a leaf's path query)
+    tg_path_/5,      % KB, LeafId, Index, Action, Necessity    (a leaf's path query)
     tg_leaves_/3.    % KB, LeafIds, MaxId                       (the leaves, left to right)
 
 % ---- the learner's state -------------------------------------------------------------------
@@ -171,11 +172,13 @@ tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )
 %
 %   Add the tg_cands_/6 clause of Leaf: it tests every candidate of the leaf on an example,
 %   Hits listing the positions (from 1) of those that succeed, in order; and its tg_path_/5
-%   clause: every solution of its path query (the action an open term the query binds).
+%   clause: every solution of its path query (the action an open term the query binds), on
+%   an index of the facts (tg_bias:facts_index/2): with the action open, a literal is
+%   proved once per solution of the literals before it, each a look-up.
 
 tg_compile_leaf(KB, leaf(Id, PathLits0, _, Cands0)) :-
     copy_term(PathLits0, PathLits1),
-    conj_goal(PathLits1, PF, PA, PN, all, PathBody),
+    conj_goal(PathLits1, PF, PA, PN, index, PathBody),
     assertz((tg_path_(KB, Id, PF, PA, PN) :- PathBody)),
     copy_term(PathLits0-Cands0, PathLits-Cands),
     term_variables(PathLits, PV),

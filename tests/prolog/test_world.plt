@@ -672,6 +672,47 @@ test(every_choice_is_legal) :-
              world_legal(KB, S, Moves),
              assertion(memberchk(M, Moves)) )).
 
+test(an_index_of_the_facts_gives_what_member_gives) :-
+    % on the views of random states of 3-12 blocks, every literal shape a path query asks
+    % (nothing bound, the first argument, the second, both, a constant) finds the facts
+    % member/2 finds, in its order
+    blocks(KB),
+    forall(( member(Size, [3, 7, 12]), between(1, 5, _) ),
+           ( world_start(KB, on(_, _), Size, S, G),
+             world_view(KB, G, S, V),
+             relrl_tg_bias:facts_index(V, Index),
+             forall(( member(Lit, [on(X, Y), on(b1, Y), on(X, b2), on(b2, b1), on(X, floor),
+                                   clear(X), highest(X), covers(X, Y), goal_on(X, Y),
+                                   covers(X, b1), nothing(X)]) ),
+                    ( findall(Lit, member(Lit, V), Expected),
+                      findall(Lit, relrl_tg_bias:fact_member(Lit, Index), Found),
+                      assertion(Found == Expected) )) )).
+
+test(a_path_query_grows_with_its_solutions_not_their_product_with_the_state) :-
+    % a path query with the action open binds the moved block from on/2 (every block of a
+    % tower), then looks up what it stands on and what stands on that: inferences for all
+    % its solutions on one tower of 120 blocks against 30 (4 times the blocks) below 6
+    % times (member/2 on the view: 16 times, the square)
+    path_inferences(30, I30),
+    path_inferences(120, I120),
+    Ratio is I120 / I30,
+    assertion(Ratio < 6).
+
+path_inferences(N, I) :-
+    blocks(KB),
+    numlist(1, N, Is),
+    maplist([J, B]>>atom_concat(b, J, B), Is, Bs),
+    towers([Bs], S),
+    Bs = [A, B|_],
+    world_view(KB, on(B, A), S, V),
+    Lits = [action(move(X, _)), on(X, Y), on(Y, Z), on(_, Z)],
+    relrl_tg_bias:conj_goal(Lits, Index, Action, none, index, Goal),
+    statistics(inferences, I0),
+    relrl_tg_bias:facts_index(V, Index),
+    findall(Action, Goal, _),
+    statistics(inferences, I1),
+    I is I1 - I0.
+
 :- end_tests(world_leaf_classes).
 
 :- begin_tests(world_exploration).
