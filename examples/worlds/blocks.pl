@@ -137,11 +137,20 @@ step_bound(_, State, Bound) :-
 action(move(_X, _Y)).
 
 precondition(move(X, Y), State) :-
-    member(clear(X), State),
-    (   member(clear(Y), State),
+    clear_block(X, State),
+    (   clear_block(Y, State),
         Y \== X
     ;   \+ memberchk(on(X, floor), State),
         Y = floor
+    ).
+
+% A block given (a learner's query proposes move(b3, _), one for each block it binds) is
+% checked with one memberchk/2 that stops where it finds the fact; an open one is each clear
+% block in turn. The same answers in the same order (the state is a set).
+clear_block(X, State) :-
+    (   nonvar(X)
+    ->  memberchk(clear(X), State)
+    ;   member(clear(X), State)
     ).
 
 effect(move(X, Y), State, [on(X, Z)|Del], [on(X, Y)|Add]) :-
