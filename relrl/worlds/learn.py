@@ -216,7 +216,7 @@ class _Run:
         if config.speed:
             sizes = config.cost_sizes or sorted({*config.train_sizes, *config.test_sizes})
             timing["step_cost_by_size"] = step_cost_by_size(
-                world, task, self.saved, sizes,
+                world, task, self.saved, sizes, seed=config.seed,
                 fit_sizes=[s for s in sizes if s >= min(config.test_sizes, default=0)])
             timing["shape"] = _shape(world, task, self.saved, config.train_sizes)
         out = {"world": Path(config.world).name, "task": config.task,
@@ -297,32 +297,37 @@ def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str,
 
 
 def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int], *,
-                      episodes: int = 20, rounds: int = 5,
-                      fit_sizes: Sequence[int] = ()) -> dict[str, Any]:
+                      episodes: int = 20, rounds: int = 5, fit_sizes: Sequence[int] = (),
+                      seed: int = 0) -> dict[str, Any]:
     """CPU microseconds per learning step at each size, from the same saved policy.
 
     For each of ``rounds`` rounds, each size in turn: load ``policy`` (not timed), learn
-    ``episodes`` episodes at that size in one crossing, timed by the CPU time of the
+    ``episodes`` episodes at that size in one crossing, drawn from a stream of the round's
+    own (seeded from ``seed`` and the round: a run measures the same episodes again, so
+    its figures differ only by the machine's noise), timed by the CPU time of the
     process (``time.process_time``: Prolog runs in it, and other work on a shared machine
     does not count). Sizes alternate within a round, so what changes from round to round
     touches every size alike. Returns per size the median over rounds of microseconds per
-    step; the ratio of each size's cost to the smallest size's beside the ratio of the
-    sizes (linear growth: the two equal); and ``slope``, the exponent k of cost ∝ size^k
-    fitted on logarithms over all the sizes (linear growth: k = 1); with ``fit_sizes`` (two
-    or more of ``sizes``: the test sizes, 10-50 blocks) also ``fit_slope``, k over those
-    sizes alone, where a cost that grows faster than the world shows (a fixed cost per
-    step weighs on the small sizes and flattens ``slope``).
+    step and the steps each round learned; the ratio of each size's cost to the smallest
+    size's beside the ratio of the sizes (linear growth: the two equal); and ``slope``, the
+    exponent k of cost ∝ size^k fitted on logarithms over all the sizes (linear growth:
+    k = 1); with ``fit_sizes`` (two or more of ``sizes``: the test sizes, 10-50 blocks)
+    also ``fit_slope``, k over those sizes alone, where a cost that grows faster than the
+    world shows (a fixed cost per step weighs on the small sizes and flattens ``slope``).
     """
     from relrl.experiments.results import loglog_slope
 
     per: dict[int, list[float]] = {s: [] for s in sizes}
-    for _ in range(rounds):
+    work: dict[int, list[int]] = {s: [] for s in sizes}
+    for r in range(rounds):
         for size in sizes:
             world.load_policy(policy)
             t0 = time.process_time()
-            eps = world.episodes(task, [size], episodes, "learn")
+            eps = world.episodes(task, [size], episodes, "learn",
+                                 seed=evaluation_seed(seed, f"step cost round {r}"))
             dt = time.process_time() - t0
             steps = sum(e.steps for e in eps)
+            work[size].append(steps)
             if steps:
                 per[size].append(1e6 * dt / steps)
     world.load_policy(policy)
@@ -330,6 +335,7 @@ def step_cost_by_size(world: World, task: Any, policy: Path, sizes: Sequence[int
     base = sizes[0]
     return {"sizes": list(sizes), "clock": "process CPU time", "rounds": rounds,
             "us_per_step": {str(s): med[s] for s in sizes},
+            "steps": {str(s): work[s] for s in sizes},
             "cost_ratio": {str(s): (med[s] / med[base]) if med[s] and med[base] else None
                            for s in sizes},
             "size_ratio": {str(s): s / base for s in sizes},

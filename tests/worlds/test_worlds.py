@@ -312,3 +312,21 @@ def test_experiment_worlds_runs_each_worlds_own_tasks(tmp_path: Path) -> None:
     assert {"optimality", "optimality_min", "success", "success_min"} <= set(row)
     timing = json.loads((out / "timing.json").read_text())
     assert all("step_cost_by_size" not in t for t in timing["jobs"])
+
+
+def test_the_step_cost_measures_the_same_episodes_again(tmp_path: Path) -> None:
+    """Each round of the step-cost measurement draws its episodes from a stream of its own:
+    measured twice, the same steps are learned (only the machine's noise differs); another
+    seed draws other episodes."""
+    from relrl.worlds.learn import step_cost_by_size
+
+    with World(BLOCKS) as world:
+        world.attach(world.learner("tg"), seed=0, task="stack")
+        world.episodes("stack", [3], 10, "learn")
+        policy = world.save_policy(tmp_path / "policy.pl", "task stack")
+        runs = [step_cost_by_size(world, "stack", policy, [3, 4], episodes=3, rounds=2,
+                                  seed=7)["steps"] for _ in range(2)]
+        other = step_cost_by_size(world, "stack", policy, [3, 4], episodes=3, rounds=2,
+                                  seed=8)["steps"]
+    assert runs[0] == runs[1] and all(len(v) == 2 and min(v) > 0 for v in runs[0].values())
+    assert other != runs[0]
