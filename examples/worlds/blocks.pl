@@ -166,16 +166,26 @@ effect(move(X, Y), State, [on(X, Z)|Del], [on(X, Y)|Add]) :-
 
 % ---- what the learner sees ---------------------------------------------------------------
 
-% Besides on/2, clear/1 and goal_on/2, two relations computed from the state and the goal,
-% each with at most two facts per block (the view grows linearly with the world; above/2
-% over every pair would grow with the square of a tower's height): covers(X, Y), X above Y
-% in Y's tower, for the blocks Y the goal names; highest(T), T the top of a tallest tower.
+% Besides on/2, clear/1 and goal_on/2, three relations computed from the state and the
+% goal, each with at most two facts per block (the view grows linearly with the world;
+% above/2 over every pair would grow with the square of a tower's height): covers(X, Y), X
+% above Y in Y's tower, for the blocks Y the goal names; goal_tower(X), X a block the goal
+% names or above one (in a goal block's tower: a block put there buries one); highest(T),
+% T the top of a tallest tower.
 derived(covers(X, Y), Facts) :-
     findall(Y0, goal_block(Facts, Y0), Ys),
     Ys \== [],
     above_map(Facts, Above),
     member(Y, Ys),
     above(Above, Y, X).
+derived(goal_tower(X), Facts) :-
+    findall(Y0, goal_block(Facts, Y0), Ys0),
+    sort(Ys0, Ys),
+    Ys \== [],
+    above_map(Facts, Above),
+    findall(X0, ( member(Y, Ys), ( X0 = Y ; above(Above, Y, X0) ) ), Xs0),
+    sort(Xs0, Xs),                  % (A above B: A's tower is part of B's; each block once)
+    member(X, Xs).
 derived(highest(T), State) :-
     above_map(State, Above),
     findall(H-Top, ( member(on(B, floor), State), tower_top(Above, B, 1, H, Top) ), Pairs),
@@ -229,6 +239,7 @@ relation(goal_on(_, _)).
 relation(goal_clear(_)).
 relation(covers(_, _)).
 relation(highest(_)).
+relation(goal_tower(_)).
 
 % The types of the relations and of the action: relrl generates the language bias from
 % them (docs/worlds.md, A bias from declarations). Blocks are objects, never named by a
@@ -240,6 +251,7 @@ signature(goal_on(block, block)).
 signature(goal_clear(block)).
 signature(covers(block, block)).
 signature(highest(block)).
+signature(goal_tower(block)).
 subtype(block, place).
 type(floor, place).
 

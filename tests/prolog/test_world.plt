@@ -83,12 +83,14 @@ test(view_tells_the_goal_and_the_tops, [View == Expected]) :-
     blocks(KB),
     towers([[b1, b2], [b3]], S),
     world_view(KB, on(b3, b1), S, View),
-    Expected = [clear(b2), clear(b3), highest(b2), covers(b2, b1), goal_on(b3, b1),
-                on(b1, floor), on(b2, b1), on(b3, floor)].
+    Expected = [clear(b2), clear(b3), goal_tower(b1), goal_tower(b2), goal_tower(b3),
+                highest(b2), covers(b2, b1), goal_on(b3, b1), on(b1, floor), on(b2, b1),
+                on(b3, floor)].
 
 test(view_derived_as_defined) :-
-    % covers/2 and highest/1 read through the map of the towers equal their definitions
-    % (X above a goal block; the top of a tallest tower) on random states of 2-12 blocks
+    % covers/2, goal_tower/1 and highest/1 read through the map of the towers equal their
+    % definitions (X above a goal block; a goal block or a block above one; the top of a
+    % tallest tower) on random states of 2-12 blocks
     blocks(KB),
     set_random(seed(5)),
     forall(( between(2, 12, N), between(1, 10, _) ),
@@ -99,6 +101,11 @@ test(view_derived_as_defined) :-
                                     naive_above(S, X, Y) ), Cs0),
              findall(covers(X, Y), member(covers(X, Y), View), Cs1),
              msort(Cs0, Cs), msort(Cs1, Cs),
+             findall(goal_tower(X), ( member(on(X, _), S),
+                                      ( memberchk(X, [A, B])
+                                      ; member(Y, [A, B]), naive_above(S, X, Y) ) ), Gs0),
+             findall(goal_tower(X), member(goal_tower(X), View), Gs1),
+             sort(Gs0, Gs), msort(Gs1, Gs),
              findall(H-T, ( member(clear(T), S), naive_height(S, T, H) ), Hs),
              max_member(Max-_, Hs),
              findall(highest(T), member(Max-T, Hs), Tops0),
@@ -417,7 +424,8 @@ test(blocks_bias_from_types, [Modes == [action(move(-block, -block)), action(mov
                                        goal_on(+block, +block), goal_on(+block, -block),
                                        goal_on(-block, +block), goal_clear(+block),
                                        covers(+block, +block), covers(+block, -block),
-                                       covers(-block, +block), highest(+block)]]) :-
+                                       covers(-block, +block), highest(+block),
+                                       goal_tower(+block)]]) :-
     % place = block (a subtype: variables) + floor (a constant); a mode needs a + (linked
     % to the path): no on(-block, -block), no on(-block, floor)
     blocks(KB),
@@ -802,7 +810,7 @@ test(states_syntax_error, [Line == 2]) :-
     states_file(["[on(b1, floor), clear(b1)].", "[on(b1 floor)]."], Path),
     world_read_states(KB, Path, stack, problem(Line, _)).
 
-test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_clear/1,goal_on/2,highest/1,on/2])"]) :-
+test(states_fact_of_no_relation, [Line-Msg == 3-"fly(b1) is not a fact of the world's relations ([clear/1,covers/2,goal_clear/1,goal_on/2,goal_tower/1,highest/1,on/2])"]) :-
     blocks(KB),
     states_file(["[on(b1, floor), clear(b1)].", "", "[on(b1, floor), fly(b1)]."], Path),
     world_read_states(KB, Path, stack, problem(Line, Msg)).
