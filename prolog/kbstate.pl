@@ -50,8 +50,8 @@ The record is made at the first use of a knowledge base (a plain-swipl user may 
 %     kept      Slot-Snapshot pairs (engine_keep/2)
 %     inner     inner(Key, Options, Record): the record of Key kept inside this one, with
 %               the options of the learner that made it (kb_nest/3), or none
-%     returns   ret(Lambda, Order, Last): tg's return_lambda, its order_splits and its
-%               last update's state and target (tg.pl, tg_update/2), or none
+%     returns   ret(Lambda, Last): tg's return_lambda and its last update's state and
+%               target (tg.pl, tg_update/2), or none
 
 empty(kb(none, wm(0, default, [], [], []), [], none, none, none, [], none, none)).
 

@@ -12,8 +12,6 @@
 :- use_module(library(lists)).
 :- use_module(library(apply)).
 :- use_module(library(pairs)).
-:- use_module(library(random)).
-:- use_module(world, [world_action_list/2]).
 :- use_module(declarations).
 :- use_module(engine).
 :- use_module(learner_hooks).
@@ -80,9 +78,7 @@ is max(1/n, alpha)), gamma, temperature (Boltzmann exploration; 0: epsilon-greed
 epsilon, q_init (Q of the first, empty leaf), significance, min_examples, stale_bonus,
 half_life, novelty_bonus and novelty_confidence (see tg_choose/6), keep_examples, action_gap
 (advantage learning, tg_update/2), return_lambda (optional, 0 when not given: the episode's
-return in the Q-target, tg_update/2), order_splits (optional, 0 when not given: splits on
-the candidate that tells apart two legal actions of one state, tg_update/2); the engine's
-reward_positive and reward_negative.
+return in the Q-target, tg_update/2); the engine's reward_positive and reward_negative.
 */
 
 % ---- starting ------------------------------------------------------------------------------
@@ -129,11 +125,7 @@ tg_init(Key, KB, Params) :-
     ->  must_be(number, Lambda)
     ;   Lambda = 0
     ),
-    (   memberchk(order_splits=Order, Params)      % (optional: 0 when not given)
-    ->  must_be(number, Order)
-    ;   Order = 0
-    ),
-    kb_set(Key, returns, ret(Lambda, Order, none)),
+    kb_set(Key, returns, ret(Lambda, none)),
     tg_forget_leaves(Key),
     tg_compile_leaf(Key, Root),
     tg_compile_tree(Key, Root).
@@ -165,9 +157,7 @@ tg_state(KB, Facts) :-
 %   With return_lambda L > 0 and the update before this one from S1 (a world's episode is
 %   learned last first), max Q(S1) in the target is (1 - L) * max Q(S1) + L * G1, G1 that
 %   update's target before its gap: the lambda-return of the steps the episode took (Peng
-%   and Williams' Q(lambda), its returns computed backwards over the episode). With
-%   order_splits > 0 and a world's legal actions, one other legal action of S0 drawn at
-%   random that sorts to A0's leaf gives the contrast of the candidates (contrast/7).
+%   and Williams' Q(lambda), its returns computed backwards over the episode).
 
 tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
     tg_data(KB, D),
@@ -184,9 +174,9 @@ tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
     ;   Gapped = none
     ),
     kb_get(KB, returns, Returns),
-    (   Returns = ret(Lambda, Order, Last)
+    (   Returns = ret(Lambda, Last)
     ->  true
-    ;   Lambda = 0, Order = 0, Last = none
+    ;   Lambda = 0, Last = none
     ),
     (   S1 == terminal                          % the episode ended (a world's goal)
     ->  Target = Reward
@@ -203,32 +193,10 @@ tg_update(KB, transition(S0, A0, N0, Allowed0, Reward, _, S1, N1, Allowed1)) :-
         )
     ),
     (   Lambda > 0
-    ->  kb_set(KB, returns, ret(Lambda, Order, seen(S0, N0, Target)))
+    ->  kb_set(KB, returns, ret(Lambda, seen(S0, N0, Target)))
     ;   true
     ),
-    contrast(Order, KB, S0, A0, N0, Allowed0, Contrast),
-    insert(KB, D, S0, A0, N0, Known, Target, Gapped, Contrast).
-
-%   Contrast: with order_splits > 0 and a world's legal actions, a legal action A1 other
-%   than A0 drawn at random; when it sorts to A0's leaf, c(Plus, Minus): the candidates of
-%   that leaf true of A0 and not of A1, and those true of A1 and not of A0.
-contrast(Order, KB, S0, A0, N0, Allowed0, Contrast) :-
-    (   Order > 0,
-        Allowed0 = actions(_, _),
-        world_action_list(Allowed0, List),
-        exclude(==(A0), List, Others),
-        Others \== [],
-        random_member(A1, Others),
-        tg_sort_(KB, S0, A0, N0, Leaf),
-        tg_sort_(KB, S0, A1, N0, Leaf1),
-        Leaf1 == Leaf
-    ->  tg_cands_(KB, Leaf, S0, A0, N0, H0),
-        tg_cands_(KB, Leaf, S0, A1, N0, H1),
-        subtract(H0, H1, Plus),
-        subtract(H1, H0, Minus),
-        Contrast = c(Plus, Minus)
-    ;   Contrast = none
-    ).
+    insert(KB, D, S0, A0, N0, Known, Target, Gapped).
 
 max_q(Leaves, Ids, Max) :-
     maplist(tg_leaf_q(Leaves), Ids, Qs),
@@ -243,12 +211,12 @@ max_q(Leaves, Ids, Max) :-
 
 tg_insert(KB, Facts, A, N, Target) :-
     tg_data(KB, D),
-    insert(KB, D, Facts, A, N, none, Target, none, none).
+    insert(KB, D, Facts, A, N, none, Target, none).
 
 %   Known is sorted(Leaf, Hits) when the choice of this example's action found its leaf and
 %   candidate hits (note_choice/5), else none. Gapped is gap(G, V) (advantage learning: the
 %   target lowered by G times V, the state's largest Q, less the leaf's Q) or none.
-insert(KB, D, Facts, A, N, Known, Target0, Gapped, Contrast) :-
+insert(KB, D, Facts, A, N, Known, Target0, Gapped) :-
     D = tg(p(Alpha, _, _, _, Level, MinEx, _, Half, _, _, _), Leaves, _, _, Clock0, _),
     Clock is Clock0 + 1,
     nb_setarg(5, D, Clock),
@@ -258,7 +226,7 @@ insert(KB, D, Facts, A, N, Known, Target0, Gapped, Contrast) :-
         tg_cands_(KB, Leaf, Facts, A, N, Hits)
     ),
     arg(Leaf, Leaves, L),
-    L = l(Q0, N0, _, _, _, C, _, _, Ring, _),
+    L = l(Q0, N0, _, _, _, C, _, _, Ring),
     (   Gapped = gap(Gap, V)                       % (an action emitted outside the
     ->  Target is Target0 - Gap * max(0, V - Q0)   % allowed ones: no gap)
     ;   Target = Target0
@@ -274,22 +242,8 @@ insert(KB, D, Facts, A, N, Known, Target0, Gapped, Contrast) :-
     SS is SS0 + W * E * E,
     nb_setarg(3, L, M), nb_setarg(4, L, S), nb_setarg(5, L, SS),
     count_hits(Hits, C, W, E),
-    count_contrast(Contrast, L, C, E),
     keep_example(Ring, ex(Facts, A, N, E, Clock)),
-    (   N1 /\ 3 =:= 0,                              % every fourth example, first the
-        Contrast \== none,                          % candidate that orders a state's
-        arg(10, L, O),                              % actions (order_splits)
-        best_contrast(O, MinEx, Level, I),
-        J is 3 * I - 2, J2 is J + 1,
-        arg(J, C, M1), arg(J2, C, S1),
-        M1 > 0, M - M1 > 0
-    ->  F is 1 / W,
-        M1t is M1 * F, Mt is M * F,
-        M2t is Mt - M1t,
-        DYes is S1 / M1, DNo is (S - S1) / (M - M1),
-        QYes is Q + DYes, QNo is Q + DNo,
-        split(KB, D, Leaf, I, s(M1t, QYes, DYes), s(M2t, QNo, DNo))
-    ;   N1 /\ 3 =:= 0,                              % every fourth example
+    (   N1 /\ 3 =:= 0,                              % every fourth example
         MinW is MinEx * W,                          % min_examples in stored units
         M >= 2 * MinW,
         best_candidate(C, M, S, MinW, I-s(M1, S1, SS1)),
@@ -388,60 +342,6 @@ best_from(J, Arity, C, M, S, Min, Max, B0, G0, B) :-
         J1 is J + 3,
         best_from(J1, Arity, C, M, S, Min, Max, B1, G1, B)
     ).
-
-%   Contrast statistics (order_splits): a leaf's l/10 term holds, from its first contrast
-%   on, o(...) with six numbers per candidate: the count, sum and sum of squares of the TD
-%   errors of the examples the candidate was true of and their state's other action was
-%   not (Plus), then of those it was false of and the other action true (Minus). Counted
-%   at weight 1 (not forgotten).
-count_contrast(none, _, _, _).
-count_contrast(c(Plus, Minus), L, C, E) :-
-    (   arg(10, L, none)
-    ->  functor(C, _, Arity),
-        K is Arity // 3 * 6,
-        functor(O0, o, K),
-        forall(between(1, K, J), zero_arg(O0, J)),
-        nb_setarg(10, L, O0)
-    ;   true
-    ),
-    arg(10, L, O),
-    forall(member(I, Plus), ( J is 6 * I - 5, add3(O, J, E) )),
-    forall(member(I, Minus), ( J is 6 * I - 2, add3(O, J, E) )).
-
-zero_arg(O, J) :-
-    (   J mod 3 =:= 1
-    ->  nb_setarg(J, O, 0)
-    ;   nb_setarg(J, O, 0.0)
-    ).
-
-add3(O, J, E) :-
-    J2 is J + 1, J3 is J + 2,
-    arg(J, O, M0), M is M0 + 1, nb_setarg(J, O, M),
-    arg(J2, O, S0), S is S0 + E, nb_setarg(J2, O, S),
-    arg(J3, O, SS0), SS is SS0 + E * E, nb_setarg(J3, O, SS).
-
-%   Best is the candidate whose two contrast sides (each of at least MinEx examples)
-%   differ most in their TD errors (the one-way F over those examples), when significant
-%   at Level over the number of candidates; fails otherwise. (An F of inf, from sides with
-%   no spread, is left to the usual test.)
-best_contrast(O, MinEx, Level, Best) :-
-    functor(O, _, Arity),
-    K is Arity // 6,
-    findall(F-I, ( between(1, K, I),
-                   J is 6 * I - 5,
-                   arg(J, O, Mp), Mp >= MinEx,
-                   J4 is J + 3, arg(J4, O, Mm), Mm >= MinEx,
-                   J2 is J + 1, J3 is J + 2, J5 is J + 4, J6 is J + 5,
-                   arg(J2, O, Sp), arg(J3, O, SSp), arg(J5, O, Sm), arg(J6, O, SSm),
-                   Mt is Mp + Mm, St is Sp + Sm, SSt is SSp + SSm,
-                   split_f(s(Mt, St, SSt), s(Mp, Sp, SSp), F, _),
-                   F \== inf ), Fs),
-    Fs \== [],
-    max_member(Fmax-Best, Fs),
-    J is 6 * Best - 5, arg(J, O, Mp), J4 is J + 3, arg(J4, O, Mm),
-    Dof is Mp + Mm - 2,
-    Corrected is Level / K,
-    f_significant(Fmax, Dof, Corrected).
 
 % ---- splitting -----------------------------------------------------------------------------
 
@@ -622,10 +522,7 @@ relrl_engine:learner_property(tg, Cap) :-
 %   a Q(lambda)-return, learned last first): a tree whose tests cannot count the moves to
 %   the goal values the states after a right and a wasted move alike, and only the return
 %   carries the difference; exploring at temperature 0.1 (rewards of size 1) keeps that
-%   return near the greedy policy's (docs/worlds.md, One bias for every task). A leaf
-%   also splits on the candidate that best tells apart the action taken and another legal
-%   action of the same state (order_splits 1): a greedy choice reads how a leaf orders one
-%   state's actions, and the usual statistics mostly tell near states from far ones.
+%   return near the greedy policy's (docs/worlds.md, One bias for every task).
 relrl_engine:learner_parameter(tg, alpha, 0.2, unit).
 relrl_engine:learner_parameter(tg, gamma, 0.9, unit).
 relrl_engine:learner_parameter(tg, epsilon, 0.05, unit).
@@ -640,11 +537,10 @@ relrl_engine:learner_parameter(tg, novelty_confidence, 2.0, nonneg).
 relrl_engine:learner_parameter(tg, keep_examples, 0.0, whole(0)).
 relrl_engine:learner_parameter(tg, action_gap, 0.0, unit).
 relrl_engine:learner_parameter(tg, return_lambda, 0.0, unit).
-relrl_engine:learner_parameter(tg, order_splits, 0.0, unit).
 relrl_engine:learner_serves(tg, domains, []).
 relrl_engine:learner_serves(tg, worlds, [q_init=0.0, novelty_bonus=0.0, stale_bonus=0.0,
                                          action_gap=0.9, return_lambda=0.8,
-                                         temperature=0.1, order_splits=1.0]).
+                                         temperature=0.1]).
 
 :- learner_hooks(tg, [forget-tg_forget, init-tg_init, choose-tg_choose, update-tg_update,
                      explain-tg_explain, size-tg_size, save-tg_save,

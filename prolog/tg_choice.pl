@@ -374,7 +374,7 @@ tg_bonus(KB, Facts, A, N, Bonus) :-
 %   when n < 2. The bonus is the largest bound, and 0 when all are below 0. Hits are the
 %   candidates that succeed on the example.
 novelty(KB, Facts, A, N, Id, L, u(Beta, Conf, Half, Clock), Hits, Bonus) :-
-    L = l(_, _, M, S, SS, C, _, Base, _, _),
+    L = l(_, _, M, S, SS, C, _, Base, _),
     (   Half =:= 0
     ->  W = 1
     ;   W is 2 ** ((Clock - Base) / Half)       % stored units / W = today's weights

@@ -119,7 +119,7 @@ tg_text(KB, face(_, _, V), Text) :-
     with_output_to(string(Text), text_node(KB, V, Root, [], "", "")).
 
 text_node(KB, V, leaf(Id, _, _, _), _, Indent, Label) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
     format("~w~wleaf [~d] ~w=~4f  (n=~d)~n", [Indent, Label, Id, V, Q, N]).
 text_node(KB, V, node(Id, Lits, New, Yes, No), Vars, Indent, Label) :-
     append(Vars, New, Vars1),
@@ -148,7 +148,7 @@ tg_graph(KB, face(_, _, V), graph(Nodes, Edges)) :-
     graph_node(KB, V, Root, [], Nodes, [], Edges, []).
 
 graph_node(KB, V, leaf(Id, _, _, _), _, [node(Id, leaf, Label)|Ns], Ns, Es, Es) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)),
     format(string(Label), "~w=~2f (n=~d)", [V, Q, N]).
 graph_node(KB, V, node(Id, Lits, New, Yes, No), Vars, [node(Id, test, Text)|Ns0], Ns,
            [edge(Id, YId, yes), edge(Id, NId, no)|Es0], Es) :-
@@ -212,7 +212,7 @@ leaf_rules(KB, Face, Form, Rules) :-
     findall(R, leaf_clause(KB, Face-Form, Root, [], [], [], R), Rules).
 
 leaf_clause(KB, face(_, Name, _)-Form, leaf(Id, _, _, _), Pos, Neg, Vars, Clause-Names) :-
-    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _, _, _)),
+    tg_leaf(KB, Id, l(Q0, _, _, _, _, _, _, _, _)),
     Q is round(Q0 * 1000) / 1000.0,
     Head =.. [Name, Action, Necessity, Q],
     foldl(positive(Action, Necessity), Pos, Goals0, []),
@@ -369,7 +369,7 @@ save_comments(ptg_tree,
                "(near 1: optimal, near 0: not; one clause per leaf)."]).
 
 saved_tree(KB, leaf(Id, _, _, _), _, leaf(Id, Q, N), []) :-
-    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _, _)).
+    tg_leaf(KB, Id, l(Q, N, _, _, _, _, _, _, _)).
 saved_tree(KB, node(Id, Lits, New, Y, N), Vars, node(Id, Lits, New, SY, SN), All) :-
     append(Vars, New, Vars1),
     saved_tree(KB, Y, Vars1, SY, AY),

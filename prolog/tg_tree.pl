@@ -135,7 +135,7 @@ tg_empty_leaves(Cap, Leaves) :-
 %   yet, K candidates with empty statistics, last updated at Clock, sums in units of
 %   Clock's weight, room for its last Keep examples (none kept yet).
 
-tg_new_stats(Q, N, K, Clock, Keep, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock, Ring, none)) :-
+tg_new_stats(Q, N, K, Clock, Keep, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock, Ring)) :-
     findall(X, ( between(1, K, _), member(X, [0, 0.0, 0.0]) ), Xs),
     C =.. [c|Xs],
     length(Slots, Keep),

@@ -97,7 +97,7 @@ test(terminal_transition_adds_no_p_example, [N == 0]) :-
     ptg_size(KB, size(_, Details)),
     memberchk(p_leaves=1, Details),
     ptg_key(KB, PK),
-    relrl_tg_tree:tg_leaf(PK, 1, l(_, N, _, _, _, _, _, _, _, _)).
+    relrl_tg_tree:tg_leaf(PK, 1, l(_, N, _, _, _, _, _, _, _)).
 
 test(a_step_labels_a_pair, [N == 2]) :-
     % into a state that is not terminal: one optimal class (target 1) and one other (0)
@@ -114,14 +114,14 @@ test(a_step_labels_a_pair, [N == 2]) :-
     relrl_tg:tg_size(PK, size(_, D0)),
     memberchk(leaves=L, D0),
     findall(Id-C, ( between(1, 1000, Id), relrl_tg_tree:tg_leaf(PK, Id, l(_, C, _, _, _, _,
-                                                                         _, _, _, _)) ), Before),
+                                                                         _, _, _)) ), Before),
     % (tg_update/2 may leave a choice point: once/1)
     once(relrl_engine:learner_update(ptg, KB, transition(V0, move(b3, floor), none, Allowed0,
                                                          0, false, V1, none, Allowed))),
     relrl_tg:tg_size(PK, size(_, D1)),
     assertion(memberchk(leaves=L, D1)),
     findall(Id-C, ( member(Id-_, Before), relrl_tg_tree:tg_leaf(PK, Id, l(_, C, _, _, _, _,
-                                                                      _, _, _, _)) ), After),
+                                                                      _, _, _)) ), After),
     foldl([_-B, _-A, S00, S01]>>(S01 is S00 + A - B), Before, After, 0, N).
 
 test(save_and_restore_act_the_same) :-

@@ -189,7 +189,7 @@ test(children_start_from_partitions, [true(abs(Q - Expected) + abs(N - 12) < 1.0
                      ( G == P -> T = 10 ; T = 0 ) ), Stream),
     forall(member(G-P-T, Stream), tg_insert(KB, [gaze(face, G)], look(P), curiosity, T)),
     root(KB, node(_, _, _, leaf(Yes, _, _, _), _)),
-    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Yes, l(Q, N, _, _, _, _, _, _, _)),
     length(First, 28), append(First, _, Stream),
     foldl(replay, First, 0-0-[], QLeaf-_-Errors),
     sum_list(Errors, Sum), length(Errors, 10),
@@ -293,7 +293,7 @@ test(forgetting_rescales, [true(abs(Today - Expected) < 1.0e-9)]) :-
     aggregate_all(sum(X), ( between(0, 99, J), X is 2 ** (-J) ), Expected).
 
 today_weight(KB, Today) :-
-    relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base, _, _)),
+    relrl_tg_tree:tg_leaf(KB, 1, l(_, _, M, _, _, _, _, Base, _)),
     relrl_tg_tree:tg_data(KB, tg(p(_, _, _, _, _, _, _, H, _, _, _), _, _, _, Clock, _)),
     Today is M / 2 ** ((Clock - Base) / H).
 
@@ -352,7 +352,7 @@ test(action_gap_lowers_the_target_by_the_gap, [true(abs(Q - Expected) < 1.0e-9)]
     tg_q(KB, S0, look(p1), curiosity, Best),
     tg_q(KB, S0, look(p2), curiosity, Q0),
     relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
-    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
     tg_update(KB, transition(S0, look(p2), curiosity, [look(p1), look(p2)], 0, false,
                              terminal, curiosity, [])),
     tg_q(KB, S0, look(p2), curiosity, Q),
@@ -365,7 +365,7 @@ test(action_gap_is_over_the_allowed_responses, [true(abs(Q - Expected) < 1.0e-9)
     S0 = [gaze(face, p1)],
     tg_q(KB, S0, look(p2), curiosity, Q0),
     relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
-    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
     tg_update(KB, transition(S0, look(p2), curiosity, [look(p2), look(p3)], 0, false,
                              terminal, curiosity, [])),
     tg_q(KB, S0, look(p2), curiosity, Q),
@@ -378,7 +378,7 @@ test(action_gap_never_raises_a_target, [true(abs(Q - Expected) < 1.0e-9)]) :-
     S0 = [gaze(face, p1)],
     tg_q(KB, S0, look(p1), curiosity, Q0),
     relrl_tg_tree:tg_sort_(KB, S0, look(p1), curiosity, Leaf),
-    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
     once(tg_update(KB, transition(S0, look(p1), curiosity, [look(p2), look(p3)], 0, false,
                                   terminal, curiosity, []))),
     tg_q(KB, S0, look(p1), curiosity, Q),
@@ -389,7 +389,7 @@ test(no_action_gap_no_change, [true(abs(Q - Expected) < 1.0e-9)]) :-
     S0 = [gaze(face, p1)],
     tg_q(KB, S0, look(p2), curiosity, Q0),
     relrl_tg_tree:tg_sort_(KB, S0, look(p2), curiosity, Leaf),
-    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _, _)),
+    relrl_tg_tree:tg_leaf(KB, Leaf, l(_, N0, _, _, _, _, _, _, _)),
     tg_update(KB, transition(S0, look(p2), curiosity, [look(p1), look(p2)], 0, false,
                              terminal, curiosity, [])),
     tg_q(KB, S0, look(p2), curiosity, Q),
@@ -586,42 +586,3 @@ test(shipped_domains_clean, [Msgs == []]) :-
                  bias_problem(KB, M) ), Msgs).
 
 :- end_tests(tg_bias_check).
-
-:- begin_tests(tg_order_splits).
-
-test(order_splits_off_unless_given, [Orders == [0, 1]]) :-
-    % the domains' default: no contrast; given, kept beside return_lambda
-    gaze_kb(KB),
-    params(0.001, 5, Params),
-    tg_init(KB, Params),
-    relrl_kbstate:kb_get(KB, returns, ret(_, O0, none)),
-    tg_init(KB, [order_splits=1|Params]),
-    relrl_kbstate:kb_get(KB, returns, ret(_, O1, none)),
-    Orders = [O0, O1].
-
-test(contrast_picks_the_test_that_orders_two_actions, [I == 2]) :-
-    % a leaf of two candidates. 40 times the action taken was on candidate 2's side and the
-    % other action of its state was not (TD errors near -0.08), 40 times the reverse (near
-    % 0.02); candidate 1 was true of the action taken only: no contrast of its own
-    relrl_tg_tree:tg_new_stats(0.0, 0, 2, 0, 0, L),
-    arg(6, L, C),
-    assertion(arg(10, L, none)),
-    forall(between(1, 40, K),
-           ( E1 is -0.1 + (K mod 5) / 100,
-             relrl_tg:count_contrast(c([2], []), L, C, E1),
-             E2 is (K mod 5) / 100,
-             relrl_tg:count_contrast(c([1], [2]), L, C, E2) )),
-    arg(10, L, O),
-    relrl_tg:best_contrast(O, 5, 0.001, I).
-
-test(contrast_without_a_difference_splits_nothing, [fail]) :-
-    relrl_tg_tree:tg_new_stats(0.0, 0, 2, 0, 0, L),
-    arg(6, L, C),
-    forall(between(1, 40, K),
-           ( E is (K mod 5) / 100,
-             relrl_tg:count_contrast(c([2], [1]), L, C, E),
-             relrl_tg:count_contrast(c([1], [2]), L, C, E) )),
-    arg(10, L, O),
-    relrl_tg:best_contrast(O, 5, 0.001, _).
-
-:- end_tests(tg_order_splits).
