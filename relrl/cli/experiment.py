@@ -208,8 +208,9 @@ def _add_worlds(sub) -> None:
     w.add_argument("--engine", choices=["local", "ray"], default="local",
                    help="local worker processes (default) or a Ray cluster")
     w.add_argument("--address", default=None, help="with --engine ray: the cluster to join")
-    from relrl.cli.learn import add_rule_seconds
+    from relrl.cli.learn import add_restart_options, add_rule_seconds
 
+    add_restart_options(w)
     add_rule_seconds(w)
     w.add_argument("--quick", action="store_true",
                    help="a short run: seed 0, learner tg, 200 episodes in blocks of 50, 30 "
@@ -521,6 +522,10 @@ def build_worlds_config(args: argparse.Namespace):
     for learner in config.learners:
         make_world_learner(learner, **config.learner_params.get(learner, {}))  # validate
     config.rule_seconds = args.rule_seconds
+    from relrl.cli.learn import check_restart_options
+
+    check_restart_options(args)
+    config.restarts, config.check_episodes = args.restarts, args.check_episodes
     for path in config.worlds:
         with World(path, rule_seconds=config.rule_seconds) as world:
             problems = world.problems()

@@ -91,6 +91,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--eval-episodes", type=int, default=100,
                         help="greedy episodes per evaluation and per evaluation size (100)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (0)")
+    add_restart_options(parser)
     add_rule_seconds(parser)
     parser.add_argument("--param", type=_param, action="append", default=[],
                         metavar="NAME=X", help="learner parameter (repeatable)")
@@ -170,15 +171,20 @@ def run(args: argparse.Namespace) -> int:
     if block < 1:
         raise ConfigError(f"--block must be at least 1, not {block}")
     params = dict(args.param)
+    check_restart_options(args)
     config = LearnConfig(world=str(path.resolve()), task=task_text, learner=args.learner,
                          params=params, train_sizes=train, test_sizes=test,
                          episodes=args.episodes, block=block,
                          eval_episodes=args.eval_episodes, seed=args.seed,
                          updates=args.updates, speed=not args.no_speed,
-                         rule_seconds=args.rule_seconds)
+                         rule_seconds=args.rule_seconds, restarts=args.restarts,
+                         check_episodes=args.check_episodes)
 
     def show(event: dict) -> None:
         e = event["entry"]
+        if event["kind"] == "check":
+            print(check_line(e, args.restarts), flush=True)
+            return
         print(f"episodes {e['episodes']:6d}  steps {e['learning_steps']:7d}  of optimal "
               f"{_of(e['optimality'])}  reached {e['success']:.3f}  positions "
               f"{e['memory_positions']}{_unreachable(e)}", flush=True)
@@ -223,6 +229,39 @@ def run(args: argparse.Namespace) -> int:
     if (out.path / "replay").is_dir():
         print(f"watch the evaluation episodes: relrl replay {out.path / 'replay'}")
     return _late(stop)
+
+
+def add_restart_options(parser: argparse.ArgumentParser) -> None:
+    """``--restarts`` and ``--check-episodes`` (relrl learn, relrl experiment worlds)."""
+    parser.add_argument("--restarts", type=int, default=3, metavar="N",
+                        help="check the learned policy on greedy episodes of the training "
+                             "sizes; when it wastes a move there, learn again from nothing "
+                             "(a stream of its own), up to N times, and keep the first "
+                             "optimal attempt or the best (3; 0: no check)")
+    parser.add_argument("--check-episodes", type=int, default=1000, metavar="N",
+                        help="greedy episodes of that check (1000, and at most --episodes)")
+
+
+def check_restart_options(args: argparse.Namespace) -> None:
+    """Refuse a negative ``--restarts`` or a ``--check-episodes`` below 1."""
+    from relrl.errors import ConfigError
+
+    if args.restarts < 0:
+        raise ConfigError(f"--restarts must be 0 or more, not {args.restarts}")
+    if args.check_episodes < 1:
+        raise ConfigError(f"--check-episodes must be at least 1, not {args.check_episodes}")
+
+
+def check_line(e: dict, restarts: int) -> str:
+    """The line printed for an attempt's check."""
+    what = (f"of optimal {_of(e['optimality'])}" if e["optimality"] is not None
+            else f"reached {e['success']:.3f}")
+    who = f"restart {e['attempt']} (seed {e['seed']})" if e["attempt"] else "the policy"
+    then = ("kept" if e["perfect"] else
+            f"learning again from nothing: restart {e['attempt'] + 1} of {restarts}"
+            if e["restart"] else "no restart left: the best attempt is kept")
+    return (f"check of {who}: {e['check_episodes']} greedy episodes of the training sizes, "
+            f"{what}; {then}")
 
 
 def _late(stop: Any) -> int:

@@ -62,6 +62,8 @@ class WorldsConfig:
     verify_states: int = 30
     rule_seconds: float = RULE_SECONDS      #: how long a rule of a world may run
     speed: bool = True                      #: measure each job's step cost by size
+    restarts: int = 3                       #: fresh attempts after a failed check (learn.py)
+    check_episodes: int = 1000              #: greedy episodes of an attempt's check
 
     def jobs(self) -> list[tuple[str, str, str, int]]:
         """Every (world, task, learner, seed) job."""
@@ -80,7 +82,8 @@ class WorldsConfig:
                            test_sizes=list(self.test_sizes), episodes=self.episodes,
                            block=self.block, eval_episodes=self.eval_episodes, seed=seed,
                            updates=self.updates, rule_seconds=self.rule_seconds,
-                           speed=self.speed)
+                           speed=self.speed, restarts=self.restarts,
+                           check_episodes=self.check_episodes)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form (world files by name: the folder is the machine's)."""
@@ -246,6 +249,9 @@ def summarize(jobs: list[dict[str, Any]], config: WorldsConfig) -> list[dict[str
                "train_success_min": min(j["final"]["success"] for j in js),
                "memory_positions": _mean([j["memory"]["positions"] for j in js]),
                "episodes_to_095": _mean([_first(j["curve"], 0.95) for j in js]),
+               # restarts (learn.py): the seeds learned again, the attempts after the first
+               "restarted_seeds": sum(len(j.get("attempts", ())) > 1 for j in js),
+               "restarts": sum(max(0, len(j.get("attempts", ())) - 1) for j in js),
                "test": {}}
         for size in config.test_sizes:
             vals = [j["test"][str(size)] for j in js if str(size) in j["test"]]
@@ -399,13 +405,19 @@ def worlds_table(results: dict[str, Any]) -> str:
             all_reached = "no: worst " + ", ".join(_f(x) for x in reached)
         lines.append(
             f"| {text(Path(r['world']).stem)} | {text(r['task'])} | {text(r['learner'])} | "
-            f"{r['seeds']} | "
+            f"{r['seeds']}{_restarted(r)} | "
             f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
             + " | ".join(f"{_f(t['optimality'])} ({_f(t.get('optimality_min'))})"
                          for t in tests)
             + f" | {all_reached} | {_f(r['episodes_to_095'], 0)} | "
             f"{_f(r['memory_positions'], 0)} |")
     return "\n".join(lines)
+
+
+def _restarted(row: dict[str, Any]) -> str:
+    """`` (N learned again)`` when N seeds restarted (none: nothing)."""
+    n = row.get("restarted_seeds", 0)
+    return f" ({n} learned again)" if n else ""
 
 
 def _f(x: float | None, digits: int = 3) -> str:

@@ -4,7 +4,15 @@
 experiment worlds``: a learner learns ``episodes`` episodes of a task on the training sizes,
 in blocks of ``block`` episodes; after each block the greedy policy (no learning, no
 exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the end
-on each test size — where the policy acts with no further learning. Evaluation draws its
+on each test size — where the policy acts with no further learning. With ``restarts`` R > 0,
+the learned policy is checked at the end on ``check_episodes`` greedy episodes of the
+training sizes (at most ``episodes``): a tree whose greedy choice wastes a move there (or misses the goal) is set
+aside and a fresh learner learns the task again from nothing, from a random stream of its
+own, up to R times; the first attempt that acts optimally in every check episode is kept, or
+else the attempt with the best check. A tree grows by greedy splits it never revises, and
+the order of its first splits decides how it acts far beyond its training sizes; a tree that
+already wastes moves on its training sizes is the one that fails there (docs/worlds.md,
+Restarts). Evaluation draws its
 start states from a random stream of its own, seeded from the run's seed and the evaluation
 point (:func:`evaluation_seed`), and learning from the learner's stream alone: the learned
 policy is the same whatever ``eval_episodes``, the test sizes and ``block`` are. Every evaluation
@@ -31,7 +39,7 @@ from typing import Any
 
 from relrl.worlds.world import RULE_SECONDS, World, score
 
-__all__ = ["LearnConfig", "evaluation_seed", "learn_task", "step_cost_by_size"]
+__all__ = ["LearnConfig", "evaluation_seed", "learn_task", "restart_seed", "step_cost_by_size"]
 
 
 @dataclass
@@ -52,6 +60,8 @@ class LearnConfig:
     speed: bool = True                      #: measure the step cost by size and the shape
     rule_seconds: float = RULE_SECONDS      #: how long a rule of the world may run
     cost_sizes: list[int] = field(default_factory=list)   #: default: train + test sizes
+    restarts: int = 3                       #: fresh attempts after a failed check (module doc)
+    check_episodes: int = 1000              #: an attempt's check (at most ``episodes``)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready form."""
@@ -117,6 +127,9 @@ class _Run:
         self.memory: dict[str, Any] = {}
         self.learn_seconds, self.learn_steps, self.done = 0.0, 0, 0
         self.policy_episodes: int | None = None     # learning episodes of the saved policy
+        self.attempt, self.attempt_done = 0, 0      # the attempt learning, its episodes
+        self.attempts: list[dict[str, Any]] = []    # each checked attempt
+        self.best: tuple[float, int, Path] | None = None   # the kept attempt's check, file
 
     def _go_on(self) -> None:
         """Stop here when a stop was asked for."""
@@ -128,15 +141,54 @@ class _Run:
         config = self.config
         header = (f"relrl policy: {config.learner} learner, world {Path(config.world).name}, "
                   f"task {config.task}")
-        if self.done < config.episodes:
-            header += f" (after {self.done} of {config.episodes} learning episodes)"
+        if self.attempt:
+            header += f", restart {self.attempt} (seed {restart_seed(config.seed, self.attempt)})"
+        if self.attempt_done < config.episodes:
+            header += f" (after {self.attempt_done} of {config.episodes} learning episodes)"
         self._go_on()
         self.world.save_policy(self.saved, header)
+        if self.best is None:           # (else policy_out keeps the best checked attempt)
+            self._publish(self.saved)
+            self.policy_episodes = self.attempt_done
+
+    def _publish(self, path: Path) -> None:
+        """Write the policy in ``path`` to ``policy_out``."""
         if self.policy_out is not None:
             from relrl.outdir import write_atomic
 
-            write_atomic(self.policy_out, self.saved.read_text(encoding="utf-8"))
-        self.policy_episodes = self.done
+            write_atomic(self.policy_out, path.read_text(encoding="utf-8"))
+
+    def _check(self, task: Any, report: Callable[[dict[str, Any]], None] | None) -> bool:
+        """Check the attempt's policy on its own greedy episodes of the training sizes;
+        keep it when it is the best so far. True: it acted optimally in every episode (no
+        restart needed)."""
+        config, k = self.config, self.attempt
+        self._go_on()
+        # (at most one check episode per learning episode: a check never costs more than
+        # the learning it checks)
+        eps = self.world.episodes(task, config.train_sizes,
+                                  min(config.check_episodes, config.episodes), "greedy",
+                                  optimal=True, seed=evaluation_seed(config.seed, f"check {k}"))
+        ev = score(eps)
+        # the fraction of optimal; a world with no optimum: the share reaching the goal
+        value = ev["optimality"] if ev["optimality"] is not None else ev["success"]
+        entry = {"attempt": k, "seed": config.seed if k == 0 else restart_seed(config.seed, k),
+                 "episodes": self.attempt_done, "check_episodes": ev["episodes"],
+                 "optimality": ev["optimality"], "success": ev["success"]}
+        self.attempts.append(entry)
+        if self.best is None or value > self.best[0]:
+            from relrl.outdir import write_atomic
+
+            kept = write_atomic(self.saved.with_name(f"attempt-{k}.pl"),
+                                self.saved.read_text(encoding="utf-8"))
+            self.best = (value, k, kept)
+            self._publish(kept)
+            self.policy_episodes = self.attempt_done
+        perfect = value >= 1.0
+        if report is not None:
+            report({"kind": "check", "entry": {**entry, "perfect": perfect,
+                                               "restart": not perfect and k < config.restarts}})
+        return perfect
 
     def learn(self, report: Callable[[dict[str, Any]], None] | None,
               policy_in: str | Path | None, traces: int, monitor: Any) -> dict[str, Any]:
@@ -161,6 +213,8 @@ class _Run:
             entry = {"point": len(curve), **ev, "eval_episodes": ev["episodes"],
                      "episodes": self.done, "learning_steps": self.learn_steps,
                      "memory_positions": positions}
+            if self.attempt:
+                entry["attempt"] = self.attempt
             curve.append(entry)
             if report is not None:
                 report({"kind": "point", "entry": entry})
@@ -171,19 +225,39 @@ class _Run:
             monitor.status("initial evaluation", f"{config.learner} on {config.task}: "
                            f"{config.eval_episodes} greedy episodes")
         evaluate()
-        while self.done < config.episodes:
-            if monitor is not None:
-                monitor.status("learning", f"{config.learner} learns {config.task}: episodes "
-                               f"{self.done + 1}-{min(self.done + config.block, config.episodes)}"
-                               f" of {config.episodes}", done=self.done, total=config.episodes)
-            n = min(config.block, config.episodes - self.done)
-            self._go_on()
-            t0 = time.perf_counter()
-            eps = world.episodes(task, config.train_sizes, n, "learn", updates=config.updates)
-            self.learn_seconds += time.perf_counter() - t0
-            self.learn_steps += sum(e.steps for e in eps)
-            self.done += n
-            evaluate()
+        # restarts start from nothing: a run that goes on from a saved policy has none
+        restarts = config.restarts if policy_in is None and config.episodes > 0 else 0
+        while True:
+            while self.attempt_done < config.episodes:
+                if monitor is not None:
+                    done = self.attempt_done
+                    upto = min(done + config.block, config.episodes)
+                    again = f" (restart {self.attempt})" if self.attempt else ""
+                    monitor.status("learning", f"{config.learner} learns {config.task}{again}: "
+                                   f"episodes {done + 1}-{upto} of {config.episodes}",
+                                   done=done, total=config.episodes)
+                n = min(config.block, config.episodes - self.attempt_done)
+                self._go_on()
+                t0 = time.perf_counter()
+                eps = world.episodes(task, config.train_sizes, n, "learn",
+                                     updates=config.updates)
+                self.learn_seconds += time.perf_counter() - t0
+                self.learn_steps += sum(e.steps for e in eps)
+                self.done += n
+                self.attempt_done += n
+                evaluate()
+            if not restarts or self._check(task, report) or self.attempt == restarts:
+                break
+            self.attempt, self.attempt_done = self.attempt + 1, 0
+            world.attach(world.learner(config.learner, **config.params),
+                         restart_seed(config.seed, self.attempt), task)
+        if self.best is not None and self.best[1] != self.attempt:   # an earlier attempt
+            kept = self.best[2]
+            world.attach(world.learner(config.learner, **config.params), config.seed, task)
+            world.load_policy(kept)
+            from relrl.outdir import write_atomic
+
+            write_atomic(self.saved, kept.read_text(encoding="utf-8"))
         positions, details = world.size()
         if monitor is not None:
             monitor.status("evaluating", "no further learning: sizes "
@@ -221,12 +295,22 @@ class _Run:
             timing["shape"] = _shape(world, task, self.saved, config.train_sizes)
         out = {"world": Path(config.world).name, "task": config.task,
                "learner": config.learner, "seed": config.seed, "curve": curve,
-               "test": self.test, "final": curve[-1],
+               "test": self.test, "final": self._final(),
                "memory": {**details, "positions": positions}, "timing": timing}
+        if self.attempts:
+            out["attempts"] = self.attempts
+            out["kept_attempt"] = self.best[1] if self.best is not None else 0
         if traces:
             out["traces"] = self.kept
             out["graph"] = world.engine.graph()
         return out
+
+    def _final(self) -> dict[str, Any] | None:
+        """The last evaluation point of the kept policy (with restarts: of the kept
+        attempt)."""
+        kept = self.best[1] if self.best is not None else self.attempt
+        return next((e for e in reversed(self.curve) if e.get("attempt", 0) == kept),
+                    self.curve[-1] if self.curve else None)
 
     def _eval_cost(self, size: int, eps: Sequence[Any], seconds: float) -> None:
         """Keep what the greedy episodes of one test size cost: CPU milliseconds per
@@ -254,11 +338,13 @@ class _Run:
         config = self.config
         out = {"world": Path(config.world).name, "task": config.task,
                "learner": config.learner, "seed": config.seed, "curve": self.curve,
-               "test": self.test, "final": self.curve[-1] if self.curve else None,
+               "test": self.test, "final": self._final(),
                "memory": self.memory, "timing": self._timing(), "partial": True,
                "stopped_by": "error" if not isinstance(exc, KeyboardInterrupt)
                else "signal", "episodes_learned": self.done,
                "policy_episodes": self.policy_episodes}
+        if self.attempts:
+            out["attempts"] = self.attempts
         if not isinstance(exc, KeyboardInterrupt):
             out["error"] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         if self.kept:
@@ -271,8 +357,18 @@ def evaluation_seed(seed: int, point: str) -> int:
     evaluation ``point`` (``point 3``, ``size 50``), so every evaluation draws the same
     start states whatever was learned or evaluated before it, and none draws from the
     learner's stream (as Gymnasium's seeded ``reset``)."""
-    digest = hashlib.sha256(f"relrl evaluation {seed} {point}".encode()).digest()
-    return int.from_bytes(digest[:6], "big")
+    return _stream_seed(f"relrl evaluation {seed} {point}")
+
+
+def _stream_seed(text: str) -> int:
+    """A seed from a hash of ``text`` (48 bits)."""
+    return int.from_bytes(hashlib.sha256(text.encode()).digest()[:6], "big")
+
+
+def restart_seed(seed: int, attempt: int) -> int:
+    """The learner's seed for restart ``attempt`` (1, 2, ...) of a run seeded ``seed``: a
+    stream of its own, the same in every run of that seed."""
+    return _stream_seed(f"relrl restart {seed} {attempt}")
 
 
 def _monitor_point(hub: Any, world: World, config: LearnConfig, entry: dict[str, Any],

@@ -105,7 +105,7 @@ def test_a_long_batch_of_a_world_is_not_a_rule_that_never_ends(tmp_path: Path) -
     step slow but ending, is not stopped."""
     world, _ = world_with(tmp_path, "precondition(move(_, _), _) :- sleep(0.02), fail.")
     proc = relrl("learn", str(world), "--size", "3", "--eval-sizes", "3", "--episodes", "30",
-                 "--block", "30", "--eval-episodes", "2", "--no-speed",
+                 "--block", "30", "--eval-episodes", "2", "--no-speed", "--restarts", "0",
                  "--rule-seconds", "0.5")
     assert proc.returncode == 0, proc.stderr[-2000:]
 

@@ -330,3 +330,79 @@ def test_the_step_cost_measures_the_same_episodes_again(tmp_path: Path) -> None:
                                   seed=8)["steps"]
     assert runs[0] == runs[1] and all(len(v) == 2 and min(v) > 0 for v in runs[0].values())
     assert other != runs[0]
+
+
+def _restart_config(**kw: object):
+    from relrl.worlds.learn import LearnConfig
+
+    base = dict(world=str(BLOCKS), task="stack", train_sizes=[3, 4], test_sizes=[4],
+                episodes=10, block=10, eval_episodes=5, seed=4, speed=False,
+                restarts=2, check_episodes=30)
+    return LearnConfig(**{**base, **kw})  # type: ignore[arg-type]
+
+
+def test_a_policy_that_wastes_moves_on_its_training_sizes_is_learned_again(
+        tmp_path: Path) -> None:
+    """With restarts, a policy checked on greedy episodes of the training sizes that is not
+    optimal in every one is learned again from nothing, from a stream of its own; the best
+    checked attempt is kept (policy_out, results) and the run is the same every time."""
+    from relrl.worlds.learn import learn_task, restart_seed
+
+    checks = []
+    out = learn_task(_restart_config(), policy_out=tmp_path / "a.pl",
+                     report=lambda ev: checks.append(ev) if ev["kind"] == "check" else None)
+    attempts = out["attempts"]
+    assert len(attempts) == 3                  # 10 episodes: no attempt is optimal
+    assert [a["attempt"] for a in attempts] == [0, 1, 2]
+    assert [a["seed"] for a in attempts] == [4, restart_seed(4, 1), restart_seed(4, 2)]
+    # (a check has at most one episode per learning episode)
+    assert all(a["optimality"] < 1 and a["check_episodes"] == 10 for a in attempts)
+    values = [a["optimality"] for a in attempts]
+    kept = values.index(max(values))
+    assert out["kept_attempt"] == kept
+    assert [c["entry"]["restart"] for c in checks] == [True, True, False]
+    text = (tmp_path / "a.pl").read_text()
+    assert (f"restart {kept}" in text.splitlines()[0]) == (kept > 0)
+    # the curve: every attempt's points, episodes counted over all of them
+    assert [c["episodes"] for c in out["curve"]] == [0, 10, 20, 30]
+    assert [c.get("attempt", 0) for c in out["curve"]] == [0, 0, 1, 2]
+    assert out["final"] == out["curve"][kept + 1]
+    again = learn_task(_restart_config(), policy_out=tmp_path / "b.pl")
+    assert (tmp_path / "b.pl").read_bytes() == (tmp_path / "a.pl").read_bytes()
+    assert again["attempts"] == attempts
+
+
+def test_a_policy_optimal_in_its_check_is_kept_at_once(tmp_path: Path) -> None:
+    """A first attempt that acts optimally in every check episode is kept: no restart, the
+    policy of a run without restarts."""
+    from relrl.worlds.learn import learn_task
+
+    config = _restart_config(episodes=200, block=200, train_sizes=[3])
+    out = learn_task(config, policy_out=tmp_path / "a.pl")
+    assert [(a["attempt"], a["optimality"]) for a in out["attempts"]] == [(0, 1.0)]
+    learn_task(_restart_config(episodes=200, block=200, train_sizes=[3], restarts=0),
+               policy_out=tmp_path / "b.pl")
+    assert (tmp_path / "a.pl").read_bytes() == (tmp_path / "b.pl").read_bytes()
+
+
+def test_no_restart_from_a_saved_policy_or_with_restarts_0(tmp_path: Path) -> None:
+    """--restarts 0 checks nothing; a run that goes on from a saved policy never starts
+    again from nothing."""
+    from relrl.worlds.learn import learn_task
+
+    out = learn_task(_restart_config(restarts=0), policy_out=tmp_path / "a.pl")
+    assert "attempts" not in out
+    out = learn_task(_restart_config(), policy_in=tmp_path / "a.pl",
+                     policy_out=tmp_path / "b.pl")
+    assert "attempts" not in out
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--restarts", "-1"], "--restarts must be 0 or more, not -1"),
+    (["--check-episodes", "0"], "--check-episodes must be at least 1, not 0")])
+def test_bad_restart_flags_are_one_line(capsys: pytest.CaptureFixture[str], flags: list[str],
+                                        message: str) -> None:
+    for command in (["learn", str(BLOCKS), "--task", "stack"],
+                    ["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack"]):
+        assert main([*command, *flags]) == 2
+        assert message in capsys.readouterr().err
