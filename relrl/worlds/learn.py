@@ -3,22 +3,22 @@
 :func:`learn_task` is the one procedure behind ``relrl learn`` and every job of ``relrl
 experiment worlds``: a learner learns ``episodes`` episodes of a task on the training sizes,
 in blocks of ``block`` episodes; after each block the greedy policy (no learning, no
-exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the end
-on each test size — where the policy acts with no further learning. With ``restarts`` R > 0,
-the learned policy is checked at the end on ``check_episodes`` greedy episodes of the
-training sizes (at most ``episodes``): a tree whose greedy choice wastes a move there (or misses the goal) is set
-aside and a fresh learner learns the task again from nothing, from a random stream of its
-own, up to R times; the first attempt that acts optimally in every check episode is kept, or
-else the attempt with the best check. A tree grows by greedy splits it never revises, and
-the order of its first splits decides how it acts far beyond its training sizes; a tree that
-already wastes moves on its training sizes is the one that fails there (docs/worlds.md,
-Restarts). Evaluation draws its
-start states from a random stream of its own, seeded from the run's seed and the evaluation
-point (:func:`evaluation_seed`), and learning from the learner's stream alone: the learned
-policy is the same whatever ``eval_episodes``, the test sizes and ``block`` are. Every evaluation
-episode's optimal number of steps comes from the world (optimal_steps/3, else a
-breadth-first search), so a score is a fraction of optimal: optimal / steps per episode, 0
-for an episode that missed the goal within the step bound (RRL's "percentage of optimal").
+exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the
+end on each test size — where the policy acts with no further learning. With ``restarts`` R
+> 0, the learned policy is checked at the end on ``check_episodes`` greedy episodes of the
+training sizes (at most ``episodes``): a tree whose greedy choice wastes a move there (or
+misses the goal) is set aside and a fresh learner learns the task again from nothing, from a
+random stream of its own, up to R times; the first attempt that acts optimally in every
+check episode is kept, or else the attempt with the best check. A tree grows by greedy
+splits it never revises, and the order of its first splits decides how it acts far beyond
+its training sizes; a tree that already wastes moves on its training sizes is the one that
+fails there (docs/worlds.md, Restarts). Evaluation draws its start states from a random
+stream of its own, seeded from the run's seed and the evaluation point
+(:func:`evaluation_seed`), and learning from the learner's stream alone: the learned policy
+is the same whatever ``eval_episodes``, the test sizes and ``block`` are. Every evaluation
+episode's optimal number of steps comes from the world (optimal_steps/3, else a breadth-
+first search), so a score is a fraction of optimal: optimal / steps per episode, 0 for an
+episode that missed the goal within the step bound (RRL's "percentage of optimal").
 
 Speed is measured inside the job: learning steps per second (wall clock of the learning
 batches, each one crossing into Prolog), the cost of a learning step at each size (CPU

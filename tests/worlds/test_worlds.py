@@ -406,3 +406,29 @@ def test_bad_restart_flags_are_one_line(capsys: pytest.CaptureFixture[str], flag
                     ["experiment", "worlds", "--worlds", str(BLOCKS), "--tasks", "stack"]):
         assert main([*command, *flags]) == 2
         assert message in capsys.readouterr().err
+
+
+def test_a_stop_while_a_restart_learns_keeps_the_checked_attempt(tmp_path: Path) -> None:
+    """Stopped while a restart learns, the run keeps the policy of the attempt it checked
+    (policy_out, and partial's policy_episodes), not the restart's half-learned tree."""
+    from relrl.worlds.learn import learn_task
+
+    first = tmp_path / "first.pl"
+    learn_task(_restart_config(restarts=0), policy_out=first)
+    state = {"checked": False, "asks": 0}
+
+    def report(event: dict) -> None:
+        state["checked"] = state["checked"] or event["kind"] == "check"
+
+    def stop() -> bool:                 # asked between crossings: the third after the check
+        state["asks"] += state["checked"]
+        return state["asks"] > 2
+
+    with pytest.raises(KeyboardInterrupt) as stopped:
+        learn_task(_restart_config(block=5), policy_out=tmp_path / "a.pl", report=report,
+                   stop=stop)
+    partial = stopped.value.partial  # type: ignore[attr-defined]
+    assert [a["attempt"] for a in partial["attempts"]] == [0]
+    assert partial["policy_episodes"] == 10
+    assert partial["episodes_learned"] == 15         # the restart had learned a block
+    assert (tmp_path / "a.pl").read_bytes() == first.read_bytes()
