@@ -4,8 +4,8 @@
 experiment worlds``: a learner learns ``episodes`` episodes of a task on the training sizes,
 in blocks of ``block`` episodes; after each block the greedy policy (no learning, no
 exploration) is evaluated on ``eval_episodes`` episodes of the training sizes, and at the
-end on each test size — where the policy acts with no further learning. With ``restarts`` R
-> 0, the learned policy is checked at the end on ``check_episodes`` greedy episodes of the
+end on each test size — where the policy acts with no further learning. With R ``restarts``
+above 0, the learned policy is checked at the end on ``check_episodes`` greedy episodes of the
 training sizes (at most ``episodes``): a tree whose greedy choice wastes a move there (or
 misses the goal) is set aside and a fresh learner learns the task again from nothing, from a
 random stream of its own, up to R times; the first attempt that acts optimally in every
