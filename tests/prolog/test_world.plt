@@ -725,6 +725,44 @@ path_inferences(N, I) :-
     statistics(inferences, I1),
     I is I1 - I0.
 
+test(a_query_splits_into_components_that_share_variables) :-
+    relrl_tg_bias:literal_components([at(B, rooma), action(pick(B1)), free(left),
+                                      carry(B2, left), at(B1, rooma), at(B, R), robby(R)],
+                                     Comps),
+    assertion(Comps == [[at(B, rooma), at(B, R), robby(R)], [action(pick(B1)), at(B1, rooma)],
+                        [free(left)], [carry(B2, left)]]).
+
+test(a_query_proves_what_the_action_does_not_need_once) :-
+    % gripper, 40 balls: "some ball in room a, the picked ball in room a, some ball in room
+    % b" with the action open has the picks' solutions of the conjunction, each once, in
+    % the order of their first solution there, at a cost that does not grow with the
+    % product of the balls (conj_goal/6: every ball of room a times every ball of room b);
+    % and a failing query (no free gripper) fails as the conjunction does
+    world_kb('examples/worlds/gripper.pl', KB),
+    numlist(1, 40, Is),
+    maplist([I, F]>>( atom_concat(o, I, O),
+                      ( I mod 2 =:= 0 -> F = at(O, rooma) ; F = at(O, roomb) ) ), Is, Balls),
+    append(Balls, [robby(rooma), free(left), free(right)], S0),
+    sort(S0, S),
+    world_view(KB, deliver, S, V),
+    relrl_tg_bias:facts_index(V, Index),
+    Lits = [at(_, rooma), action(pick(B1)), at(B1, rooma), at(_, roomb)],
+    copy_term(Lits, Lits1),
+    relrl_tg_bias:conj_goal(Lits, Index, A0, none, index, All),
+    relrl_tg_bias:query_goal(Lits1, Index, A1, none, index, Once),
+    findall(A0, All, As0),
+    list_to_set(As0, Expected),
+    statistics(inferences, I0),
+    findall(A1, Once, As1),
+    statistics(inferences, I1),
+    assertion(As1 == Expected),
+    length(Expected, 20),
+    Inferences is I1 - I0,
+    assertion(Inferences < 2000),
+    Fail = [at(_, rooma), action(pick(B2)), at(B2, rooma), free(middle)],
+    relrl_tg_bias:query_goal(Fail, V, pick(o2), none, last, G),
+    assertion(\+ call(G)).
+
 :- end_tests(world_leaf_classes).
 
 :- begin_tests(world_exploration).
