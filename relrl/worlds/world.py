@@ -130,8 +130,11 @@ class World:
         self.tasks: list[Term] = list(info["tasks"][0])
         self.actions: list[Term] = list(info["actions"][0])
         self.relations: list[Term] = list(info["relations"][0])
-        self.train_sizes: list[int] = list(info["sizes"][0]) or [3]
-        self.test_sizes: list[int] = list(info["sizes"][1])
+        #: the sizes the world declares (sizes/2; [] when it does not)
+        self.declared_sizes: dict[str, list[int]] = {"train": list(info["sizes"][0]),
+                                                     "test": list(info["sizes"][1])}
+        self.train_sizes: list[int] = self.declared_sizes["train"] or [3]
+        self.test_sizes: list[int] = self.declared_sizes["test"]
         self.optimal_known: bool = info["optimal"][0] == "true"
         #: the task's discount (discount/1), the learners' gamma unless given; None: theirs
         self.discount: float | None = (None if info["discount"][0] == "none"
