@@ -121,5 +121,5 @@ optimal_steps(deliver, State, N) :-
         N is 2 * K + Moves
     ).
 
-sizes(train, [1, 2, 3]).
+sizes(train, [1, 2, 3, 4, 5]).
 sizes(test, [10, 20, 50]).
