@@ -139,6 +139,10 @@ class World:
         #: the task's discount (discount/1), the learners' gamma unless given; None: theirs
         self.discount: float | None = (None if info["discount"][0] == "none"
                                        else float(info["discount"][0]))
+        #: per learner, the parameters the world gives it (learner_param/3)
+        self.learner_params: dict[str, dict[str, float]] = {}
+        for learner, name, value in info["learner_params"][0]:
+            self.learner_params.setdefault(str(learner), {})[str(name)] = float(value)
         self.engine = Engine(self.kb)
         self.learner_name: str | None = None
 
@@ -257,11 +261,12 @@ class World:
 
     def learner(self, name: str, **params: float) -> Learner:
         """The learner ``name`` with its defaults in worlds, the world's discount as its
-        gamma (discount/1), and ``params`` over both
-        (:func:`~relrl.learners.make_world_learner`)."""
-        if self.discount is not None and "gamma" not in params:
-            params = {**params, "gamma": self.discount}
-        return make_world_learner(name, **params)
+        gamma (discount/1) and the world's values of its parameters (learner_param/3) over
+        them, and ``params`` over all (:func:`~relrl.learners.make_world_learner`)."""
+        own = dict(self.learner_params.get(name, {}))
+        if self.discount is not None:
+            own.setdefault("gamma", self.discount)
+        return make_world_learner(name, **{**own, **params})
 
     def attach(self, learner: Learner, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a learner of worlds: :func:`relrl.learners.learners`

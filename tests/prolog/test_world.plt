@@ -270,6 +270,17 @@ test(wrong_optimal_steps, [Line == 10]) :-
             KB, Path),
     world_problems(KB, [problem(Path, Line, _)]).
 
+test(learner_param_of_the_wrong_shape, [Msg == "learner_param(tg, temperature, hot): a learner, a parameter's name and a number, e.g. learner_param(tg, temperature, 1.0)"]) :-
+    text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
+             "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",
+             "goal(t, S) :- memberchk(p(a), S).", "relation(p(_)).",
+             "learner_param(tg, temperature, 1.0).", "learner_param(tg, temperature, hot)."],
+            KB, _),
+    world_problems(KB, [problem(_, 9, Msg)]),
+    world_info(KB, Info),
+    memberchk(learner_params(Ps), Info),
+    assertion(Ps == [[tg, temperature, 1.0], [tg, temperature, hot]]).
+
 test(task_rmode_of_no_task, [Msg == "task_rmode(fly, p(+x)): no declared task is fly"]) :-
     text_kb(["initial_state(_, [p(a)]).", "task(t).", "action(go(_)).",
              "precondition(go(X), S) :- member(p(X), S).", "effect(go(_), _, [], []).",

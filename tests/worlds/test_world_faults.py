@@ -199,6 +199,22 @@ def test_experiment_worlds_takes_each_worlds_declared_sizes() -> None:
         c = given.learn_config(str(world.resolve()), task, "tg", 0)
         assert (c.train_sizes, c.test_sizes) == ([2], [6, 7])
 
+
+def test_a_world_gives_its_learners_parameters() -> None:
+    """learner_param/3: gripper.pl's tg explores at temperature 1, over tg's worlds default
+    (blocks.pl: 0.1) and under a parameter given; its discount is tg's gamma."""
+    from relrl.worlds import World
+
+    with World(BLOCKS.parent / "gripper.pl") as world:
+        assert world.learner_params == {"tg": {"temperature": 1.0}}
+        tg = world.learner("tg")
+        assert (tg.params["temperature"], tg.params["gamma"]) == (1.0, 0.95)
+        given = world.learner("tg", temperature=0.3, gamma=0.9)
+        assert (given.params["temperature"], given.params["gamma"]) == (0.3, 0.9)
+    with World(BLOCKS) as world:
+        assert world.learner_params == {}
+        assert world.learner("tg").params["temperature"] == 0.1
+
 # ---- B: relrl learn stopped keeps what it learned ------------------------------------------
 
 LONG_LEARN = ("learn", str(BLOCKS), "--task", "stack", "--episodes", "1000000", "--block",
