@@ -4,6 +4,8 @@
             root_refinements/2,   % +KB, -Texts
             literal_goal/6,       % +Literal, +Facts, +Action, +Necessity, +Last, -Goal
             conj_goal/6,          % +Literals, +Facts, +Action, +Necessity, +Bound, -Goal
+            query_goal/6,         % +Literals, +Facts, +Action, +Necessity, +Bound, -Goal
+            literal_components/2, % +Literals, -Components
             facts_index/2,        % +Facts, -Index
             fact_member/2,        % ?Literal, +Index
             literal_holds/4,      % +Literal, +Facts, +Action, +Necessity
@@ -227,6 +229,69 @@ conj_goal([L|Ls], Facts, A, N, Bound, (G, Gs)) :-
     ),
     literal_goal(L, Facts, A, N, Last, G),
     conj_goal(Ls, Facts, A, N, Bound, Gs).
+
+%!  query_goal(+Literals, +Facts, +Action, +Necessity, +Bound, -Goal) is det.
+%
+%   As conj_goal/6, for a query whose solutions matter only through the action: Literals
+%   are split into their components (literal_components/2), and a component that holds no
+%   action/1 literal is proved once (once/1), as is every component when Bound is `last`
+%   (the query is proved once). Its variables are then existential: "some ball is still in
+%   room a" is true or not whatever the action, and a query that binds the action's
+%   arguments from the facts does not prove the action's part again for every such ball,
+%   nor does a failing query try every ball before it fails. Goal has the truth value of
+%   conj_goal/6's and, with Bound `index`, the same solutions for Action in the same order
+%   of first occurrence (the components are independent: their solutions are a product).
+
+query_goal(Lits, Facts, A, N, Bound, Goal) :-
+    literal_components(Lits, Comps),
+    maplist(component_goal(Facts, A, N, Bound), Comps, Goals),
+    list_conj(Goals, Goal).
+
+component_goal(Facts, A, N, Bound, Comp, Goal) :-
+    conj_goal(Comp, Facts, A, N, Bound, G),
+    (   ( Bound == last ; \+ memberchk(action(_), Comp) ),
+        \+ ( Bound == last, Comp = [_] )          % (then G is memberchk/2 already)
+    ->  Goal = once(G)
+    ;   Goal = G
+    ).
+
+%!  literal_components(+Literals:list, -Components:list) is det.
+%
+%   Components are the lists of Literals (each in its order in Literals) that share
+%   variables, directly or through others, in the order of their first literals; a literal
+%   without variables is a component of its own.
+
+literal_components([], []).
+literal_components([L|Ls], [[L|Comp]|Comps]) :-
+    term_variables(L, Vs),
+    component_of(Vs, Ls, Comp, Rest),
+    literal_components(Rest, Comps).
+
+%   Comp: the literals of Ls linked to the variables Vs (through each other), Rest the
+%   others, both in order.
+component_of(Vs, Ls, Comp, Rest) :-
+    partition(shares(Vs), Ls, In, Out),
+    (   In == []
+    ->  Comp = [], Rest = Ls
+    ;   term_variables(Vs-In, Vs1),
+        component_of(Vs1, Out, Comp1, Rest),
+        merge_in_order(Ls, In, Comp1, Comp)
+    ).
+
+shares(Vs, L) :-
+    term_variables(L, LVs),
+    member(X, LVs), member(Y, Vs), X == Y,
+    !.
+
+%   The literals of A and B (both sub-lists of Ls), in Ls' order.
+merge_in_order(Ls, A, B, Merged) :-
+    include(in_either(A, B), Ls, Merged).
+
+in_either(A, B, L) :-
+    (   member(X, A), X == L
+    ->  true
+    ;   member(X, B), X == L
+    ).
 
 %!  facts_index(+Facts:list, -Index) is det.
 %

@@ -147,7 +147,8 @@ tg_new_stats(Q, N, K, Clock, Keep, l(Q, N, 0, 0.0, 0.0, C, Clock, Clock, Ring)) 
 %!  tg_compile_tree(+KB, +Root) is det.
 %
 %   Compile the tree Root into KB's tg_sort_/5 clause: an if-then-else per node, whose
-%   condition proves the node's query (its path and its test) on the example's facts; and
+%   condition proves the node's query (its path and its test) on the example's facts, each
+%   part of it that shares no variable with the rest once (tg_bias:query_goal/6); and
 %   its tg_leaves_/3 fact: the leaf ids left to right and the largest.
 
 tg_compile_tree(KB, Root) :-
@@ -164,7 +165,7 @@ tree_goal(leaf(Id, _, _, _), _, _, _, _, Leaf, Leaf = Id).
 tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )) :-
     append(Path, Lits, Path1),
     copy_term(Path1, Test),
-    conj_goal(Test, F, A, N, last, Cond),
+    query_goal(Test, F, A, N, last, Cond),
     tree_goal(Yes, Path1, F, A, N, Leaf, GYes),
     tree_goal(No, Path, F, A, N, Leaf, GNo).
 
@@ -172,13 +173,14 @@ tree_goal(node(_, Lits, _, Yes, No), Path, F, A, N, Leaf, ( Cond -> GYes ; GNo )
 %
 %   Add the tg_cands_/6 clause of Leaf: it tests every candidate of the leaf on an example,
 %   Hits listing the positions (from 1) of those that succeed, in order; and its tg_path_/5
-%   clause: every solution of its path query (the action an open term the query binds), on
+%   clause: every solution of its path query (the action an open term the query binds; a
+%   part of the query that shares no variable with the action proved once), on
 %   an index of the facts (tg_bias:facts_index/2): with the action open, a literal is
 %   proved once per solution of the literals before it, each a look-up.
 
 tg_compile_leaf(KB, leaf(Id, PathLits0, _, Cands0)) :-
     copy_term(PathLits0, PathLits1),
-    conj_goal(PathLits1, PF, PA, PN, index, PathBody),
+    query_goal(PathLits1, PF, PA, PN, index, PathBody),
     assertz((tg_path_(KB, Id, PF, PA, PN) :- PathBody)),
     copy_term(PathLits0-Cands0, PathLits-Cands),
     term_variables(PathLits, PV),

@@ -44,6 +44,7 @@ facts, kept sorted (an ordered set). The vocabulary (docs/worlds.md):
   | task_rmode(Task, Mode)                | optional: a mode of the language bias for episodes of Task only (world_for_task/2) |
   | task_own_bias(Task)                   | optional: Task's bias is its task_rmode/2 modes alone, without rmode/1 |
   | discount(Gamma)                       | optional: the task's discount, the learners' gamma (default theirs) |
+  | learner_param(Learner, Name, Value)   | optional: the world's value of a learner's parameter, over the learner's defaults in worlds (temperature) |
   | relation/1, rmode/1, rconst/2         | the learner's view and language bias, as in a domain (docs/tg.md) |
   | signature/1, subtype/2, type/2        | optional: argument types of relations and actions; with no rmode/1 the bias is generated from them (world_bias.pl) |
 
@@ -124,12 +125,14 @@ relrl_tg_bias:own_rmodes(KB) :-
 %!  world_info(+KB, -Info:list) is det.
 %
 %   Info is [tasks(Tasks), actions(Templates), relations(Templates), sizes(Train, Test),
-%   optimal(Known), discount(Gamma)]: the world's declarations (sizes [] when not declared;
-%   Known true when the world states its optimal number of steps; Gamma `none` when the
-%   world states no discount).
+%   optimal(Known), discount(Gamma), learner_params(Params)]: the world's declarations
+%   (sizes [] when not declared; Known true when the world states its optimal number of
+%   steps; Gamma `none` when the world states no discount; Params a [Learner, Name, Value]
+%   list for each learner_param/3).
 
 world_info(KB, [tasks(Tasks), actions(Actions), relations(Relations), sizes(Train, Test),
-                optimal(Known), discount(Gamma)]) :-
+                optimal(Known), discount(Gamma), learner_params(Params)]) :-
+    findall([L, N, V], declared(KB, learner_param(L, N, V)), Params),
     (   declared(KB, discount(G)), number(G)
     ->  Gamma = G
     ;   Gamma = none

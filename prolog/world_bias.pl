@@ -32,10 +32,13 @@ Each argument of a relation's signature becomes, in a mode:
   - each constant of the type (`floor`, `parcel`), but not those of an enumerated type an
     action names (a test speaks of the direction the action takes, not of north).
 
-A mode is kept when it is linked to the path (some `+`), or names constants only (a test
-of the state such as `here(parcel)` or `carried`); a mode with new variables and no `+`
-would ask whether the state holds such facts at all, which tells states near the goal
-from far ones and not a good action from a bad one. An action's signature gives
+A mode is kept when it is linked to the path (some `+`), names constants only (a test
+of the state such as `here(parcel)` or `carried`), or names a constant of an enumerated
+type beside its new variables (`at(-ball, rooma)`: some ball is still in room a, a fact of
+one of the world's landmarks that an action without arguments, gripper's `move`, turns
+on); any other mode with new variables and no `+` would ask whether the state holds such
+facts at all ("some block is on some block", "some block is on the floor"), which tells
+states near the goal from far ones and not a good action from a bad one. An action's signature gives
 `action(...)` modes with `-S` for each object or enumerated type and the constants not of
 an enumerated type (`move(-block, floor)`, `go(-dir)`). A
 mode whose `+S` no kept mode can bind (no `-S` for it) is dropped. Relations without a
@@ -108,7 +111,7 @@ signature_mode(KB, Types, Sig, Mode) :-
         compound_or_atom(Name, Opts, A),
         Mode = action(A)
     ;   maplist(relation_option(KB, Types), Args, Opts),
-        linked_or_ground(Opts),
+        linked_or_ground(KB, Opts),
         compound_or_atom(Name, Opts, Mode)
     ).
 
@@ -155,11 +158,23 @@ action_option(KB, Types, T, Opt) :-
         \+ ( member(S, VarTypes), declared(KB, type(Opt, S)) )
     ).
 
-linked_or_ground(Opts) :-
+linked_or_ground(KB, Opts) :-
     (   memberchk(+(_), Opts)
     ->  true
     ;   \+ memberchk(-(_), Opts)
+    ->  true
+    ;   member(C, Opts),
+        enumerated_constant(KB, C)
+    ->  true
     ).
+
+% C is a constant of an enumerated type (rooma of room, left of gripper; not floor, a place
+% that blocks are too).
+enumerated_constant(KB, C) :-
+    atomic(C),
+    declared(KB, type(C, S)),
+    var_type(KB, S),
+    !.
 
 % The modes whose every +S some mode binds (a -S of a kept mode), to a fixpoint.
 bindable(Modes0, Modes) :-

@@ -101,6 +101,12 @@ static_problem(KB, problem(File, Line, Msg)) :-
     format(string(Msg), "sizes(~q, ~q): use sizes(train, [3, 4, 5]) or sizes(test, [...]) \c
                          with positive integers", [K, L]).
 static_problem(KB, problem(File, Line, Msg)) :-
+    world_clause(KB, learner_param(L, N, V), true, Ref),
+    \+ ( atom(L), atom(N), number(V) ),
+    clause_location(Ref, File, Line),
+    format(string(Msg), "learner_param(~q, ~q, ~q): a learner, a parameter's name and a \c
+                         number, e.g. learner_param(tg, temperature, 1.0)", [L, N, V]).
+static_problem(KB, problem(File, Line, Msg)) :-
     world_clause(KB, discount(G), true, Ref),
     \+ ( number(G), G > 0, G =< 1 ),
     clause_location(Ref, File, Line),

@@ -51,6 +51,7 @@ world_predicate(step_bound/3, optional).
 world_predicate(optimal_steps/3, optional).
 world_predicate(sizes/2, optional).
 world_predicate(discount/1, optional).
+world_predicate(learner_param/3, optional).
 world_predicate(task_rmode/2, optional).
 world_predicate(task_own_bias/1, optional).
 world_predicate(signature/1, optional).

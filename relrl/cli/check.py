@@ -144,6 +144,9 @@ def _check_world(args: argparse.Namespace) -> int:
             print(f"optimal steps: {optimal}")
             if world.discount is not None:
                 print(f"discount: {world.discount:g}")
+            for learner, params in world.learner_params.items():
+                print(f"{learner}'s parameters (learner_param/3): "
+                      + ", ".join(f"{k}={v:g}" for k, v in params.items()))
         for warning in [*bias_warnings(world.kb), *warnings]:
             print(warning, file=sys.stderr)
         if problems:

@@ -192,9 +192,12 @@ def _add_worlds(sub) -> None:
                    help="comma-separated learners (default: every learner of worlds)")
     w.add_argument("--seeds", default=None,
                    help="comma-separated seeds or ranges, 0-9 (default 0,1,2)")
-    w.add_argument("--sizes", default="3,4,5", help="training sizes (default 3,4,5)")
-    w.add_argument("--test-sizes", default="10,20,50",
-                   help="sizes evaluated with no further learning (default 10,20,50)")
+    w.add_argument("--sizes", default=None,
+                   help="training sizes of every world (default: each world's sizes(train, "
+                        "...), else 3,4,5)")
+    w.add_argument("--test-sizes", default=None,
+                   help="sizes evaluated with no further learning, in every world (default: "
+                        "each world's sizes(test, ...), else 10,20,50)")
     w.add_argument("--episodes", type=int, default=None,
                    help="learning episodes per job (default 1000; --quick 200)")
     w.add_argument("--block", type=int, default=None,
@@ -500,9 +503,10 @@ def build_worlds_config(args: argparse.Namespace):
                               f"{', '.join(learners(WORLDS))})")
     if (args.tasks is not None and not config.tasks) or not config.learners:
         raise ConfigError("--tasks and --learners must name at least one each")
-    config.train_sizes = _ints(args.sizes, "--sizes")
-    config.test_sizes = _ints(args.test_sizes, "--test-sizes")
-    if any(s < 1 for s in config.train_sizes + config.test_sizes):
+    given = {"train": _ints(args.sizes, "--sizes") if args.sizes is not None else None,
+             "test": (_ints(args.test_sizes, "--test-sizes") if args.test_sizes is not None
+                      else None)}
+    if any(s < 1 for ss in given.values() if ss is not None for s in ss):
         raise ConfigError("sizes must be whole numbers >= 1")
     config.episodes = (args.episodes if args.episodes is not None
                        else 200 if args.quick else 1000)
@@ -540,8 +544,15 @@ def build_worlds_config(args: argparse.Namespace):
                                             if t.split("(")[0] in names]
                 for task in config.world_tasks[path]:
                     world.task(task)
+            declared = world.declared_sizes
+            default = {"train": [3, 4, 5], "test": [10, 20, 50]}
+            config.world_sizes[path] = {k: given[k] or declared[k] or default[k]
+                                        for k in ("train", "test")}
             for task in config.world_tasks[path]:
-                world.check_instance(task, [*config.train_sizes, *config.test_sizes])
+                world.check_instance(task, [*config.world_sizes[path]["train"],
+                                            *config.world_sizes[path]["test"]])
+    config.train_sizes = sorted({s for ss in config.world_sizes.values() for s in ss["train"]})
+    config.test_sizes = sorted({s for ss in config.world_sizes.values() for s in ss["test"]})
     if args.tasks is None:
         config.tasks = list(dict.fromkeys(t for ts in config.world_tasks.values() for t in ts))
     missing = [t for t in config.tasks

@@ -54,6 +54,10 @@ class WorldsConfig:
     learner_params: dict[str, dict[str, float]] = field(default_factory=dict)
     train_sizes: list[int] = field(default_factory=lambda: [3, 4, 5])
     test_sizes: list[int] = field(default_factory=lambda: [10, 20, 50])
+    #: per world file, its own {"train": [...], "test": [...]} sizes (its sizes/2
+    #: declarations, when no sizes were given), over train_sizes and test_sizes (then the
+    #: union of the worlds')
+    world_sizes: dict[str, dict[str, list[int]]] = field(default_factory=dict)
     episodes: int = 1000
     block: int = 100
     eval_episodes: int = 100
@@ -74,12 +78,19 @@ class WorldsConfig:
         """The tasks run in ``world``: those of ``tasks`` it declares."""
         return self.world_tasks.get(world, self.tasks)
 
+    def sizes_of(self, world: str, which: str) -> list[int]:
+        """The training (``which`` = ``"train"``) or test sizes of ``world``."""
+        own = self.world_sizes.get(world, {}).get(which)
+        if own is not None:
+            return list(own)
+        return list(self.train_sizes if which == "train" else self.test_sizes)
+
     def learn_config(self, world: str, task: str, learner: str, seed: int) -> LearnConfig:
         """The :class:`LearnConfig` of one job."""
         return LearnConfig(world=world, task=task, learner=learner,
                            params=dict(self.learner_params.get(learner, {})),
-                           train_sizes=list(self.train_sizes),
-                           test_sizes=list(self.test_sizes), episodes=self.episodes,
+                           train_sizes=self.sizes_of(world, "train"),
+                           test_sizes=self.sizes_of(world, "test"), episodes=self.episodes,
                            block=self.block, eval_episodes=self.eval_episodes, seed=seed,
                            updates=self.updates, rule_seconds=self.rule_seconds,
                            speed=self.speed, restarts=self.restarts,
@@ -90,6 +101,7 @@ class WorldsConfig:
         out = asdict(self)
         out["worlds"] = [Path(w).name for w in self.worlds]
         out["world_tasks"] = {Path(w).name: ts for w, ts in self.world_tasks.items()}
+        out["world_sizes"] = {Path(w).name: ss for w, ss in self.world_sizes.items()}
         return out
 
 
@@ -390,7 +402,10 @@ def worlds_table(results: dict[str, Any]) -> str:
 
     sizes = results["config"]["test_sizes"]
     train = results["config"]["train_sizes"]
-    head = (f"| world | task | learner | seeds | of optimal, sizes {min(train)}–{max(train)} "
+    own = {w: ss["train"] for w, ss in results["config"].get("world_sizes", {}).items()}
+    mixed = len({tuple(ts) for ts in own.values()}) > 1
+    span = "training sizes" if mixed else f"sizes {min(train)}–{max(train)}"
+    head = (f"| world | task | learner | seeds | of optimal, {span} "
             "(worst seed) | " + " | ".join(f"size {s} (worst)" for s in sizes)
             + " | all reached the goal | episodes to 0.95 | positions |")
     lines = [head, "|" + "---|" * (9 + len(sizes) - 1)]
@@ -406,7 +421,9 @@ def worlds_table(results: dict[str, Any]) -> str:
         lines.append(
             f"| {text(Path(r['world']).stem)} | {text(r['task'])} | {text(r['learner'])} | "
             f"{r['seeds']}{_restarted(r)} | "
-            f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
+            + (f"{min(own[r['world']])}–{max(own[r['world']])}: "
+               if mixed and r["world"] in own else "")
+            + f"{_f(r['train_optimality'])} ({_f(r['train_optimality_min'])}) | "
             + " | ".join(f"{_f(t['optimality'])} ({_f(t.get('optimality_min'))})"
                          for t in tests)
             + f" | {all_reached} | {_f(r['episodes_to_095'], 0)} | "

@@ -130,12 +130,19 @@ class World:
         self.tasks: list[Term] = list(info["tasks"][0])
         self.actions: list[Term] = list(info["actions"][0])
         self.relations: list[Term] = list(info["relations"][0])
-        self.train_sizes: list[int] = list(info["sizes"][0]) or [3]
-        self.test_sizes: list[int] = list(info["sizes"][1])
+        #: the sizes the world declares (sizes/2; [] when it does not)
+        self.declared_sizes: dict[str, list[int]] = {"train": list(info["sizes"][0]),
+                                                     "test": list(info["sizes"][1])}
+        self.train_sizes: list[int] = self.declared_sizes["train"] or [3]
+        self.test_sizes: list[int] = self.declared_sizes["test"]
         self.optimal_known: bool = info["optimal"][0] == "true"
         #: the task's discount (discount/1), the learners' gamma unless given; None: theirs
         self.discount: float | None = (None if info["discount"][0] == "none"
                                        else float(info["discount"][0]))
+        #: per learner, the parameters the world gives it (learner_param/3)
+        self.learner_params: dict[str, dict[str, float]] = {}
+        for learner, name, value in info["learner_params"][0]:
+            self.learner_params.setdefault(str(learner), {})[str(name)] = float(value)
         self.engine = Engine(self.kb)
         self.learner_name: str | None = None
 
@@ -254,11 +261,12 @@ class World:
 
     def learner(self, name: str, **params: float) -> Learner:
         """The learner ``name`` with its defaults in worlds, the world's discount as its
-        gamma (discount/1), and ``params`` over both
-        (:func:`~relrl.learners.make_world_learner`)."""
-        if self.discount is not None and "gamma" not in params:
-            params = {**params, "gamma": self.discount}
-        return make_world_learner(name, **params)
+        gamma (discount/1) and the world's values of its parameters (learner_param/3) over
+        them, and ``params`` over all (:func:`~relrl.learners.make_world_learner`)."""
+        own = dict(self.learner_params.get(name, {}))
+        if self.discount is not None:
+            own.setdefault("gamma", self.discount)
+        return make_world_learner(name, **{**own, **params})
 
     def attach(self, learner: Learner, seed: int, task: Term | str | None = None) -> None:
         """Start ``learner`` (a learner of worlds: :func:`relrl.learners.learners`

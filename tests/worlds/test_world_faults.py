@@ -167,6 +167,54 @@ def test_experiment_worlds_quick_runs_tg_alone() -> None:
     assert (given.learners, given.episodes) == (["ptg"], 7)
 
 
+
+def test_experiment_worlds_takes_each_worlds_declared_sizes() -> None:
+    """Without --sizes and --test-sizes each world learns and is tested on its own
+    sizes(train, ...) and sizes(test, ...) (gripper.pl's, blocks.pl's), as relrl learn
+    does; given, they hold for every world; config's sizes are the union."""
+    import argparse
+
+    from relrl.cli.experiment import add_arguments, build_worlds_config
+    from relrl.worlds import World
+
+    gripper = BLOCKS.parent / "gripper.pl"
+    with World(gripper) as world:
+        train, test = world.declared_sizes["train"], world.declared_sizes["test"]
+    assert train and train != [3, 4, 5] and test
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    both = [str(BLOCKS), str(gripper)]
+    own = build_worlds_config(parser.parse_args(["worlds", "--worlds", ",".join(both),
+                                                 "--learners", "tg"]))
+    g = own.learn_config(str(gripper.resolve()), "deliver", "tg", 0)
+    b = own.learn_config(str(BLOCKS.resolve()), "stack", "tg", 0)
+    assert (g.train_sizes, g.test_sizes) == (train, test)
+    assert (b.train_sizes, b.test_sizes) == ([3, 4, 5], [10, 20, 50])
+    assert own.train_sizes == sorted({*train, 3, 4, 5})
+    assert own.to_dict()["world_sizes"]["gripper.pl"] == {"train": train, "test": test}
+    given = build_worlds_config(parser.parse_args(["worlds", "--worlds", ",".join(both),
+                                                   "--learners", "tg", "--sizes", "2",
+                                                   "--test-sizes", "6,7"]))
+    for world, task in [(gripper, "deliver"), (BLOCKS, "stack")]:
+        c = given.learn_config(str(world.resolve()), task, "tg", 0)
+        assert (c.train_sizes, c.test_sizes) == ([2], [6, 7])
+
+
+def test_a_world_gives_its_learners_parameters() -> None:
+    """learner_param/3: gripper.pl's tg explores at temperature 1, over tg's worlds default
+    (blocks.pl: 0.1) and under a parameter given; its discount is tg's gamma."""
+    from relrl.worlds import World
+
+    with World(BLOCKS.parent / "gripper.pl") as world:
+        assert world.learner_params == {"tg": {"temperature": 1.0}}
+        tg = world.learner("tg")
+        assert (tg.params["temperature"], tg.params["gamma"]) == (1.0, 0.95)
+        given = world.learner("tg", temperature=0.3, gamma=0.9)
+        assert (given.params["temperature"], given.params["gamma"]) == (0.3, 0.9)
+    with World(BLOCKS) as world:
+        assert world.learner_params == {}
+        assert world.learner("tg").params["temperature"] == 0.1
+
 # ---- B: relrl learn stopped keeps what it learned ------------------------------------------
 
 LONG_LEARN = ("learn", str(BLOCKS), "--task", "stack", "--episodes", "1000000", "--block",
