@@ -237,7 +237,7 @@ def add_restart_options(parser: argparse.ArgumentParser) -> None:
                         help="check the learned policy on greedy episodes of the training "
                              "sizes; when it wastes a move there, learn again from nothing "
                              "(a stream of its own), up to N times, and keep the first "
-                             "optimal attempt or the best (3; 0: no check)")
+                             "optimal attempt, else the first (3; 0: no check)")
     parser.add_argument("--check-episodes", type=int, default=1000, metavar="N",
                         help="greedy episodes of that check (1000, and at most --episodes)")
 
@@ -259,7 +259,7 @@ def check_line(e: dict, restarts: int) -> str:
     who = f"restart {e['attempt']} (seed {e['seed']})" if e["attempt"] else "the policy"
     then = ("kept" if e["perfect"] else
             f"learning again from nothing: restart {e['attempt'] + 1} of {restarts}"
-            if e["restart"] else "no restart left: the best attempt is kept")
+            if e["restart"] else "no restart left: the first attempt is kept")
     return (f"check of {who}: {e['check_episodes']} greedy episodes of the training sizes, "
             f"{what}; {then}")
 

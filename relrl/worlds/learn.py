@@ -9,7 +9,7 @@ above 0, the learned policy is checked at the end on ``check_episodes`` greedy e
 training sizes (at most ``episodes``): a tree whose greedy choice wastes a move there (or
 misses the goal) is set aside and a fresh learner learns the task again from nothing, from a
 random stream of its own, up to R times; the first attempt that acts optimally in every
-check episode is kept, or else the attempt with the best check. A tree grows by greedy
+check episode is kept, or else the first attempt. A tree grows by greedy
 splits it never revises, and the order of its first splits decides how it acts far beyond
 its training sizes; a tree that already wastes moves on its training sizes is the one that
 fails there (docs/worlds.md, Restarts). Evaluation draws its start states from a random
@@ -129,7 +129,7 @@ class _Run:
         self.policy_episodes: int | None = None     # learning episodes of the saved policy
         self.attempt, self.attempt_done = 0, 0      # the attempt learning, its episodes
         self.attempts: list[dict[str, Any]] = []    # each checked attempt
-        self.best: tuple[float, int, Path] | None = None   # the kept attempt's check, file
+        self.best: tuple[float, int, Path] | None = None   # the kept attempt: check, number, file
 
     def _go_on(self) -> None:
         """Stop here when a stop was asked for."""
@@ -147,7 +147,7 @@ class _Run:
             header += f" (after {self.attempt_done} of {config.episodes} learning episodes)"
         self._go_on()
         self.world.save_policy(self.saved, header)
-        if self.best is None:           # (else policy_out keeps the best checked attempt)
+        if self.best is None:           # (else policy_out keeps the kept attempt)
             self._publish(self.saved)
             self.policy_episodes = self.attempt_done
 
@@ -160,8 +160,8 @@ class _Run:
 
     def _check(self, task: Any, report: Callable[[dict[str, Any]], None] | None) -> bool:
         """Check the attempt's policy on its own greedy episodes of the training sizes;
-        keep it when it is the best so far. True: it acted optimally in every episode (no
-        restart needed)."""
+        keep it when it is the first or acted optimally in every episode (True: no restart
+        needed)."""
         config, k = self.config, self.attempt
         self._go_on()
         # (at most one check episode per learning episode: a check never costs more than
@@ -176,7 +176,11 @@ class _Run:
                  "episodes": self.attempt_done, "check_episodes": ev["episodes"],
                  "optimality": ev["optimality"], "success": ev["success"]}
         self.attempts.append(entry)
-        if self.best is None or value > self.best[0]:
+        perfect = value >= 1.0
+        # the check vouches for a policy optimal in every episode, and ranks no others (in
+        # gripper a better check of an imperfect policy acted worse at 50 balls): the first
+        # attempt is kept until one is optimal in its check
+        if self.best is None or perfect:
             from relrl.outdir import write_atomic
 
             kept = write_atomic(self.saved.with_name(f"attempt-{k}.pl"),
@@ -184,7 +188,6 @@ class _Run:
             self.best = (value, k, kept)
             self._publish(kept)
             self.policy_episodes = self.attempt_done
-        perfect = value >= 1.0
         if report is not None:
             report({"kind": "check", "entry": {**entry, "perfect": perfect,
                                                "restart": not perfect and k < config.restarts}})

@@ -344,32 +344,46 @@ def _restart_config(**kw: object):
 def test_a_policy_that_wastes_moves_on_its_training_sizes_is_learned_again(
         tmp_path: Path) -> None:
     """With restarts, a policy checked on greedy episodes of the training sizes that is not
-    optimal in every one is learned again from nothing, from a stream of its own; the best
-    checked attempt is kept (policy_out, results) and the run is the same every time."""
+    optimal in every one is learned again from nothing, from a stream of its own; the first
+    attempt optimal in its check is kept (policy_out, results), not an imperfect one with a
+    better check; the run is the same every time."""
     from relrl.worlds.learn import learn_task, restart_seed
 
     checks = []
-    out = learn_task(_restart_config(), policy_out=tmp_path / "a.pl",
+    config = _restart_config(seed=2, episodes=20, block=20)
+    out = learn_task(config, policy_out=tmp_path / "a.pl",
                      report=lambda ev: checks.append(ev) if ev["kind"] == "check" else None)
     attempts = out["attempts"]
-    assert len(attempts) == 3                  # 10 episodes: no attempt is optimal
     assert [a["attempt"] for a in attempts] == [0, 1, 2]
-    assert [a["seed"] for a in attempts] == [4, restart_seed(4, 1), restart_seed(4, 2)]
-    # (a check has at most one episode per learning episode)
-    assert all(a["optimality"] < 1 and a["check_episodes"] == 10 for a in attempts)
-    values = [a["optimality"] for a in attempts]
-    kept = values.index(max(values))
-    assert out["kept_attempt"] == kept
-    assert [c["entry"]["restart"] for c in checks] == [True, True, False]
-    text = (tmp_path / "a.pl").read_text()
-    assert (f"restart {kept}" in text.splitlines()[0]) == (kept > 0)
+    assert [a["seed"] for a in attempts] == [2, restart_seed(2, 1), restart_seed(2, 2)]
+    assert [a["check_episodes"] for a in attempts] == [20, 20, 20]   # at most the episodes
+    assert attempts[0]["optimality"] < attempts[1]["optimality"] < 1
+    assert attempts[2]["optimality"] == 1.0
+    assert out["kept_attempt"] == 2
+    assert [(c["entry"]["perfect"], c["entry"]["restart"]) for c in checks] == [
+        (False, True), (False, True), (True, False)]
+    assert "restart 2 (seed" in (tmp_path / "a.pl").read_text().splitlines()[0]
     # the curve: every attempt's points, episodes counted over all of them
-    assert [c["episodes"] for c in out["curve"]] == [0, 10, 20, 30]
+    assert [c["episodes"] for c in out["curve"]] == [0, 20, 40, 60]
     assert [c.get("attempt", 0) for c in out["curve"]] == [0, 0, 1, 2]
-    assert out["final"] == out["curve"][kept + 1]
-    again = learn_task(_restart_config(), policy_out=tmp_path / "b.pl")
+    assert out["final"] == out["curve"][3]
+    again = learn_task(config, policy_out=tmp_path / "b.pl")
     assert (tmp_path / "b.pl").read_bytes() == (tmp_path / "a.pl").read_bytes()
     assert again["attempts"] == attempts
+
+
+def test_with_no_attempt_optimal_the_first_is_kept(tmp_path: Path) -> None:
+    """When no attempt is optimal in its check the first is kept, whatever the others'
+    checks: the policy, the final point and the test sizes are the first attempt's."""
+    from relrl.worlds.learn import learn_task
+
+    out = learn_task(_restart_config(), policy_out=tmp_path / "a.pl")
+    assert len(out["attempts"]) == 3 and out["kept_attempt"] == 0
+    assert all(a["optimality"] < 1 for a in out["attempts"])
+    assert out["final"] == out["curve"][1]
+    alone = learn_task(_restart_config(restarts=0), policy_out=tmp_path / "b.pl")
+    assert (tmp_path / "a.pl").read_bytes() == (tmp_path / "b.pl").read_bytes()
+    assert out["test"] == alone["test"]
 
 
 def test_a_policy_optimal_in_its_check_is_kept_at_once(tmp_path: Path) -> None:
