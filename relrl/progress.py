@@ -56,6 +56,15 @@ class Progress:
                 self._last = now
                 log.info("%s", self.line())
 
+    def grow(self, n: int) -> None:
+        """``n`` more pieces of work than the total said (a total not known: nothing)."""
+        if self.total is None:
+            return
+        self.total += n
+        if self._bar is not None:
+            self._bar.total = self.total
+            self._bar.refresh()
+
     def set_description(self, text: str) -> None:
         """Change what the bar says."""
         self.desc = text

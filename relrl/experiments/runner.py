@@ -97,6 +97,11 @@ class ProgressBar:
         self._progress.set_description(label)
         self._progress.update(units)
 
+    def grow(self, units: int) -> None:
+        """``units`` more to do than the bar was made for (a job learning again)."""
+        self.total += units
+        self._progress.grow(units)
+
     def close(self) -> None:
         """End the bar."""
         self._progress.close()
@@ -240,6 +245,8 @@ def run_jobs(fn: JobFn, arglist: list[tuple], *, workers: int = 1, engine: str =
         outcome.events[index].append(ev)
         if ev.get("kind") == "point":
             bar.update(f"{label(arglist[index])} point {ev.get('point', '')}")
+        elif ev.get("kind") == "check" and ev["entry"].get("restart"):
+            bar.grow(units - 1)     # a restart's points: a job's less its first evaluation
         if on_event is not None:
             on_event(index, ev)
 

@@ -37,3 +37,15 @@ def square_or_fail(x: int, *, report) -> dict:
     if x == 2:
         raise ConfigError(f"x={x}: not a good value")
     return square(x, report=report)
+
+
+def learned_again(x: int, *, report) -> dict:
+    """Three points, a check that restarts, two more points (a restart has no initial
+    evaluation), a check that keeps it."""
+    for point in range(3):
+        report({"kind": "point", "point": point})
+    report({"kind": "check", "entry": {"attempt": 0, "restart": True}})
+    for point in range(3, 5):
+        report({"kind": "point", "point": point})
+    report({"kind": "check", "entry": {"attempt": 1, "restart": False}})
+    return {"x": x}

@@ -49,3 +49,22 @@ def test_a_worker_that_vanishes_stops_the_run_naming_the_job() -> None:
 def test_bad_runner_options(kwargs: dict, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         run_jobs(jobs.square, [(1,)], **kwargs)
+
+
+def test_a_job_learned_again_grows_the_progress_total(monkeypatch) -> None:
+    """A restart (a check event that restarts) adds a job's points less its first
+    evaluation to the bar: the bar ends full, not past its total."""
+    from relrl.experiments import runner
+
+    bars = []
+
+    made = runner.ProgressBar
+
+    def keep(total: int):
+        bars.append(made(total))
+        return bars[-1]
+
+    monkeypatch.setattr(runner, "ProgressBar", keep)
+    out = run_jobs(jobs.learned_again, [(1,), (2,)], workers=1, units=3)
+    assert out.complete
+    assert bars[0].total == 2 * 3 + 2 * 2 and bars[0].done == bars[0].total

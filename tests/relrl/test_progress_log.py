@@ -96,3 +96,20 @@ def test_a_session_writes_its_log_file(tmp_path: Path, capsys) -> None:
     assert "session started" in text and "evaluation after 10 steps" in text
     assert main(["-v", "run", str(script), "--out", str(tmp_path / "o2"), "--no-plots"]) == 0
     assert "evaluation after 10 steps" in capsys.readouterr().err
+
+
+def test_progress_grows_when_more_work_comes(monkeypatch) -> None:
+    """grow(n): n more pieces than the total said (a job learning again); an unknown total
+    stays unknown."""
+    err = io.StringIO()
+    monkeypatch.setattr("sys.stderr", err)
+    log.setup(0)
+    bar = progress(5, "points", unit="point", interval=0.0)
+    bar.grow(3)
+    bar.update(8)
+    assert bar.total == 8 and "8/8" in err.getvalue().splitlines()[-1]
+    bar.close()
+    unknown = progress(None, "points", interval=0.0)
+    unknown.grow(2)
+    assert unknown.total is None
+    unknown.close()
