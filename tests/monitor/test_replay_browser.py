@@ -159,6 +159,12 @@ def test_the_tree_pans_zooms_and_fits(page, recorded: Path) -> None:
         _scrub(page, 80)
         _wait_text(page, "#scrub-label", "t 80 of 80")
         page.wait_for_selector("#tree svg g.node")
+        # the picture of t 80, not t 1's still shown while t 80's is fetched (on a loaded
+        # machine it came after the fit was read, and the fit of the new picture differed)
+        want = page.evaluate("""async () => {
+            const d = await getJSON("api/tree", { t: 80 });
+            return d.svg.match(/viewBox="([^"]+)"/)[1].split(/[\\s,]+/).map(Number); }""")
+        wait_until(lambda: page.evaluate("() => tree.base") == want, 15, "the tree of t 80")
         page.locator("#tree-box").scroll_into_view_if_needed()
         box = page.locator("#tree-box").bounding_box()
         base = page.evaluate("() => tree.base")
