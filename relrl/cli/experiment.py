@@ -526,6 +526,8 @@ def build_worlds_config(args: argparse.Namespace):
     for learner in config.learners:
         make_world_learner(learner, **config.learner_params.get(learner, {}))  # validate
     config.rule_seconds = args.rule_seconds
+    # a world that declares no sizes: WorldsConfig's (3-5, then 10, 20, 50)
+    default = {"train": config.train_sizes, "test": config.test_sizes}
     from relrl.cli.learn import check_restart_options
 
     check_restart_options(args)
@@ -545,7 +547,6 @@ def build_worlds_config(args: argparse.Namespace):
                 for task in config.world_tasks[path]:
                     world.task(task)
             declared = world.declared_sizes
-            default = {"train": [3, 4, 5], "test": [10, 20, 50]}
             config.world_sizes[path] = {k: given[k] or declared[k] or default[k]
                                         for k in ("train", "test")}
             for task in config.world_tasks[path]:

@@ -37,6 +37,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+from relrl.outdir import write_atomic
 from relrl.worlds.world import RULE_SECONDS, World, score
 
 __all__ = ["LearnConfig", "evaluation_seed", "learn_task", "restart_seed", "step_cost_by_size"]
@@ -129,7 +130,7 @@ class _Run:
         self.policy_episodes: int | None = None     # learning episodes of the saved policy
         self.attempt, self.attempt_done = 0, 0      # the attempt learning, its episodes
         self.attempts: list[dict[str, Any]] = []    # each checked attempt
-        self.best: tuple[float, int, Path] | None = None   # the kept attempt: check, number, file
+        self.kept_attempt: tuple[int, Path] | None = None   # its number and policy file
 
     def _go_on(self) -> None:
         """Stop here when a stop was asked for."""
@@ -142,21 +143,23 @@ class _Run:
         header = (f"relrl policy: {config.learner} learner, world {Path(config.world).name}, "
                   f"task {config.task}")
         if self.attempt:
-            header += f", restart {self.attempt} (seed {restart_seed(config.seed, self.attempt)})"
+            header += f", restart {self.attempt} (seed {self._seed(self.attempt)})"
         if self.attempt_done < config.episodes:
             header += f" (after {self.attempt_done} of {config.episodes} learning episodes)"
         self._go_on()
         self.world.save_policy(self.saved, header)
-        if self.best is None:           # (else policy_out keeps the kept attempt)
+        if self.kept_attempt is None:   # (else policy_out keeps the kept attempt)
             self._publish(self.saved)
             self.policy_episodes = self.attempt_done
 
     def _publish(self, path: Path) -> None:
         """Write the policy in ``path`` to ``policy_out``."""
         if self.policy_out is not None:
-            from relrl.outdir import write_atomic
-
             write_atomic(self.policy_out, path.read_text(encoding="utf-8"))
+
+    def _seed(self, attempt: int) -> int:
+        """The learner's seed of ``attempt`` (0: the run's own)."""
+        return restart_seed(self.config.seed, attempt) if attempt else self.config.seed
 
     def _check(self, task: Any, report: Callable[[dict[str, Any]], None] | None) -> bool:
         """Check the attempt's policy on its own greedy episodes of the training sizes;
@@ -172,7 +175,7 @@ class _Run:
         ev = score(eps)
         # the fraction of optimal; a world with no optimum: the share reaching the goal
         value = ev["optimality"] if ev["optimality"] is not None else ev["success"]
-        entry = {"attempt": k, "seed": config.seed if k == 0 else restart_seed(config.seed, k),
+        entry = {"attempt": k, "seed": self._seed(k),
                  "episodes": self.attempt_done, "check_episodes": ev["episodes"],
                  "optimality": ev["optimality"], "success": ev["success"]}
         self.attempts.append(entry)
@@ -180,12 +183,10 @@ class _Run:
         # the check vouches for a policy optimal in every episode, and ranks no others (in
         # gripper a better check of an imperfect policy acted worse at 50 balls): the first
         # attempt is kept until one is optimal in its check
-        if self.best is None or perfect:
-            from relrl.outdir import write_atomic
-
+        if self.kept_attempt is None or perfect:
             kept = write_atomic(self.saved.with_name(f"attempt-{k}.pl"),
                                 self.saved.read_text(encoding="utf-8"))
-            self.best = (value, k, kept)
+            self.kept_attempt = (k, kept)
             self._publish(kept)
             self.policy_episodes = self.attempt_done
         if report is not None:
@@ -253,13 +254,11 @@ class _Run:
                 break
             self.attempt, self.attempt_done = self.attempt + 1, 0
             world.attach(world.learner(config.learner, **config.params),
-                         restart_seed(config.seed, self.attempt), task)
-        if self.best is not None and self.best[1] != self.attempt:   # an earlier attempt
-            kept = self.best[2]
+                         self._seed(self.attempt), task)
+        if self.kept_attempt is not None and self.kept_attempt[0] != self.attempt:
+            kept = self.kept_attempt[1]                 # an earlier attempt: learned again
             world.attach(world.learner(config.learner, **config.params), config.seed, task)
             world.load_policy(kept)
-            from relrl.outdir import write_atomic
-
             write_atomic(self.saved, kept.read_text(encoding="utf-8"))
         positions, details = world.size()
         if monitor is not None:
@@ -302,7 +301,7 @@ class _Run:
                "memory": {**details, "positions": positions}, "timing": timing}
         if self.attempts:
             out["attempts"] = self.attempts
-            out["kept_attempt"] = self.best[1] if self.best is not None else 0
+            out["kept_attempt"] = self.kept_attempt[0] if self.kept_attempt else 0
         if traces:
             out["traces"] = self.kept
             out["graph"] = world.engine.graph()
@@ -311,7 +310,7 @@ class _Run:
     def _final(self) -> dict[str, Any] | None:
         """The last evaluation point of the kept policy (with restarts: of the kept
         attempt)."""
-        kept = self.best[1] if self.best is not None else self.attempt
+        kept = self.kept_attempt[0] if self.kept_attempt is not None else self.attempt
         return next((e for e in reversed(self.curve) if e.get("attempt", 0) == kept),
                     self.curve[-1] if self.curve else None)
 
